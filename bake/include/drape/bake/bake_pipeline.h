@@ -1,0 +1,21 @@
+#pragma once
+// The whole bake: import, then every collider stage the config enables, into one asset plus a
+// JSON report (what was built, what was left out and why, timings per stage).
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "drape/bake/bake_config.h"
+#include "drape/formats/character_asset.h"
+#include "drape/formats/status.h"
+
+namespace drape::bake {
+
+struct BakeResult {
+  CharacterAsset asset;
+  nlohmann::json report;
+};
+
+Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result);
+
+}  // namespace drape::bake

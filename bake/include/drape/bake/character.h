@@ -1,0 +1,20 @@
+#pragma once
+// The editable bake-side character: what the importer produces and every bake stage reads.
+
+#include <string>
+#include <vector>
+
+#include "drape/formats/character_asset.h"
+
+namespace drape::bake {
+
+struct Character {
+  AssetInfo info;               // source name, unit scale, up axis, source_to_asset
+  SkeletonData skeleton;        // asset frame (metres, +Y up, facing +Z)
+  std::vector<ClipData> clips;  // resampled at a fixed rate
+  MeshData mesh;                // bind pose, welded, weights renormalised
+  double source_to_asset[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // row-major 4x4
+  std::vector<std::string> warnings;  // for the bake report
+};
+
+}  // namespace drape::bake

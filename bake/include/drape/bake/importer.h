@@ -1,0 +1,28 @@
+#pragma once
+// assimp -> Character. Measured pitfalls handled here are listed in ../shared/notes/algorithms.md §1:
+// joints keyed by node name (preferring the node without meshes), rest != bind, unit scale and
+// up axis chosen explicitly, weights renormalised by us (never LimitBoneWeights), no
+// PreTransformVertices/OptimizeGraph, FBX pivots not preserved.
+
+#include <string>
+
+#include "drape/bake/character.h"
+#include "drape/formats/status.h"
+
+namespace drape::bake {
+
+struct ImportOptions {
+  // Metres per source unit. 0 = detect: FBX UnitScaleFactor metadata, glTF metres, then a
+  // sanity check on the body height (a body taller than 20 m is taken to be in cm).
+  double unit_scale = 0.0;
+  // "auto" (FBX UpAxis metadata, +Y otherwise) or one of +X -X +Y -Y +Z -Z: the source axis
+  // that becomes the asset's +Y.
+  std::string up_axis = "auto";
+  float clip_sample_rate = 30.f;  // Hz, (0, 1000]: the rate clips are resampled at
+  // Duplicate joint names are an error unless this is set; then they get "#2", "#3" suffixes.
+  bool rename_duplicate_joints = false;
+};
+
+Status ImportCharacter(const std::string& path, const ImportOptions& options, Character* character);
+
+}  // namespace drape::bake

@@ -1,0 +1,40 @@
+#pragma once
+// The .drape container: a fixed 32-byte header read before any decoding, then a cereal
+// portable-binary payload. See docs/FORMAT.md.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drape/formats/character_asset.h"
+#include "drape/formats/status.h"
+
+namespace drape {
+
+inline constexpr uint32_t kAssetFormatVersion = 1;
+inline constexpr size_t kAssetHeaderSize = 32;
+
+// Serialises the asset into the bytes of a .drape file. Fails if the asset does not validate.
+Status EncodeAsset(const CharacterAsset& asset, std::vector<uint8_t>* bytes);
+
+// Decodes and validates the bytes of a .drape file. `name` is used in messages (usually the
+// path). On failure `asset` is left empty and the message says which check failed and why.
+Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, CharacterAsset* asset);
+
+// Writes to "path.tmp-<pid>" and renames, so a failed write leaves no partial file at `path`.
+Status WriteAssetFile(const std::string& path, const CharacterAsset& asset);
+Status ReadAssetFile(const std::string& path, CharacterAsset* asset);
+
+// Checks every count, index and value range the runtime relies on. Returns a message naming the
+// first offending field, e.g. "skeleton.parents[3] = 7 is not smaller than 3".
+Status ValidateAsset(const CharacterAsset& asset);
+
+// The whole asset as JSON (cereal's JSON archive), for people and golden-file diffs.
+std::string AssetToJson(const CharacterAsset& asset);
+
+// CRC-32 (IEEE 802.3, the zlib polynomial) of the bytes.
+uint32_t Crc32(std::span<const uint8_t> bytes);
+
+}  // namespace drape

@@ -1,0 +1,255 @@
+#pragma once
+// cereal serialisation of the .drape schema. Private to drape_formats: only asset_file.cpp
+// instantiates archives. Every type carries CEREAL_CLASS_VERSION and refuses versions it does
+// not know, naming the type. Arrays are bounded by the payload size before anything is
+// allocated, so a corrupt count cannot make the loader allocate gigabytes.
+
+#include <cereal/archives/json.hpp>
+#include <cereal/archives/portable_binary.hpp>
+#include <cereal/cereal.hpp>
+#include <cereal/types/string.hpp>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "drape/formats/character_asset.h"
+
+namespace drape {
+
+// Thrown inside the decoder only; asset_file.cpp turns it into a Status.
+struct DecodeError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+namespace detail {
+
+// Upper bound on any element count while decoding: the payload size in bytes (every element
+// takes at least one byte). Set by the decoder for the current thread.
+inline thread_local uint64_t g_max_elements = UINT64_MAX;
+
+inline void CheckVersion(uint32_t version, uint32_t known, const char* type) {
+  if (version != known) {
+    throw DecodeError(std::string("unsupported version ") + std::to_string(version) + " of " +
+                      type + " (this build reads version " + std::to_string(known) + ")");
+  }
+}
+
+template <class T>
+constexpr bool kIsFlatFloats = std::is_same_v<T, Float3> || std::is_same_v<T, Quat> ||
+                               std::is_same_v<T, Mat34> || std::is_same_v<T, Plane>;
+
+template <class Archive, class T>
+void SaveArray(Archive& ar, const std::vector<T>& values) {
+  ar(cereal::make_size_tag(static_cast<cereal::size_type>(values.size())));
+  constexpr bool binary = std::is_same_v<Archive, cereal::PortableBinaryOutputArchive>;
+  if constexpr (binary && std::is_arithmetic_v<T>) {
+    ar(cereal::binary_data(values.data(), values.size() * sizeof(T)));
+  } else if constexpr (binary && kIsFlatFloats<T>) {
+    static_assert(sizeof(T) % sizeof(float) == 0);
+    ar(cereal::binary_data(reinterpret_cast<const float*>(values.data()), values.size() * sizeof(T)));
+  } else {
+    for (const T& v : values) ar(v);
+  }
+}
+
+template <class Archive, class T>
+void LoadArray(Archive& ar, std::vector<T>& values) {
+  cereal::size_type count = 0;
+  ar(cereal::make_size_tag(count));
+  if (count > g_max_elements) {
+    throw DecodeError("array of " + std::to_string(count) + " elements exceeds the payload size");
+  }
+  values.resize(static_cast<size_t>(count));
+  if constexpr (std::is_arithmetic_v<T>) {
+    ar(cereal::binary_data(values.data(), values.size() * sizeof(T)));
+  } else if constexpr (kIsFlatFloats<T>) {
+    ar(cereal::binary_data(reinterpret_cast<float*>(values.data()), values.size() * sizeof(T)));
+  } else {
+    for (T& v : values) ar(v);
+  }
+}
+
+}  // namespace detail
+
+// Small value types: fixed layouts, no version of their own (versioned through their owners).
+template <class Archive>
+void serialize(Archive& ar, Float3& v) {
+  ar(cereal::make_nvp("x", v.x), cereal::make_nvp("y", v.y), cereal::make_nvp("z", v.z));
+}
+template <class Archive>
+void serialize(Archive& ar, Quat& q) {
+  ar(cereal::make_nvp("x", q.x), cereal::make_nvp("y", q.y), cereal::make_nvp("z", q.z),
+     cereal::make_nvp("w", q.w));
+}
+template <class Archive>
+void serialize(Archive& ar, Mat34& m) {
+  ar(cereal::make_nvp("m", m.m));
+}
+template <class Archive>
+void serialize(Archive& ar, Transform& t) {
+  ar(cereal::make_nvp("translation", t.translation), cereal::make_nvp("rotation", t.rotation),
+     cereal::make_nvp("scale", t.scale));
+}
+template <class Archive>
+void serialize(Archive& ar, Plane& p) {
+  ar(cereal::make_nvp("normal", p.normal), cereal::make_nvp("offset", p.offset));
+}
+template <class Archive>
+void serialize(Archive& ar, Obb& o) {
+  ar(cereal::make_nvp("center", o.center), cereal::make_nvp("axes", o.axes),
+     cereal::make_nvp("half_extents", o.half_extents));
+}
+
+// A named reference to a vector, so every array goes through the bounded loader and the
+// binary fast path, and still shows up as a named JSON array.
+template <class T>
+struct ArrayRef {
+  std::vector<T>* values;
+};
+template <class Archive, class T>
+void save(Archive& ar, const ArrayRef<T>& ref) {
+  detail::SaveArray(ar, *ref.values);
+}
+template <class Archive, class T>
+void load(Archive& ar, ArrayRef<T>& ref) {
+  detail::LoadArray(ar, *ref.values);
+}
+template <class Archive, class T>
+void Array(Archive& ar, const char* name, std::vector<T>& values) {
+  ArrayRef<T> ref{&values};
+  ar(cereal::make_nvp(name, ref));
+}
+
+template <class Archive>
+void serialize(Archive& ar, AssetInfo& info, const uint32_t version) {
+  detail::CheckVersion(version, 1, "AssetInfo");
+  ar(cereal::make_nvp("source_name", info.source_name),
+     cereal::make_nvp("tool_version", info.tool_version),
+     cereal::make_nvp("unit_scale", info.unit_scale), cereal::make_nvp("up_axis", info.up_axis),
+     cereal::make_nvp("source_to_asset", info.source_to_asset));
+}
+
+template <class Archive>
+void serialize(Archive& ar, SkeletonData& s, const uint32_t version) {
+  detail::CheckVersion(version, 1, "SkeletonData");
+  Array(ar, "joint_names", s.joint_names);
+  Array(ar, "parents", s.parents);
+  Array(ar, "rest_local", s.rest_local);
+  Array(ar, "inverse_bind", s.inverse_bind);
+}
+
+template <class Archive>
+void serialize(Archive& ar, ClipData& c, const uint32_t version) {
+  detail::CheckVersion(version, 1, "ClipData");
+  ar(cereal::make_nvp("name", c.name), cereal::make_nvp("duration", c.duration),
+     cereal::make_nvp("sample_rate", c.sample_rate), cereal::make_nvp("frame_count", c.frame_count));
+  Array(ar, "keys", c.keys);
+}
+
+template <class Archive>
+void serialize(Archive& ar, MeshData& m, const uint32_t version) {
+  detail::CheckVersion(version, 1, "MeshData");
+  Array(ar, "positions", m.positions);
+  Array(ar, "triangles", m.triangles);
+  Array(ar, "influence_offsets", m.influence_offsets);
+  Array(ar, "influence_joints", m.influence_joints);
+  Array(ar, "influence_weights", m.influence_weights);
+}
+
+template <class Archive>
+void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
+  detail::CheckVersion(version, 1, "BodyMapPose");
+  ar(cereal::make_nvp("clip", p.clip), cereal::make_nvp("time", p.time),
+     cereal::make_nvp("width", p.width), cereal::make_nvp("height", p.height),
+     cereal::make_nvp("origin_x", p.origin_x), cereal::make_nvp("origin_y", p.origin_y),
+     cereal::make_nvp("texel_size", p.texel_size), cereal::make_nvp("front_z", p.front_z),
+     cereal::make_nvp("depth_range", p.depth_range),
+     cereal::make_nvp("depth_encoding", p.depth_encoding),
+     cereal::make_nvp("normal_encoding", p.normal_encoding));
+  static const char* const kViews[2] = {"front", "back"};
+  for (int view = 0; view < 2; ++view) {
+    const std::string v = kViews[view];
+    Array(ar, ("depth_f32_" + v).c_str(), p.depth_f32[view]);
+    Array(ar, ("depth_u16_" + v).c_str(), p.depth_u16[view]);
+    Array(ar, ("normal_f32_" + v).c_str(), p.normal_f32[view]);
+    Array(ar, ("normal_oct16_" + v).c_str(), p.normal_oct16[view]);
+    Array(ar, ("normal_rgb8_" + v).c_str(), p.normal_rgb8[view]);
+  }
+}
+
+template <class Archive>
+void serialize(Archive& ar, BodyMapSet& s, const uint32_t version) {
+  detail::CheckVersion(version, 1, "BodyMapSet");
+  ar(cereal::make_nvp("epsilon", s.epsilon), cereal::make_nvp("resolution", s.resolution),
+     cereal::make_nvp("fitted_window", s.fitted_window));
+  Array(ar, "poses", s.poses);
+}
+
+template <class Archive>
+void serialize(Archive& ar, KirkpatrickHierarchy& k, const uint32_t version) {
+  detail::CheckVersion(version, 1, "KirkpatrickHierarchy");
+  Array(ar, "vertices_uv", k.vertices_uv);
+  Array(ar, "node_triangles", k.node_triangles);
+  Array(ar, "child_offsets", k.child_offsets);
+  Array(ar, "children", k.children);
+  Array(ar, "leaf_planes", k.leaf_planes);
+  ar(cereal::make_nvp("root_begin", k.root_begin), cereal::make_nvp("root_end", k.root_end));
+}
+
+template <class Archive>
+void serialize(Archive& ar, MapTableData& t, const uint32_t version) {
+  detail::CheckVersion(version, 1, "MapTableData");
+  ar(cereal::make_nvp("kind", t.kind), cereal::make_nvp("rows", t.rows),
+     cereal::make_nvp("cols", t.cols), cereal::make_nvp("origin", t.origin),
+     cereal::make_nvp("axis", t.axis), cereal::make_nvp("reference", t.reference),
+     cereal::make_nvp("length", t.length));
+  Array(ar, "cell_offsets", t.cell_offsets);
+  Array(ar, "cell_triangles", t.cell_triangles);
+}
+
+template <class Archive>
+void serialize(Archive& ar, HullColliderData& h, const uint32_t version) {
+  detail::CheckVersion(version, 1, "HullColliderData");
+  ar(cereal::make_nvp("joint", h.joint), cereal::make_nvp("bind_frame", h.bind_frame));
+  Array(ar, "vertices", h.vertices);
+  Array(ar, "triangles", h.triangles);
+  Array(ar, "triangle_planes", h.triangle_planes);
+  Array(ar, "planes", h.planes);
+  ar(cereal::make_nvp("obb", h.obb), cereal::make_nvp("projection_axis", h.projection_axis),
+     cereal::make_nvp("projection_u", h.projection_u),
+     cereal::make_nvp("projection_v", h.projection_v), cereal::make_nvp("upper", h.upper),
+     cereal::make_nvp("lower", h.lower), cereal::make_nvp("map", h.map));
+}
+
+template <class Archive>
+void serialize(Archive& ar, JointSphereData& s, const uint32_t version) {
+  detail::CheckVersion(version, 1, "JointSphereData");
+  ar(cereal::make_nvp("joint", s.joint), cereal::make_nvp("parent_joint", s.parent_joint),
+     cereal::make_nvp("center", s.center), cereal::make_nvp("radius", s.radius));
+}
+
+template <class Archive>
+void serialize(Archive& ar, CharacterAsset& a, const uint32_t version) {
+  detail::CheckVersion(version, 1, "CharacterAsset");
+  ar(cereal::make_nvp("info", a.info), cereal::make_nvp("skeleton", a.skeleton));
+  Array(ar, "clips", a.clips);
+  ar(cereal::make_nvp("mesh", a.mesh), cereal::make_nvp("body_maps", a.body_maps));
+  Array(ar, "hulls", a.hulls);
+  Array(ar, "joint_spheres", a.joint_spheres);
+}
+
+}  // namespace drape
+
+CEREAL_CLASS_VERSION(drape::AssetInfo, 1)
+CEREAL_CLASS_VERSION(drape::SkeletonData, 1)
+CEREAL_CLASS_VERSION(drape::ClipData, 1)
+CEREAL_CLASS_VERSION(drape::MeshData, 1)
+CEREAL_CLASS_VERSION(drape::BodyMapPose, 1)
+CEREAL_CLASS_VERSION(drape::BodyMapSet, 1)
+CEREAL_CLASS_VERSION(drape::KirkpatrickHierarchy, 1)
+CEREAL_CLASS_VERSION(drape::MapTableData, 1)
+CEREAL_CLASS_VERSION(drape::HullColliderData, 1)
+CEREAL_CLASS_VERSION(drape::JointSphereData, 1)
+CEREAL_CLASS_VERSION(drape::CharacterAsset, 1)

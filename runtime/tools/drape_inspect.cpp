@@ -1,0 +1,192 @@
+// drape-inspect FILE.drape [--json | --dump-json]
+// What a .drape file holds, loaded through formats + runtime alone (no bake dependency).
+
+#include <cstdio>
+#include <cstring>
+#include <sstream>
+#include <string>
+
+#include "drape/formats/asset_file.h"
+#include "drape/runtime/skeleton_pose.h"
+
+namespace {
+
+int Usage() {
+  std::fprintf(stderr,
+               "usage: drape-inspect FILE.drape [--json | --dump-json]\n"
+               "  --json       a JSON summary\n"
+               "  --dump-json  the whole asset as JSON (large; for golden diffs)\n");
+  return 2;
+}
+
+std::string Quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+size_t PoseBytes(const drape::BodyMapPose& p) {
+  size_t bytes = 0;
+  for (int v = 0; v < 2; ++v) {
+    bytes += p.depth_f32[v].size() * 4 + p.depth_u16[v].size() * 2 + p.normal_f32[v].size() * 4 +
+             p.normal_oct16[v].size() * 2 + p.normal_rgb8[v].size();
+  }
+  return bytes;
+}
+
+const char* DepthName(drape::DepthEncoding e) {
+  return e == drape::DepthEncoding::kFloat32 ? "float32" : "unorm16";
+}
+const char* NormalName(drape::NormalEncoding e) {
+  switch (e) {
+    case drape::NormalEncoding::kFloat32: return "float32";
+    case drape::NormalEncoding::kOct16: return "oct16";
+    case drape::NormalEncoding::kRgb8: return "rgb8";
+  }
+  return "?";
+}
+
+std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path) {
+  std::ostringstream o;
+  o << "{\n  \"file\": " << Quote(path) << ",\n  \"format_version\": " << drape::kAssetFormatVersion
+    << ",\n  \"source\": " << Quote(a.info.source_name) << ",\n  \"tool_version\": "
+    << Quote(a.info.tool_version) << ",\n  \"unit_scale\": " << a.info.unit_scale
+    << ",\n  \"up_axis\": " << Quote(a.info.up_axis) << ",\n  \"joints\": [";
+  for (size_t j = 0; j < a.skeleton.joint_names.size(); ++j) {
+    o << (j ? ", " : "") << "{\"name\": " << Quote(a.skeleton.joint_names[j])
+      << ", \"parent\": " << a.skeleton.parents[j] << "}";
+  }
+  o << "],\n  \"clips\": [";
+  for (size_t c = 0; c < a.clips.size(); ++c) {
+    const auto& clip = a.clips[c];
+    o << (c ? ", " : "") << "{\"name\": " << Quote(clip.name) << ", \"duration\": " << clip.duration
+      << ", \"sample_rate\": " << clip.sample_rate << ", \"frames\": " << clip.frame_count << "}";
+  }
+  o << "],\n  \"mesh\": {\"vertices\": " << a.mesh.vertex_count()
+    << ", \"triangles\": " << a.mesh.triangle_count()
+    << ", \"influences\": " << a.mesh.influence_joints.size() << "},\n  \"body_maps\": {\"epsilon\": "
+    << a.body_maps.epsilon << ", \"resolution\": " << a.body_maps.resolution << ", \"poses\": [";
+  for (size_t p = 0; p < a.body_maps.poses.size(); ++p) {
+    const auto& pose = a.body_maps.poses[p];
+    o << (p ? ", " : "") << "{\"clip\": " << pose.clip << ", \"time\": " << pose.time
+      << ", \"width\": " << pose.width << ", \"height\": " << pose.height
+      << ", \"texel_size_mm\": " << pose.texel_size * 1000.f << ", \"depth\": \""
+      << DepthName(pose.depth_encoding) << "\", \"normal\": \"" << NormalName(pose.normal_encoding)
+      << "\", \"bytes\": " << PoseBytes(pose) << "}";
+  }
+  o << "]},\n  \"hulls\": [";
+  for (size_t h = 0; h < a.hulls.size(); ++h) {
+    const auto& hull = a.hulls[h];
+    o << (h ? ", " : "") << "{\"joint\": " << Quote(a.skeleton.joint_names[hull.joint])
+      << ", \"triangles\": " << hull.triangles.size() / 3 << ", \"planes\": " << hull.planes.size()
+      << ", \"map\": \"" << (hull.map.kind == drape::MapTableKind::kSphere ? "sphere" : "cylinder")
+      << "\", \"map_cells\": " << hull.map.rows * hull.map.cols << "}";
+  }
+  o << "],\n  \"joint_spheres\": [";
+  for (size_t s = 0; s < a.joint_spheres.size(); ++s) {
+    const auto& sphere = a.joint_spheres[s];
+    o << (s ? ", " : "") << "{\"joint\": " << Quote(a.skeleton.joint_names[sphere.joint])
+      << ", \"radius\": " << sphere.radius << "}";
+  }
+  o << "]\n}\n";
+  return o.str();
+}
+
+void PrintText(const drape::CharacterAsset& a, const std::string& path) {
+  std::printf("%s: drape asset, format version %u, baked by drape %s from '%s'\n", path.c_str(),
+              drape::kAssetFormatVersion, a.info.tool_version.c_str(), a.info.source_name.c_str());
+  std::printf("  units: %g m per source unit, source up axis %s\n", a.info.unit_scale,
+              a.info.up_axis.c_str());
+  std::printf("  skeleton: %u joints\n", a.skeleton.joint_count());
+  for (size_t j = 0; j < a.skeleton.joint_names.size(); ++j) {
+    const int32_t parent = a.skeleton.parents[j];
+    std::printf("    %3zu %-28s parent %s\n", j, a.skeleton.joint_names[j].c_str(),
+                parent < 0 ? "-" : a.skeleton.joint_names[parent].c_str());
+  }
+  std::printf("  clips: %zu\n", a.clips.size());
+  for (const auto& clip : a.clips) {
+    std::printf("    %-28s %.3f s, %u frames at %g Hz\n", clip.name.c_str(), clip.duration,
+                clip.frame_count, clip.sample_rate);
+  }
+  std::printf("  mesh: %u vertices, %u triangles, %zu influences\n", a.mesh.vertex_count(),
+              a.mesh.triangle_count(), a.mesh.influence_joints.size());
+  std::printf("  body maps: %zu poses (epsilon %.1f mm)\n", a.body_maps.poses.size(),
+              a.body_maps.epsilon * 1000.f);
+  for (const auto& pose : a.body_maps.poses) {
+    std::printf("    clip %d t=%.3f s: %ux%u texels of %.2f mm, depth %s, normals %s, %zu bytes\n",
+                pose.clip, pose.time, pose.width, pose.height, pose.texel_size * 1000.f,
+                DepthName(pose.depth_encoding), NormalName(pose.normal_encoding), PoseBytes(pose));
+  }
+  std::printf("  hulls: %zu\n", a.hulls.size());
+  for (const auto& hull : a.hulls) {
+    std::printf("    %-28s %zu triangles, %zu planes, map %s %ux%u\n",
+                a.skeleton.joint_names[hull.joint].c_str(), hull.triangles.size() / 3,
+                hull.planes.size(),
+                hull.map.kind == drape::MapTableKind::kSphere ? "sphere" : "cylinder", hull.map.rows,
+                hull.map.cols);
+  }
+  std::printf("  joint spheres: %zu\n", a.joint_spheres.size());
+  for (const auto& sphere : a.joint_spheres) {
+    std::printf("    %-28s radius %.1f mm\n", a.skeleton.joint_names[sphere.joint].c_str(),
+                sphere.radius * 1000.f);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string path;
+  bool json = false, dump = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--json") == 0) {
+      json = true;
+    } else if (std::strcmp(argv[i], "--dump-json") == 0) {
+      dump = true;
+    } else if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+      Usage();
+      return 0;
+    } else if (argv[i][0] == '-' || !path.empty()) {
+      return Usage();
+    } else {
+      path = argv[i];
+    }
+  }
+  if (path.empty()) return Usage();
+  drape::CharacterAsset asset;
+  if (drape::Status status = drape::ReadAssetFile(path, &asset); !status.ok()) {
+    std::fprintf(stderr, "drape-inspect: error: %s\n", status.message().c_str());
+    return 1;
+  }
+  // Prove the runtime can pose what it loaded: every clip's first frame.
+  drape::SkeletonPose pose;
+  if (drape::Status status = pose.Init(asset.skeleton); !status.ok()) {
+    std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
+    return 1;
+  }
+  for (const auto& clip : asset.clips) {
+    if (drape::Status status = pose.SampleClip(clip, 0.f, false); !status.ok()) {
+      std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
+      return 1;
+    }
+  }
+  if (dump) {
+    std::fputs(drape::AssetToJson(asset).c_str(), stdout);
+    std::fputc('\n', stdout);
+  } else if (json) {
+    std::fputs(JsonSummary(asset, path).c_str(), stdout);
+  } else {
+    PrintText(asset, path);
+  }
+  return 0;
+}
