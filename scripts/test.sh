@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# The README's test command: installs what is missing, builds and runs every test.
+#  1. the full build (bake + runtime + tools) and its tests;
+#  2. formats + runtime alone with -DDRAPE_BUILD_BAKE=OFF: builds, passes its tests, and its link
+#     lines name no assimp, CGAL or OSMesa;
+#  3. cmake --install of that build, and a tiny consumer that find_package(drape)s it.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+jobs=${DRAPE_JOBS:-2}
+scripts/setup.sh || exit 1
+
+total_passed=0 total_failed=0
+run_ctest() {  # build dir; adds to the totals
+  local log
+  log=$(mktemp)
+  (cd "$1" && ctest --output-on-failure -j "$jobs" --timeout 900) | tee "$log"
+  local line
+  line=$(grep -E "tests passed, [0-9]+ tests failed out of" "$log" | tail -1)
+  local failed total
+  failed=$(echo "$line" | sed -E 's/.* ([0-9]+) tests failed out of ([0-9]+).*/\1/')
+  total=$(echo "$line" | sed -E 's/.* out of ([0-9]+).*/\1/')
+  if [ -z "$line" ]; then failed=1 total=1; fi
+  total_passed=$((total_passed + total - failed))
+  total_failed=$((total_failed + failed))
+  rm -f "$log"
+}
+check() {  # name, command...: one pass/fail step of this script
+  local name=$1
+  shift
+  if "$@"; then
+    echo "check passed: $name"
+    total_passed=$((total_passed + 1))
+  else
+    echo "check FAILED: $name"
+    total_failed=$((total_failed + 1))
+  fi
+}
+
+echo "== 1. full build"
+cmake --preset default >/dev/null && cmake --build build -j "$jobs" || { echo "tests: 0 passed, 1 failed"; exit 1; }
+run_ctest build
+
+echo "== 2. runtime alone (-DDRAPE_BUILD_BAKE=OFF)"
+cmake --preset runtime-only >/dev/null && cmake --build build-runtime -j "$jobs" || { echo "tests: $total_passed passed, $((total_failed + 1)) failed"; exit 1; }
+run_ctest build-runtime
+no_bake_in_link_lines() {
+  local hits
+  hits=$(grep -rliE "assimp|CGAL|OSMesa|libgmp|libmpfr" build-runtime/formats build-runtime/runtime \
+    --include=link.txt 2>/dev/null)
+  if [ -n "$hits" ]; then echo "bake libraries on runtime link lines: $hits"; return 1; fi
+  if grep -qiE "^(assimp|CGAL|Eigen3)_DIR:PATH=/" build-runtime/CMakeCache.txt; then
+    echo "the runtime-only configure looked for bake packages"; return 1
+  fi
+  ! ldd build-runtime/bin/drape-inspect | grep -qiE "assimp|CGAL|OSMesa|gmp|mpfr"
+}
+check "runtime link lines name no assimp, CGAL or OSMesa" no_bake_in_link_lines
+
+echo "== 3. install and find_package(drape) from a consumer"
+install_consumer() {
+  local prefix consumer
+  prefix=$(mktemp -d) consumer=$(mktemp -d)
+  cmake --install build-runtime --prefix "$prefix" >/dev/null &&
+    cmake -S tests/install_consumer -B "$consumer" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null &&
+    cmake --build "$consumer" -j "$jobs" >/dev/null &&
+    "$consumer/consumer" "$root/tests/golden/mannequin_v1.drape"
+  local rc=$?
+  rm -rf "$prefix" "$consumer"
+  return $rc
+}
+check "installed drape::runtime links into a consumer" install_consumer
+
+echo "tests: $total_passed passed, $total_failed failed"
+[ "$total_failed" -eq 0 ]
