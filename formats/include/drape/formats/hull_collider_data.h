@@ -54,8 +54,10 @@ struct MapTableData {
 
 struct HullColliderData {
   int32_t joint = -1;  // the bone that carries it
-  // Collider frame -> asset frame at bind (rigid). At a pose the collider's world transform is
-  // skinning(joint) * bind_frame.
+  // Collider frame -> bind-pose asset frame. At a pose the collider's world transform is
+  // skinning(joint) * bind_frame, which is rigid (the collider frame is the joint's rest-pose
+  // frame without scale). bind_frame itself is affine: where the bind pose is scaled against the
+  // rest pose (Animated_Human.fbx: about 65x), it carries that scale.
   Mat34 bind_frame;
   std::vector<Float3> vertices;            // collider surface, collider frame, metres
   std::vector<uint32_t> triangles;         // 3 per triangle, counter-clockwise outside
@@ -71,8 +73,8 @@ struct HullColliderData {
 struct JointSphereData {
   int32_t joint = -1;         // the child bone of the joint; the sphere moves with it
   int32_t parent_joint = -1;  // the other bone of the joint (-1 when none)
-  Float3 center;              // asset frame at bind; at a pose: skinning(joint) * center
-  float radius = 0.f;         // metres, > 0
+  Float3 center;              // bind-pose asset frame; at a pose: skinning(joint) * center
+  float radius = 0.f;         // metres in the rest pose (the animation's scale), > 0
 };
 
 }  // namespace drape
