@@ -18,8 +18,9 @@ struct Parameter {
 };
 
 // Accessors by lambda keep the table readable without pointer-to-nested-member gymnastics.
-Parameter MakeNumber(std::string section, std::string key, std::string unit, double lo, double hi, bool lo_open,
-                     std::string description, std::function<double&(BakeConfig&)> field) {
+Parameter MakeNumber(std::string section, std::string key, std::string unit, double lo, double hi,
+                     bool lo_open, std::string description,
+                     std::function<double&(BakeConfig&)> field) {
   Parameter p;
   p.section = std::move(section);
   p.key = std::move(key);
@@ -37,11 +38,13 @@ Parameter MakeNumber(std::string section, std::string key, std::string unit, dou
   return p;
 }
 
-Parameter MakeFloat(std::string section, std::string key, std::string unit, double lo, double hi, bool lo_open,
-                    std::string description, std::function<float&(BakeConfig&)> field) {
+Parameter MakeFloat(std::string section, std::string key, std::string unit, double lo, double hi,
+                    bool lo_open, std::string description,
+                    std::function<float&(BakeConfig&)> field) {
   auto holder = std::make_shared<double>();
-  Parameter p = MakeNumber(std::move(section), std::move(key), std::move(unit), lo, hi, lo_open,
-                           std::move(description), [holder](BakeConfig&) -> double& { return *holder; });
+  Parameter p =
+      MakeNumber(std::move(section), std::move(key), std::move(unit), lo, hi, lo_open,
+                 std::move(description), [holder](BakeConfig&) -> double& { return *holder; });
   p.get = [field](const BakeConfig& c) { return json(field(const_cast<BakeConfig&>(c))); };
   auto check = p.set;
   p.set = [check, holder, field](const json& v, BakeConfig& c) -> std::string {
@@ -54,7 +57,8 @@ Parameter MakeFloat(std::string section, std::string key, std::string unit, doub
 
 Parameter MakeBool(std::string section, std::string key, std::string description,
                    std::function<bool&(BakeConfig&)> field) {
-  Parameter p{std::move(section), std::move(key), "", "true | false", std::move(description), nullptr, nullptr};
+  Parameter p{std::move(section),     std::move(key), "",     "true | false",
+              std::move(description), nullptr,        nullptr};
   p.get = [field](const BakeConfig& c) { return json(field(const_cast<BakeConfig&>(c))); };
   p.set = [field](const json& v, BakeConfig& c) -> std::string {
     if (!v.is_boolean()) return "must be true or false";
@@ -64,16 +68,18 @@ Parameter MakeBool(std::string section, std::string key, std::string description
   return p;
 }
 
-Parameter MakeChoice(std::string section, std::string key, std::vector<std::string> choices, std::string description,
-                     std::function<std::string&(BakeConfig&)> field) {
+Parameter MakeChoice(std::string section, std::string key, std::vector<std::string> choices,
+                     std::string description, std::function<std::string&(BakeConfig&)> field) {
   std::string range;
   for (const auto& c : choices) range += (range.empty() ? "" : " | ") + c;
-  Parameter p{std::move(section), std::move(key), "", range, std::move(description), nullptr, nullptr};
+  Parameter p{std::move(section),     std::move(key), "",     range,
+              std::move(description), nullptr,        nullptr};
   p.get = [field](const BakeConfig& c) { return json(field(const_cast<BakeConfig&>(c))); };
   p.set = [field, choices, range](const json& v, BakeConfig& c) -> std::string {
     if (!v.is_string()) return "must be a string: " + range;
     const std::string s = v.get<std::string>();
-    if (std::find(choices.begin(), choices.end(), s) == choices.end()) return "'" + s + "' is not one of " + range;
+    if (std::find(choices.begin(), choices.end(), s) == choices.end())
+      return "'" + s + "' is not one of " + range;
     field(c) = s;
     return "";
   };
@@ -88,7 +94,8 @@ const std::vector<Parameter>& Parameters() {
       MakeChoice("import", "up_axis", {"auto", "+X", "-X", "+Y", "-Y", "+Z", "-Z"},
                  "source axis that becomes the asset's +Y; auto = file metadata, else +Y",
                  [](BakeConfig& c) -> std::string& { return c.import.up_axis; }),
-      MakeFloat("import", "clip_sample_rate", "Hz", 0, 1000, true, "rate the clips are resampled at",
+      MakeFloat("import", "clip_sample_rate", "Hz", 0, 1000, true,
+                "rate the clips are resampled at",
                 [](BakeConfig& c) -> float& { return c.import.clip_sample_rate; }),
       MakeBool("import", "rename_duplicate_joints",
                "repair duplicate or empty joint names with suffixes instead of failing",
@@ -100,11 +107,13 @@ const std::vector<Parameter>& Parameters() {
 }  // namespace
 
 Status ApplyBakeConfig(const json& config, const std::string& source, BakeConfig* out) {
-  if (!config.is_object()) return Status(StatusCode::kInvalidArgument, source + ": the config must be a JSON object");
+  if (!config.is_object())
+    return Status(StatusCode::kInvalidArgument, source + ": the config must be a JSON object");
   BakeConfig result = *out;
   for (const auto& [section, values] : config.items()) {
     if (!values.is_object()) {
-      return Status(StatusCode::kInvalidArgument, source + ": /" + section + " must be an object of parameters");
+      return Status(StatusCode::kInvalidArgument,
+                    source + ": /" + section + " must be an object of parameters");
     }
     for (const auto& [key, value] : values.items()) {
       const Parameter* match = nullptr;
@@ -112,7 +121,8 @@ Status ApplyBakeConfig(const json& config, const std::string& source, BakeConfig
         if (p.section == section && p.key == key) match = &p;
       const std::string where = source + ": /" + section + "/" + key;
       if (match == nullptr) {
-        return Status(StatusCode::kInvalidArgument, where + " is not a parameter (see drape-bake --dump-config)");
+        return Status(StatusCode::kInvalidArgument,
+                      where + " is not a parameter (see drape-bake --dump-config)");
       }
       if (std::string why = match->set(value, result); !why.empty()) {
         return Status(StatusCode::kInvalidArgument, where + " " + why);
@@ -139,7 +149,9 @@ json BakeConfigReference() {
   const BakeConfig defaults;
   json out = json::object();
   for (const Parameter& p : Parameters()) {
-    out[p.section][p.key] = {{"default", p.get(defaults)}, {"unit", p.unit}, {"range", p.range},
+    out[p.section][p.key] = {{"default", p.get(defaults)},
+                             {"unit", p.unit},
+                             {"range", p.range},
                              {"description", p.description}};
   }
   return out;

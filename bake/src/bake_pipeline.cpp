@@ -47,10 +47,12 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   report["joint_count"] = asset.skeleton.joint_count();
   nlohmann::json clips = nlohmann::json::array();
   for (const ClipData& clip : asset.clips) {
-    clips.push_back({{"name", clip.name}, {"duration_s", clip.duration}, {"frames", clip.frame_count}});
+    clips.push_back(
+        {{"name", clip.name}, {"duration_s", clip.duration}, {"frames", clip.frame_count}});
   }
   report["clips"] = clips;
-  report["mesh"] = {{"vertices", asset.mesh.vertex_count()}, {"triangles", asset.mesh.triangle_count()}};
+  report["mesh"] = {{"vertices", asset.mesh.vertex_count()},
+                    {"triangles", asset.mesh.triangle_count()}};
   report["warnings"] = character.warnings;
 
   const auto validate_start = Clock::now();

@@ -20,12 +20,13 @@ namespace {
 using Mat4 = Eigen::Matrix4d;
 using Vec3 = Eigen::Vector3d;
 
-constexpr int kMaxNodeDepth = 4096;        // deeper hierarchies are treated as corrupt (cycles)
+constexpr int kMaxNodeDepth = 4096;  // deeper hierarchies are treated as corrupt (cycles)
 constexpr size_t kMaxNodes = 1u << 22;
 
 Mat4 ToEigen(const aiMatrix4x4& m) {
   Mat4 r;
-  r << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4;
+  r << m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4, m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3,
+      m.d4;
   return r;
 }
 
@@ -59,7 +60,8 @@ Status FlattenNodes(const aiNode* root, const std::string& path, std::vector<Nod
   while (!stack.empty()) {
     const Item item = stack.back();
     stack.pop_back();
-    if (!seen.insert(item.node).second || item.depth > kMaxNodeDepth || nodes->size() >= kMaxNodes) {
+    if (!seen.insert(item.node).second || item.depth > kMaxNodeDepth ||
+        nodes->size() >= kMaxNodes) {
       return Status(StatusCode::kCorrupt, path + ": the node hierarchy is cyclic or too deep");
     }
     Node n;
@@ -67,10 +69,12 @@ Status FlattenNodes(const aiNode* root, const std::string& path, std::vector<Nod
     n.parent = item.parent;
     n.local_rest = ToEigen(item.node->mTransformation);
     if (!AllFinite(n.local_rest)) {
-      return Status(StatusCode::kCorrupt, path + ": node '" + std::string(item.node->mName.C_Str()) +
+      return Status(StatusCode::kCorrupt, path + ": node '" +
+                                              std::string(item.node->mName.C_Str()) +
                                               "' has a non-finite transform");
     }
-    n.global_rest = item.parent < 0 ? n.local_rest : Mat4((*nodes)[item.parent].global_rest * n.local_rest);
+    n.global_rest =
+        item.parent < 0 ? n.local_rest : Mat4((*nodes)[item.parent].global_rest * n.local_rest);
     const int index = static_cast<int>(nodes->size());
     nodes->push_back(n);
     for (unsigned c = item.node->mNumChildren; c-- > 0;) {
@@ -115,7 +119,8 @@ double Decompose(const Mat4& m, Transform* t) {
   const Eigen::Matrix3d rotation = u * v.transpose();
   const Eigen::Matrix3d stretch = v * sigma.asDiagonal() * v.transpose();
   const Eigen::Quaterniond q(rotation);
-  t->translation = {static_cast<float>(m(0, 3)), static_cast<float>(m(1, 3)), static_cast<float>(m(2, 3))};
+  t->translation = {static_cast<float>(m(0, 3)), static_cast<float>(m(1, 3)),
+                    static_cast<float>(m(2, 3))};
   t->rotation = {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()),
                  static_cast<float>(q.w())};
   t->scale = {static_cast<float>(stretch(0, 0)), static_cast<float>(stretch(1, 1)),
@@ -155,11 +160,20 @@ bool MetadataNumber(const aiScene* scene, const char* key, double* value) {
     const aiMetadataEntry& e = meta->mValues[i];
     if (e.mData == nullptr) return false;
     switch (e.mType) {
-      case AI_INT32: *value = *static_cast<const int32_t*>(e.mData); return true;
-      case AI_UINT64: *value = static_cast<double>(*static_cast<const uint64_t*>(e.mData)); return true;
-      case AI_FLOAT: *value = *static_cast<const float*>(e.mData); return true;
-      case AI_DOUBLE: *value = *static_cast<const double*>(e.mData); return true;
-      default: return false;
+      case AI_INT32:
+        *value = *static_cast<const int32_t*>(e.mData);
+        return true;
+      case AI_UINT64:
+        *value = static_cast<double>(*static_cast<const uint64_t*>(e.mData));
+        return true;
+      case AI_FLOAT:
+        *value = *static_cast<const float*>(e.mData);
+        return true;
+      case AI_DOUBLE:
+        *value = *static_cast<const double*>(e.mData);
+        return true;
+      default:
+        return false;
     }
   }
   return false;
@@ -168,8 +182,8 @@ bool MetadataNumber(const aiScene* scene, const char* key, double* value) {
 aiVector3D SampleVectorKeys(const aiVectorKey* keys, unsigned count, double tick) {
   if (count == 1 || tick <= keys[0].mTime) return keys[0].mValue;
   if (tick >= keys[count - 1].mTime) return keys[count - 1].mValue;
-  const aiVectorKey* upper = std::upper_bound(keys, keys + count, tick,
-                                              [](double t, const aiVectorKey& k) { return t < k.mTime; });
+  const aiVectorKey* upper = std::upper_bound(
+      keys, keys + count, tick, [](double t, const aiVectorKey& k) { return t < k.mTime; });
   const aiVectorKey& a = *(upper - 1);
   const aiVectorKey& b = *upper;
   const double span = b.mTime - a.mTime;
@@ -180,8 +194,8 @@ aiVector3D SampleVectorKeys(const aiVectorKey* keys, unsigned count, double tick
 aiQuaternion SampleQuatKeys(const aiQuatKey* keys, unsigned count, double tick) {
   if (count == 1 || tick <= keys[0].mTime) return keys[0].mValue;
   if (tick >= keys[count - 1].mTime) return keys[count - 1].mValue;
-  const aiQuatKey* upper = std::upper_bound(keys, keys + count, tick,
-                                            [](double t, const aiQuatKey& k) { return t < k.mTime; });
+  const aiQuatKey* upper = std::upper_bound(
+      keys, keys + count, tick, [](double t, const aiQuatKey& k) { return t < k.mTime; });
   const aiQuatKey& a = *(upper - 1);
   const aiQuatKey& b = *upper;
   const double span = b.mTime - a.mTime;
@@ -200,11 +214,16 @@ Mat4 ChannelLocal(const aiNodeAnim& channel, const Mat4& rest, double tick) {
     for (int c = 0; c < 4; ++c) rest_ai[r][c] = static_cast<ai_real>(rest(r, c));
   rest_ai.Decompose(rest_scale, rest_rotation, rest_position);
   const aiVector3D position =
-      channel.mNumPositionKeys ? SampleVectorKeys(channel.mPositionKeys, channel.mNumPositionKeys, tick) : rest_position;
+      channel.mNumPositionKeys
+          ? SampleVectorKeys(channel.mPositionKeys, channel.mNumPositionKeys, tick)
+          : rest_position;
   const aiQuaternion rotation =
-      channel.mNumRotationKeys ? SampleQuatKeys(channel.mRotationKeys, channel.mNumRotationKeys, tick) : rest_rotation;
-  const aiVector3D scale =
-      channel.mNumScalingKeys ? SampleVectorKeys(channel.mScalingKeys, channel.mNumScalingKeys, tick) : rest_scale;
+      channel.mNumRotationKeys
+          ? SampleQuatKeys(channel.mRotationKeys, channel.mNumRotationKeys, tick)
+          : rest_rotation;
+  const aiVector3D scale = channel.mNumScalingKeys ? SampleVectorKeys(channel.mScalingKeys,
+                                                                      channel.mNumScalingKeys, tick)
+                                                   : rest_scale;
   return ToEigen(aiMatrix4x4(scale, rotation, position));
 }
 
@@ -216,13 +235,18 @@ std::string Fmt(double v) {
 
 }  // namespace
 
-Status ImportCharacter(const std::string& path, const ImportOptions& options, Character* character) {
+Status ImportCharacter(const std::string& path, const ImportOptions& options,
+                       Character* character) {
   *character = Character{};
-  auto fail = [&](StatusCode code, const std::string& reason) { return Status(code, path + ": " + reason); };
+  auto fail = [&](StatusCode code, const std::string& reason) {
+    return Status(code, path + ": " + reason);
+  };
   std::error_code fs_error;
   if (!std::filesystem::exists(path, fs_error)) return fail(StatusCode::kIoError, "file not found");
-  if (std::filesystem::is_directory(path, fs_error)) return fail(StatusCode::kIoError, "is a directory");
-  if (std::filesystem::file_size(path, fs_error) == 0) return fail(StatusCode::kCorrupt, "file is empty");
+  if (std::filesystem::is_directory(path, fs_error))
+    return fail(StatusCode::kIoError, "is a directory");
+  if (std::filesystem::file_size(path, fs_error) == 0)
+    return fail(StatusCode::kCorrupt, "file is empty");
   if (!(options.clip_sample_rate > 0.f && options.clip_sample_rate <= 1000.f)) {
     return fail(StatusCode::kInvalidArgument, "clip_sample_rate must be in (0, 1000] Hz");
   }
@@ -232,15 +256,18 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
 
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                                     aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_SortByPType | aiProcess_ValidateDataStructure);
   if (scene == nullptr) {
     std::string why = importer.GetErrorString();
     std::replace(why.begin(), why.end(), '\n', ' ');
     return fail(StatusCode::kCorrupt, "unsupported or corrupt model: " + why);
   }
-  if (scene->mRootNode == nullptr) return fail(StatusCode::kCorrupt, "the scene has no node hierarchy");
+  if (scene->mRootNode == nullptr)
+    return fail(StatusCode::kCorrupt, "the scene has no node hierarchy");
   if (scene->mNumMeshes == 0) return fail(StatusCode::kCorrupt, "the scene has no meshes");
 
   std::vector<Node> nodes;
@@ -252,7 +279,8 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
   for (int n = 0; n < static_cast<int>(nodes.size()); ++n) {
     for (unsigned k = 0; k < nodes[n].node->mNumMeshes; ++k) {
       const unsigned mesh = nodes[n].node->mMeshes[k];
-      if (mesh >= scene->mNumMeshes) return fail(StatusCode::kCorrupt, "a node references a missing mesh");
+      if (mesh >= scene->mNumMeshes)
+        return fail(StatusCode::kCorrupt, "a node references a missing mesh");
       mesh_instances.emplace_back(n, mesh);
     }
   }
@@ -273,10 +301,12 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
       has_bones = true;
       const std::string name = m->mBones[b]->mName.C_Str();
       auto it = node_by_name.find(name);
-      if (it == node_by_name.end()) return fail(StatusCode::kCorrupt, "bone '" + name + "' has no node");
+      if (it == node_by_name.end())
+        return fail(StatusCode::kCorrupt, "bone '" + name + "' has no node");
       const Mat4 offset = ToEigen(m->mBones[b]->mOffsetMatrix);
       if (!AllFinite(offset) || std::fabs(offset.topLeftCorner<3, 3>().determinant()) < 1e-30) {
-        return fail(StatusCode::kCorrupt, "bone '" + name + "' has a singular or non-finite offset matrix");
+        return fail(StatusCode::kCorrupt,
+                    "bone '" + name + "' has a singular or non-finite offset matrix");
       }
       bone_offset.emplace(it->second, offset);
     }
@@ -321,7 +351,8 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
   }
   Eigen::Matrix3d up_rotation;
   if (!UpAxisRotation(up, &up_rotation)) {
-    return fail(StatusCode::kInvalidArgument, "up_axis '" + options.up_axis + "' is not auto, +X, -X, +Y, -Y, +Z or -Z");
+    return fail(StatusCode::kInvalidArgument,
+                "up_axis '" + options.up_axis + "' is not auto, +X, -X, +Y, -Y, +Z or -Z");
   }
 
   // Rest-pose world positions of all vertices (source units) for the scale check.
@@ -342,9 +373,11 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
       const Mat4 skin = nodes[bn].global_rest * ToEigen(bone->mOffsetMatrix);
       for (unsigned w = 0; w < bone->mNumWeights; ++w) {
         const unsigned v = bone->mWeights[w].mVertexId;
-        if (v >= m->mNumVertices) return fail(StatusCode::kCorrupt, "a bone weight names a missing vertex");
+        if (v >= m->mNumVertices)
+          return fail(StatusCode::kCorrupt, "a bone weight names a missing vertex");
         if (bone->mWeights[w].mWeight > 0.5f) {
-          rest_box.extend(TransformPoint(skin, Vec3(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z)));
+          rest_box.extend(
+              TransformPoint(skin, Vec3(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z)));
         }
       }
     }
@@ -395,30 +428,36 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
       std::string name = n.node->mName.C_Str();
       if (name.empty()) {
         if (!options.rename_duplicate_joints) {
-          return fail(StatusCode::kCorrupt, "joint node #" + std::to_string(joint_nodes[j]) + " has no name");
+          return fail(StatusCode::kCorrupt,
+                      "joint node #" + std::to_string(joint_nodes[j]) + " has no name");
         }
         name = "joint_" + std::to_string(j);
       }
       const int seen = ++name_count[name];
       if (seen > 1) {
         if (!options.rename_duplicate_joints) {
-          return fail(StatusCode::kCorrupt, "duplicate joint name '" + name + "' (set import.rename_duplicate_joints to repair)");
+          return fail(StatusCode::kCorrupt, "duplicate joint name '" + name +
+                                                "' (set import.rename_duplicate_joints to repair)");
         }
-        character->warnings.push_back("renamed duplicate joint '" + name + "' to '" + name + "#" + std::to_string(seen) + "'");
+        character->warnings.push_back("renamed duplicate joint '" + name + "' to '" + name + "#" +
+                                      std::to_string(seen) + "'");
         name += "#" + std::to_string(seen);
       }
       const int parent_joint = joint_ancestor(n.parent);
       skeleton.joint_names.push_back(name);
       skeleton.parents.push_back(parent_joint < 0 ? -1 : joint_of_node[parent_joint]);
-      const Mat4 local = parent_joint < 0 ? Mat4(to_asset * n.global_rest)
-                                          : Mat4(nodes[parent_joint].global_rest.inverse() * n.global_rest);
+      const Mat4 local = parent_joint < 0
+                             ? Mat4(to_asset * n.global_rest)
+                             : Mat4(nodes[parent_joint].global_rest.inverse() * n.global_rest);
       Transform t;
       if (Decompose(local, &t) > 1e-3) {
-        character->warnings.push_back("joint '" + name + "' rest transform has shear; stored without it");
+        character->warnings.push_back("joint '" + name +
+                                      "' rest transform has shear; stored without it");
       }
       skeleton.rest_local.push_back(t);
       auto offset = bone_offset.find(joint_nodes[j]);
-      inverse_bind_source.push_back(offset != bone_offset.end() ? offset->second : Mat4(n.global_rest.inverse()));
+      inverse_bind_source.push_back(offset != bone_offset.end() ? offset->second
+                                                                : Mat4(n.global_rest.inverse()));
     }
   }
   const size_t joint_count = skeleton.joint_names.size();
@@ -430,7 +469,8 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
   // --- Mesh: bind positions in the asset frame, welded per source mesh, weights renormalised.
   MeshData& out = character->mesh;
   out.influence_offsets.push_back(0);
-  size_t weight_sum_warnings = 0, zero_weight_vertices = 0, degenerate_triangles = 0, weld_conflicts = 0;
+  size_t weight_sum_warnings = 0, zero_weight_vertices = 0, degenerate_triangles = 0,
+         weld_conflicts = 0;
   size_t mesh_space_mismatch = 0;
   for (const auto& [node, mesh_index] : mesh_instances) {
     const aiMesh* m = scene->mMeshes[mesh_index];
@@ -443,14 +483,16 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
     } else if (m->mNumBones == 0) {
       const int jn = joint_ancestor(node);
       rigid_joint = joint_of_node[jn];
-      to_bind = inverse_bind_source[rigid_joint].inverse() * nodes[jn].global_rest.inverse() * nodes[node].global_rest;
+      to_bind = inverse_bind_source[rigid_joint].inverse() * nodes[jn].global_rest.inverse() *
+                nodes[node].global_rest;
     } else {
       // A mesh whose offset matrices differ from the first mesh's by a constant transform lives
       // in another mesh space: bring it into the shared one.
       bool first = true;
       for (unsigned b = 0; b < m->mNumBones; ++b) {
         const int jn = node_by_name.at(m->mBones[b]->mName.C_Str());
-        const Mat4 correction = inverse_bind_source[joint_of_node[jn]].inverse() * ToEigen(m->mBones[b]->mOffsetMatrix);
+        const Mat4 correction =
+            inverse_bind_source[joint_of_node[jn]].inverse() * ToEigen(m->mBones[b]->mOffsetMatrix);
         if (first) {
           to_bind = correction;
           first = false;
@@ -468,20 +510,26 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
       const int joint = joint_of_node[node_by_name.at(bone->mName.C_Str())];
       for (unsigned w = 0; w < bone->mNumWeights; ++w) {
         const float weight = bone->mWeights[w].mWeight;
-        if (!std::isfinite(weight)) return fail(StatusCode::kCorrupt, "bone '" + std::string(bone->mName.C_Str()) + "' has a non-finite weight");
+        if (!std::isfinite(weight))
+          return fail(StatusCode::kCorrupt,
+                      "bone '" + std::string(bone->mName.C_Str()) + "' has a non-finite weight");
         if (weight > 0.f) influences[bone->mWeights[w].mVertexId].emplace_back(joint, weight);
       }
     }
-    const int fallback_joint = rigid_joint >= 0 ? rigid_joint
-                                                : (joint_ancestor(node) >= 0 ? joint_of_node[joint_ancestor(node)] : 0);
+    const int fallback_joint =
+        rigid_joint >= 0 ? rigid_joint
+                         : (joint_ancestor(node) >= 0 ? joint_of_node[joint_ancestor(node)] : 0);
 
     std::map<std::tuple<float, float, float>, uint32_t> welded;
     std::vector<uint32_t> remap(m->mNumVertices);
     for (unsigned v = 0; v < m->mNumVertices; ++v) {
-      const Vec3 p = TransformPoint(vertex_to_asset, Vec3(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z));
-      const Float3 position{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+      const Vec3 p = TransformPoint(vertex_to_asset,
+                                    Vec3(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z));
+      const Float3 position{static_cast<float>(p.x()), static_cast<float>(p.y()),
+                            static_cast<float>(p.z())};
       if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) {
-        return fail(StatusCode::kCorrupt, "vertex " + std::to_string(v) + " of mesh '" + std::string(m->mName.C_Str()) +
+        return fail(StatusCode::kCorrupt, "vertex " + std::to_string(v) + " of mesh '" +
+                                              std::string(m->mName.C_Str()) +
                                               "' is not finite after transforming to metres");
       }
       std::vector<std::pair<int, float>> inf = influences[v];
@@ -515,7 +563,8 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
         bool same = end - begin == merged.size();
         for (uint32_t k = begin; same && k < end; ++k) {
           same = out.influence_joints[k] == merged[k - begin].first &&
-                 std::fabs(out.influence_weights[k] - static_cast<float>(merged[k - begin].second / sum)) < 1e-4f;
+                 std::fabs(out.influence_weights[k] -
+                           static_cast<float>(merged[k - begin].second / sum)) < 1e-4f;
         }
         weld_conflicts += !same;
         continue;
@@ -532,12 +581,14 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
       if (face.mNumIndices != 3) continue;
       uint32_t idx[3];
       for (int k = 0; k < 3; ++k) {
-        if (face.mIndices[k] >= m->mNumVertices) return fail(StatusCode::kCorrupt, "a face names a missing vertex");
+        if (face.mIndices[k] >= m->mNumVertices)
+          return fail(StatusCode::kCorrupt, "a face names a missing vertex");
         idx[k] = remap[face.mIndices[k]];
       }
       const Float3 a = out.positions[idx[0]], b = out.positions[idx[1]], c = out.positions[idx[2]];
       const Vec3 e1(b.x - a.x, b.y - a.y, b.z - a.z), e2(c.x - a.x, c.y - a.y, c.z - a.z);
-      if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2] || e1.cross(e2).squaredNorm() == 0.0) {
+      if (idx[0] == idx[1] || idx[1] == idx[2] || idx[0] == idx[2] ||
+          e1.cross(e2).squaredNorm() == 0.0) {
         ++degenerate_triangles;
         continue;
       }
@@ -552,7 +603,8 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
   warn_count(zero_weight_vertices, "vertices had no weight (made rigid to their mesh's joint)");
   warn_count(degenerate_triangles, "degenerate or zero-area triangles were dropped");
   warn_count(weld_conflicts, "welded vertices had differing weights (the first was kept)");
-  warn_count(mesh_space_mismatch, "bones disagree on their mesh's bind space (blended skin may be off)");
+  warn_count(mesh_space_mismatch,
+             "bones disagree on their mesh's bind space (blended skin may be off)");
 
   // --- Clips: every animation resampled at a fixed rate into joint-local transforms.
   if (!synthetic_root) {
@@ -564,7 +616,8 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
       const double ticks_per_second = anim->mTicksPerSecond > 0 ? anim->mTicksPerSecond : 25.0;
       const double duration = anim->mDuration / ticks_per_second;
       if (!std::isfinite(duration) || duration < 0 || duration > 3600) {
-        character->warnings.push_back("clip '" + name + "' skipped: duration " + Fmt(duration) + " s");
+        character->warnings.push_back("clip '" + name + "' skipped: duration " + Fmt(duration) +
+                                      " s");
         continue;
       }
       std::vector<const aiNodeAnim*> channel_of_node(nodes.size(), nullptr);
@@ -578,27 +631,35 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
       clip.name = name;
       clip.duration = static_cast<float>(duration);
       clip.sample_rate = options.clip_sample_rate;
-      clip.frame_count = static_cast<uint32_t>(std::ceil(static_cast<double>(clip.duration) * clip.sample_rate - 1e-3) + 1);
+      clip.frame_count = static_cast<uint32_t>(
+          std::ceil(static_cast<double>(clip.duration) * clip.sample_rate - 1e-3) + 1);
       clip.keys.resize(static_cast<size_t>(clip.frame_count) * joint_count);
       std::vector<Mat4> global(nodes.size());
       bool shear = false;
       for (uint32_t f = 0; f < clip.frame_count; ++f) {
-        const double seconds = std::min(static_cast<double>(f) / clip.sample_rate, static_cast<double>(clip.duration));
+        const double seconds =
+            std::min(static_cast<double>(f) / clip.sample_rate, static_cast<double>(clip.duration));
         const double tick = seconds * ticks_per_second;
         for (size_t n = 0; n < nodes.size(); ++n) {
-          const Mat4 local = channel_of_node[n] ? ChannelLocal(*channel_of_node[n], nodes[n].local_rest, tick)
-                                                : nodes[n].local_rest;
+          const Mat4 local = channel_of_node[n]
+                                 ? ChannelLocal(*channel_of_node[n], nodes[n].local_rest, tick)
+                                 : nodes[n].local_rest;
           global[n] = nodes[n].parent < 0 ? local : Mat4(global[nodes[n].parent] * local);
         }
         for (size_t j = 0; j < joint_count; ++j) {
           const int jn = joint_nodes[j];
           const int parent_joint = joint_ancestor(nodes[jn].parent);
-          const Mat4 local = parent_joint < 0 ? Mat4(to_asset * global[jn]) : Mat4(global[parent_joint].inverse() * global[jn]);
-          if (!local.allFinite()) return fail(StatusCode::kCorrupt, "clip '" + name + "' produces a non-finite transform");
+          const Mat4 local = parent_joint < 0 ? Mat4(to_asset * global[jn])
+                                              : Mat4(global[parent_joint].inverse() * global[jn]);
+          if (!local.allFinite())
+            return fail(StatusCode::kCorrupt,
+                        "clip '" + name + "' produces a non-finite transform");
           shear |= Decompose(local, &clip.keys[static_cast<size_t>(f) * joint_count + j]) > 1e-3;
         }
       }
-      if (shear) character->warnings.push_back("clip '" + name + "' has sheared joint transforms; stored without shear");
+      if (shear)
+        character->warnings.push_back("clip '" + name +
+                                      "' has sheared joint transforms; stored without shear");
       character->clips.push_back(std::move(clip));
     }
   }
@@ -612,8 +673,8 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options, Ch
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) character->source_to_asset[4 * r + c] = to_asset(r, c);
   character->warnings.insert(character->warnings.begin(),
-                             "unit scale " + Fmt(scale) + " m/unit from " + scale_source + "; up axis " + up +
-                                 " from " + up_source);
+                             "unit scale " + Fmt(scale) + " m/unit from " + scale_source +
+                                 "; up axis " + up + " from " + up_source);
   return Status::Ok();
 }
 

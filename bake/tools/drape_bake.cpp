@@ -3,12 +3,12 @@
 // drape-bake --dump-config
 // On any error: one line on stderr naming the input and the reason, exit code 1, no output file.
 
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include "drape/bake/bake_config.h"
 #include "drape/bake/bake_pipeline.h"
@@ -45,7 +45,8 @@ drape::Status WriteTextAtomically(const std::string& path, const std::string& te
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
+  CLI::App app{
+      "drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
   std::string input, output, config_path, scene_path, report_path, preview_dir;
   bool dump_config = false;
   app.add_option("INPUT", input, "character file (anything assimp reads)");
@@ -70,19 +71,23 @@ int main(int argc, char** argv) {
 
   drape::bake::BakeConfig config;
   if (!config_path.empty()) {
-    if (drape::Status s = drape::bake::LoadBakeConfig(config_path, &config); !s.ok()) return Fail(s.message());
+    if (drape::Status s = drape::bake::LoadBakeConfig(config_path, &config); !s.ok())
+      return Fail(s.message());
   }
   const auto start = std::chrono::steady_clock::now();
   drape::bake::BakeResult result;
-  if (drape::Status s = drape::bake::BakeCharacter(input, config, &result); !s.ok()) return Fail(s.message());
+  if (drape::Status s = drape::bake::BakeCharacter(input, config, &result); !s.ok())
+    return Fail(s.message());
   if (!preview_dir.empty()) {
     std::error_code error;
     std::filesystem::create_directories(preview_dir, error);
-    if (error) return Fail(preview_dir + ": cannot create the preview directory: " + error.message());
+    if (error)
+      return Fail(preview_dir + ": cannot create the preview directory: " + error.message());
   }
 
   std::vector<uint8_t> bytes;
-  if (drape::Status s = drape::EncodeAsset(result.asset, &bytes); !s.ok()) return Fail(input + ": " + s.message());
+  if (drape::Status s = drape::EncodeAsset(result.asset, &bytes); !s.ok())
+    return Fail(input + ": " + s.message());
   result.report["output"] = output;
   result.report["output_bytes"] = bytes.size();
   result.report["timings"]["total_ms"] =

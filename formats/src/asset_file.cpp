@@ -22,7 +22,8 @@ namespace {
 constexpr std::array<uint8_t, 8> kMagic = {0x89, 'D', 'R', 'A', 'P', 'E', '\r', '\n'};
 constexpr uint32_t kFlagLittleEndian = 1u << 0;
 constexpr uint32_t kFlagFloatSizeShift = 8;  // bits 8-15: sizeof(float) of the payload
-constexpr uint32_t kCurrentFlags = kFlagLittleEndian | (uint32_t{sizeof(float)} << kFlagFloatSizeShift);
+constexpr uint32_t kCurrentFlags =
+    kFlagLittleEndian | (uint32_t{sizeof(float)} << kFlagFloatSizeShift);
 
 void PutU32(uint8_t* out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out[i] = static_cast<uint8_t>(v >> (8 * i));
@@ -59,16 +60,26 @@ Status Error(StatusCode code, const std::string& name, const std::string& reason
 
 const char* ToString(StatusCode code) {
   switch (code) {
-    case StatusCode::kOk: return "ok";
-    case StatusCode::kIoError: return "I/O error";
-    case StatusCode::kBadMagic: return "not a .drape file";
-    case StatusCode::kUnsupportedVersion: return "unsupported version";
-    case StatusCode::kTruncated: return "truncated";
-    case StatusCode::kTrailingBytes: return "trailing bytes";
-    case StatusCode::kChecksumMismatch: return "checksum mismatch";
-    case StatusCode::kCorrupt: return "corrupt";
-    case StatusCode::kInvalidArgument: return "invalid argument";
-    case StatusCode::kInvalidState: return "invalid state";
+    case StatusCode::kOk:
+      return "ok";
+    case StatusCode::kIoError:
+      return "I/O error";
+    case StatusCode::kBadMagic:
+      return "not a .drape file";
+    case StatusCode::kUnsupportedVersion:
+      return "unsupported version";
+    case StatusCode::kTruncated:
+      return "truncated";
+    case StatusCode::kTrailingBytes:
+      return "trailing bytes";
+    case StatusCode::kChecksumMismatch:
+      return "checksum mismatch";
+    case StatusCode::kCorrupt:
+      return "corrupt";
+    case StatusCode::kInvalidArgument:
+      return "invalid argument";
+    case StatusCode::kInvalidState:
+      return "invalid state";
   }
   return "unknown";
 }
@@ -129,16 +140,17 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
     return Error(StatusCode::kUnsupportedVersion, name,
                  "format version " + std::to_string(version) + " is " +
                      (version > kAssetFormatVersion ? "newer" : "older") +
-                     " than the version this build reads (" + std::to_string(kAssetFormatVersion) + ")");
+                     " than the version this build reads (" + std::to_string(kAssetFormatVersion) +
+                     ")");
   }
   const uint32_t flags = GetU32(header + 12);
   if (flags != kCurrentFlags) {
-    return Error(StatusCode::kUnsupportedVersion, name,
-                 "unsupported flags 0x" + [&] {
-                   char buffer[16];
-                   std::snprintf(buffer, sizeof(buffer), "%08x", flags);
-                   return std::string(buffer);
-                 }() + " (expected little-endian payload with 4-byte floats)");
+    return Error(
+        StatusCode::kUnsupportedVersion, name, "unsupported flags 0x" + [&] {
+          char buffer[16];
+          std::snprintf(buffer, sizeof(buffer), "%08x", flags);
+          return std::string(buffer);
+        }() + " (expected little-endian payload with 4-byte floats)");
   }
   const uint64_t payload_size = GetU64(header + 16);
   const uint64_t available = bytes.size() - kAssetHeaderSize;
@@ -197,7 +209,8 @@ Status WriteAssetFile(const std::string& path, const CharacterAsset& asset) {
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     if (!out) return Error(StatusCode::kIoError, path, "cannot open for writing");
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
     out.flush();
     if (!out) {
       out.close();
@@ -209,7 +222,8 @@ Status WriteAssetFile(const std::string& path, const CharacterAsset& asset) {
   std::filesystem::rename(temporary, path, error);
   if (error) {
     std::remove(temporary.c_str());
-    return Error(StatusCode::kIoError, path, "cannot rename the temporary file: " + error.message());
+    return Error(StatusCode::kIoError, path,
+                 "cannot rename the temporary file: " + error.message());
   }
   return Status::Ok();
 }
@@ -222,7 +236,8 @@ Status ReadAssetFile(const std::string& path, CharacterAsset* asset) {
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) return Error(StatusCode::kIoError, path, "cannot open (missing or unreadable)");
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
   if (in.bad()) return Error(StatusCode::kIoError, path, "read failed");
   return DecodeAsset(bytes, path, asset);
 }

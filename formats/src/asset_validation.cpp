@@ -10,7 +10,9 @@
 namespace drape {
 namespace {
 
-bool IsFinite(const Float3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool IsFinite(const Float3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 class Checker {
  public:
@@ -22,7 +24,9 @@ class Checker {
     if (!condition && message_.empty()) message_ = field + " " + reason;
     return condition;
   }
-  bool Finite(float v, const std::string& field) { return Require(std::isfinite(v), field, "is not finite"); }
+  bool Finite(float v, const std::string& field) {
+    return Require(std::isfinite(v), field, "is not finite");
+  }
   bool Finite(const Float3& v, const std::string& field) {
     return Finite(v.x, field + ".x") && Finite(v.y, field + ".y") && Finite(v.z, field + ".z");
   }
@@ -32,21 +36,27 @@ class Checker {
     return true;
   }
   bool Index(int64_t value, int64_t count, const std::string& field) {
-    return Require(value >= 0 && value < count, field,
-                   "= " + std::to_string(value) + " is out of range [0, " + std::to_string(count) + ")");
+    return Require(
+        value >= 0 && value < count, field,
+        "= " + std::to_string(value) + " is out of range [0, " + std::to_string(count) + ")");
   }
   bool Size(size_t actual, size_t expected, const std::string& field) {
-    return Require(actual == expected, field,
-                   "has " + std::to_string(actual) + " elements, expected " + std::to_string(expected));
+    return Require(
+        actual == expected, field,
+        "has " + std::to_string(actual) + " elements, expected " + std::to_string(expected));
   }
   // Compressed-row offsets: count + 1 entries, from 0, non-decreasing, ending at `total`.
-  bool Offsets(const std::vector<uint32_t>& offsets, size_t count, size_t total, const std::string& field) {
+  bool Offsets(const std::vector<uint32_t>& offsets, size_t count, size_t total,
+               const std::string& field) {
     if (!Size(offsets.size(), count + 1, field)) return false;
     if (!Require(offsets.front() == 0, field, "does not start at 0")) return false;
     for (size_t i = 1; i < offsets.size(); ++i)
-      if (!Require(offsets[i] >= offsets[i - 1], field + "[" + std::to_string(i) + "]", "decreases")) return false;
-    return Require(offsets.back() == total, field,
-                   "ends at " + std::to_string(offsets.back()) + ", expected " + std::to_string(total));
+      if (!Require(offsets[i] >= offsets[i - 1], field + "[" + std::to_string(i) + "]",
+                   "decreases"))
+        return false;
+    return Require(
+        offsets.back() == total, field,
+        "ends at " + std::to_string(offsets.back()) + ", expected " + std::to_string(total));
   }
 
  private:
@@ -66,36 +76,45 @@ void CheckSkeleton(const SkeletonData& s, Checker& c) {
     if (!c.Require(!s.joint_names[j].empty(), "skeleton.joint_names" + at, "is empty") ||
         !c.Require(names.insert(s.joint_names[j]).second, "skeleton.joint_names" + at,
                    "'" + s.joint_names[j] + "' is a duplicate") ||
-        !c.Require(s.parents[j] >= -1 && s.parents[j] < static_cast<int32_t>(j), "skeleton.parents" + at,
-                   "= " + std::to_string(s.parents[j]) + " is not -1 or smaller than " + std::to_string(j)) ||
+        !c.Require(s.parents[j] >= -1 && s.parents[j] < static_cast<int32_t>(j),
+                   "skeleton.parents" + at,
+                   "= " + std::to_string(s.parents[j]) + " is not -1 or smaller than " +
+                       std::to_string(j)) ||
         !c.Finite(s.rest_local[j].translation, "skeleton.rest_local" + at + ".translation") ||
         !c.Finite(s.rest_local[j].scale, "skeleton.rest_local" + at + ".scale") ||
         !c.Finite(s.inverse_bind[j], "skeleton.inverse_bind" + at))
       return;
     const Quat q = s.rest_local[j].rotation;
-    if (!c.Require(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w),
-                   "skeleton.rest_local" + at + ".rotation", "is not finite"))
+    if (!c.Require(
+            std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w),
+            "skeleton.rest_local" + at + ".rotation", "is not finite"))
       return;
   }
 }
 
 void CheckClip(const ClipData& clip, size_t index, size_t joints, Checker& c) {
   const std::string at = "clips[" + std::to_string(index) + "]";
-  if (!c.Require(clip.duration >= 0.f && std::isfinite(clip.duration), at + ".duration", "is negative or not finite") ||
-      !c.Require(clip.sample_rate > 0.f && clip.sample_rate <= 10000.f && std::isfinite(clip.sample_rate),
-                 at + ".sample_rate", "is not in (0, 10000]") ||
+  if (!c.Require(clip.duration >= 0.f && std::isfinite(clip.duration), at + ".duration",
+                 "is negative or not finite") ||
+      !c.Require(
+          clip.sample_rate > 0.f && clip.sample_rate <= 10000.f && std::isfinite(clip.sample_rate),
+          at + ".sample_rate", "is not in (0, 10000]") ||
       !c.Require(clip.frame_count >= 1, at + ".frame_count", "is 0"))
     return;
   // Frame k sits at min(k / rate, duration): the last frame must reach the duration.
-  const double needed = std::ceil(static_cast<double>(clip.duration) * clip.sample_rate - 1e-3) + 1.0;
-  if (!c.Require(static_cast<double>(clip.frame_count) >= needed && clip.frame_count <= needed + 1.0,
-                 at + ".frame_count", "= " + std::to_string(clip.frame_count) + " does not cover the duration"))
+  const double needed =
+      std::ceil(static_cast<double>(clip.duration) * clip.sample_rate - 1e-3) + 1.0;
+  if (!c.Require(
+          static_cast<double>(clip.frame_count) >= needed && clip.frame_count <= needed + 1.0,
+          at + ".frame_count",
+          "= " + std::to_string(clip.frame_count) + " does not cover the duration"))
     return;
-  if (!c.Size(clip.keys.size(), static_cast<size_t>(clip.frame_count) * joints, at + ".keys")) return;
+  if (!c.Size(clip.keys.size(), static_cast<size_t>(clip.frame_count) * joints, at + ".keys"))
+    return;
   for (size_t k = 0; k < clip.keys.size(); ++k) {
     const Transform& t = clip.keys[k];
-    if (IsFinite(t.translation) && IsFinite(t.scale) && std::isfinite(t.rotation.x) && std::isfinite(t.rotation.y) &&
-        std::isfinite(t.rotation.z) && std::isfinite(t.rotation.w))
+    if (IsFinite(t.translation) && IsFinite(t.scale) && std::isfinite(t.rotation.x) &&
+        std::isfinite(t.rotation.y) && std::isfinite(t.rotation.z) && std::isfinite(t.rotation.w))
       continue;
     const std::string key = at + ".keys[" + std::to_string(k) + "]";
     if (!c.Finite(t.translation, key + ".translation") || !c.Finite(t.scale, key + ".scale") ||
@@ -107,21 +126,28 @@ void CheckClip(const ClipData& clip, size_t index, size_t joints, Checker& c) {
 
 void CheckMesh(const MeshData& m, size_t joints, Checker& c) {
   const size_t v = m.positions.size();
-  if (!c.Require(m.triangles.size() % 3 == 0, "mesh.triangles", "size is not a multiple of 3")) return;
+  if (!c.Require(m.triangles.size() % 3 == 0, "mesh.triangles", "size is not a multiple of 3"))
+    return;
   for (size_t i = 0; i < v; ++i)
-    if (!IsFinite(m.positions[i]) && !c.Finite(m.positions[i], "mesh.positions[" + std::to_string(i) + "]")) return;
-  for (size_t i = 0; i < m.triangles.size(); ++i)
-    if (m.triangles[i] >= v && !c.Index(m.triangles[i], static_cast<int64_t>(v), "mesh.triangles[" + std::to_string(i) + "]"))
+    if (!IsFinite(m.positions[i]) &&
+        !c.Finite(m.positions[i], "mesh.positions[" + std::to_string(i) + "]"))
       return;
-  if (m.influence_offsets.empty() && m.influence_joints.empty() && m.influence_weights.empty()) return;
+  for (size_t i = 0; i < m.triangles.size(); ++i)
+    if (m.triangles[i] >= v && !c.Index(m.triangles[i], static_cast<int64_t>(v),
+                                        "mesh.triangles[" + std::to_string(i) + "]"))
+      return;
+  if (m.influence_offsets.empty() && m.influence_joints.empty() && m.influence_weights.empty())
+    return;
   if (!c.Offsets(m.influence_offsets, v, m.influence_joints.size(), "mesh.influence_offsets") ||
       !c.Size(m.influence_weights.size(), m.influence_joints.size(), "mesh.influence_weights"))
     return;
   for (size_t i = 0; i < m.influence_joints.size(); ++i) {
     const float w = m.influence_weights[i];
-    if (m.influence_joints[i] < joints && std::isfinite(w) && w >= 0.f && w <= 1.f + 1e-4f) continue;
+    if (m.influence_joints[i] < joints && std::isfinite(w) && w >= 0.f && w <= 1.f + 1e-4f)
+      continue;
     const std::string at = "[" + std::to_string(i) + "]";
-    if (!c.Index(m.influence_joints[i], static_cast<int64_t>(joints), "mesh.influence_joints" + at) ||
+    if (!c.Index(m.influence_joints[i], static_cast<int64_t>(joints),
+                 "mesh.influence_joints" + at) ||
         !c.Require(std::isfinite(m.influence_weights[i]) && m.influence_weights[i] >= 0.f &&
                        m.influence_weights[i] <= 1.f + 1e-4f,
                    "mesh.influence_weights" + at, "is not in [0, 1]"))
@@ -130,20 +156,27 @@ void CheckMesh(const MeshData& m, size_t joints, Checker& c) {
 }
 
 void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
-  if (!c.Require(std::isfinite(set.epsilon) && set.epsilon >= 0.f, "body_maps.epsilon", "is negative or not finite"))
+  if (!c.Require(std::isfinite(set.epsilon) && set.epsilon >= 0.f, "body_maps.epsilon",
+                 "is negative or not finite"))
     return;
   for (size_t p = 0; p < set.poses.size(); ++p) {
     const BodyMapPose& pose = set.poses[p];
     const std::string at = "body_maps.poses[" + std::to_string(p) + "]";
-    if (!c.Require(pose.clip >= -1 && pose.clip < static_cast<int64_t>(clips), at + ".clip", "is not -1 or a clip index") ||
-        !c.Require(pose.width >= 1 && pose.height >= 1 && pose.width <= 16384 && pose.height <= 16384,
-                   at, "size is not in [1, 16384] texels") ||
-        !c.Require(std::isfinite(pose.texel_size) && pose.texel_size > 0.f, at + ".texel_size", "is not > 0") ||
-        !c.Require(std::isfinite(pose.depth_range) && pose.depth_range > 0.f, at + ".depth_range", "is not > 0") ||
+    if (!c.Require(pose.clip >= -1 && pose.clip < static_cast<int64_t>(clips), at + ".clip",
+                   "is not -1 or a clip index") ||
+        !c.Require(
+            pose.width >= 1 && pose.height >= 1 && pose.width <= 16384 && pose.height <= 16384, at,
+            "size is not in [1, 16384] texels") ||
+        !c.Require(std::isfinite(pose.texel_size) && pose.texel_size > 0.f, at + ".texel_size",
+                   "is not > 0") ||
+        !c.Require(std::isfinite(pose.depth_range) && pose.depth_range > 0.f, at + ".depth_range",
+                   "is not > 0") ||
         !c.Finite(pose.origin_x, at + ".origin_x") || !c.Finite(pose.origin_y, at + ".origin_y") ||
         !c.Finite(pose.front_z, at + ".front_z") || !c.Finite(pose.time, at + ".time") ||
-        !c.Require(static_cast<uint8_t>(pose.depth_encoding) <= 1, at + ".depth_encoding", "is unknown") ||
-        !c.Require(static_cast<uint8_t>(pose.normal_encoding) <= 2, at + ".normal_encoding", "is unknown"))
+        !c.Require(static_cast<uint8_t>(pose.depth_encoding) <= 1, at + ".depth_encoding",
+                   "is unknown") ||
+        !c.Require(static_cast<uint8_t>(pose.normal_encoding) <= 2, at + ".normal_encoding",
+                   "is unknown"))
       return;
     const size_t texels = static_cast<size_t>(pose.width) * pose.height;
     const bool f32 = pose.depth_encoding == DepthEncoding::kFloat32;
@@ -151,43 +184,59 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
       const std::string v = view == 0 ? "front" : "back";
       if (!c.Size(pose.depth_f32[view].size(), f32 ? texels : 0, at + ".depth_f32_" + v) ||
           !c.Size(pose.depth_u16[view].size(), f32 ? 0 : texels, at + ".depth_u16_" + v) ||
-          !c.Size(pose.normal_f32[view].size(), pose.normal_encoding == NormalEncoding::kFloat32 ? 3 * texels : 0,
+          !c.Size(pose.normal_f32[view].size(),
+                  pose.normal_encoding == NormalEncoding::kFloat32 ? 3 * texels : 0,
                   at + ".normal_f32_" + v) ||
-          !c.Size(pose.normal_oct16[view].size(), pose.normal_encoding == NormalEncoding::kOct16 ? 2 * texels : 0,
+          !c.Size(pose.normal_oct16[view].size(),
+                  pose.normal_encoding == NormalEncoding::kOct16 ? 2 * texels : 0,
                   at + ".normal_oct16_" + v) ||
-          !c.Size(pose.normal_rgb8[view].size(), pose.normal_encoding == NormalEncoding::kRgb8 ? 3 * texels : 0,
+          !c.Size(pose.normal_rgb8[view].size(),
+                  pose.normal_encoding == NormalEncoding::kRgb8 ? 3 * texels : 0,
                   at + ".normal_rgb8_" + v))
         return;
       for (size_t i = 0; i < pose.depth_f32[view].size(); ++i)
-        if (std::isnan(pose.depth_f32[view][i]) && !c.Require(!std::isnan(pose.depth_f32[view][i]), at + ".depth_f32_" + v + "[" + std::to_string(i) + "]",
-                       "is NaN"))
+        if (std::isnan(pose.depth_f32[view][i]) &&
+            !c.Require(!std::isnan(pose.depth_f32[view][i]),
+                       at + ".depth_f32_" + v + "[" + std::to_string(i) + "]", "is NaN"))
           return;
       for (size_t i = 0; i < pose.normal_f32[view].size(); ++i)
-        if (!std::isfinite(pose.normal_f32[view][i]) && !c.Finite(pose.normal_f32[view][i], at + ".normal_f32_" + v + "[" + std::to_string(i) + "]")) return;
+        if (!std::isfinite(pose.normal_f32[view][i]) &&
+            !c.Finite(pose.normal_f32[view][i],
+                      at + ".normal_f32_" + v + "[" + std::to_string(i) + "]"))
+          return;
     }
   }
 }
 
-void CheckHierarchy(const KirkpatrickHierarchy& k, size_t planes, const std::string& at, Checker& c) {
-  if (k.node_triangles.empty() && k.vertices_uv.empty() && k.child_offsets.empty()) return;  // not baked
+void CheckHierarchy(const KirkpatrickHierarchy& k, size_t planes, const std::string& at,
+                    Checker& c) {
+  if (k.node_triangles.empty() && k.vertices_uv.empty() && k.child_offsets.empty())
+    return;  // not baked
   const size_t vertices = k.vertices_uv.size() / 2;
   const size_t nodes = k.node_triangles.size() / 3;
   if (!c.Require(k.vertices_uv.size() % 2 == 0, at + ".vertices_uv", "size is odd") ||
-      !c.Require(k.node_triangles.size() % 3 == 0, at + ".node_triangles", "size is not a multiple of 3") ||
+      !c.Require(k.node_triangles.size() % 3 == 0, at + ".node_triangles",
+                 "size is not a multiple of 3") ||
       !c.Offsets(k.child_offsets, nodes, k.children.size(), at + ".child_offsets") ||
       !c.Size(k.leaf_planes.size(), nodes, at + ".leaf_planes") ||
       !c.Require(k.root_begin <= k.root_end && k.root_end <= nodes && k.root_begin < k.root_end, at,
                  "root range is empty or out of range"))
     return;
   for (size_t i = 0; i < k.vertices_uv.size(); ++i)
-    if (!std::isfinite(k.vertices_uv[i]) && !c.Finite(k.vertices_uv[i], at + ".vertices_uv[" + std::to_string(i) + "]")) return;
+    if (!std::isfinite(k.vertices_uv[i]) &&
+        !c.Finite(k.vertices_uv[i], at + ".vertices_uv[" + std::to_string(i) + "]"))
+      return;
   for (size_t i = 0; i < k.node_triangles.size(); ++i)
-    if (k.node_triangles[i] >= vertices && !c.Index(k.node_triangles[i], static_cast<int64_t>(vertices), at + ".node_triangles[" + std::to_string(i) + "]"))
+    if (k.node_triangles[i] >= vertices &&
+        !c.Index(k.node_triangles[i], static_cast<int64_t>(vertices),
+                 at + ".node_triangles[" + std::to_string(i) + "]"))
       return;
   for (size_t node = 0; node < nodes; ++node) {
     for (uint32_t e = k.child_offsets[node]; e < k.child_offsets[node + 1]; ++e) {
       // Children come before their parent, so every walk from a root terminates.
-      if (k.children[e] >= node && !c.Index(k.children[e], static_cast<int64_t>(node), at + ".children[" + std::to_string(e) + "]")) return;
+      if (k.children[e] >= node && !c.Index(k.children[e], static_cast<int64_t>(node),
+                                            at + ".children[" + std::to_string(e) + "]"))
+        return;
     }
     if (!c.Require(k.leaf_planes[node] >= -1 && k.leaf_planes[node] < static_cast<int64_t>(planes),
                    at + ".leaf_planes[" + std::to_string(node) + "]", "is not -1 or a plane index"))
@@ -197,15 +246,18 @@ void CheckHierarchy(const KirkpatrickHierarchy& k, size_t planes, const std::str
 
 void CheckHull(const HullColliderData& h, size_t index, size_t joints, Checker& c) {
   const std::string at = "hulls[" + std::to_string(index) + "]";
-  if (!c.Index(h.joint, static_cast<int64_t>(joints), at + ".joint") || !c.Finite(h.bind_frame, at + ".bind_frame") ||
-      !c.Require(!h.planes.empty() && h.planes.size() <= 4096, at + ".planes", "count is not in [1, 4096]") ||
+  if (!c.Index(h.joint, static_cast<int64_t>(joints), at + ".joint") ||
+      !c.Finite(h.bind_frame, at + ".bind_frame") ||
+      !c.Require(!h.planes.empty() && h.planes.size() <= 4096, at + ".planes",
+                 "count is not in [1, 4096]") ||
       !c.Require(h.triangles.size() % 3 == 0, at + ".triangles", "size is not a multiple of 3") ||
       !c.Size(h.triangle_planes.size(), h.triangles.size() / 3, at + ".triangle_planes"))
     return;
   for (size_t i = 0; i < h.vertices.size(); ++i)
     if (!c.Finite(h.vertices[i], at + ".vertices[" + std::to_string(i) + "]")) return;
   for (size_t i = 0; i < h.triangles.size(); ++i)
-    if (!c.Index(h.triangles[i], static_cast<int64_t>(h.vertices.size()), at + ".triangles[" + std::to_string(i) + "]"))
+    if (!c.Index(h.triangles[i], static_cast<int64_t>(h.vertices.size()),
+                 at + ".triangles[" + std::to_string(i) + "]"))
       return;
   for (size_t i = 0; i < h.triangle_planes.size(); ++i)
     if (!c.Index(h.triangle_planes[i], static_cast<int64_t>(h.planes.size()),
@@ -213,10 +265,14 @@ void CheckHull(const HullColliderData& h, size_t index, size_t joints, Checker& 
       return;
   for (size_t i = 0; i < h.planes.size(); ++i) {
     const std::string p = at + ".planes[" + std::to_string(i) + "]";
-    if (!c.Finite(h.planes[i].normal, p + ".normal") || !c.Finite(h.planes[i].offset, p + ".offset")) return;
+    if (!c.Finite(h.planes[i].normal, p + ".normal") ||
+        !c.Finite(h.planes[i].offset, p + ".offset"))
+      return;
   }
-  if (!c.Finite(h.obb.center, at + ".obb.center") || !c.Finite(h.obb.half_extents, at + ".obb.half_extents") ||
-      !c.Finite(h.obb.axes[0], at + ".obb.axes[0]") || !c.Finite(h.obb.axes[1], at + ".obb.axes[1]") ||
+  if (!c.Finite(h.obb.center, at + ".obb.center") ||
+      !c.Finite(h.obb.half_extents, at + ".obb.half_extents") ||
+      !c.Finite(h.obb.axes[0], at + ".obb.axes[0]") ||
+      !c.Finite(h.obb.axes[1], at + ".obb.axes[1]") ||
       !c.Finite(h.obb.axes[2], at + ".obb.axes[2]"))
     return;
   CheckHierarchy(h.upper, h.planes.size(), at + ".upper", c);
@@ -224,14 +280,16 @@ void CheckHull(const HullColliderData& h, size_t index, size_t joints, Checker& 
   const MapTableData& t = h.map;
   if (t.rows == 0 && t.cols == 0 && t.cell_offsets.empty()) return;  // no table baked
   if (!c.Require(static_cast<uint8_t>(t.kind) <= 1, at + ".map.kind", "is unknown") ||
-      !c.Require(t.rows >= 1 && t.cols >= 1 && static_cast<uint64_t>(t.rows) * t.cols <= (1u << 20), at + ".map",
-                 "rows x cols is not in [1, 2^20]") ||
-      !c.Offsets(t.cell_offsets, static_cast<size_t>(t.rows) * t.cols, t.cell_triangles.size(), at + ".map.cell_offsets") ||
+      !c.Require(t.rows >= 1 && t.cols >= 1 && static_cast<uint64_t>(t.rows) * t.cols <= (1u << 20),
+                 at + ".map", "rows x cols is not in [1, 2^20]") ||
+      !c.Offsets(t.cell_offsets, static_cast<size_t>(t.rows) * t.cols, t.cell_triangles.size(),
+                 at + ".map.cell_offsets") ||
       !c.Finite(t.origin, at + ".map.origin") || !c.Finite(t.axis, at + ".map.axis") ||
       !c.Finite(t.reference, at + ".map.reference") || !c.Finite(t.length, at + ".map.length"))
     return;
   for (size_t i = 0; i < t.cell_triangles.size(); ++i)
-    if (t.cell_triangles[i] >= h.triangles.size() / 3 && !c.Index(t.cell_triangles[i], static_cast<int64_t>(h.triangles.size() / 3),
+    if (t.cell_triangles[i] >= h.triangles.size() / 3 &&
+        !c.Index(t.cell_triangles[i], static_cast<int64_t>(h.triangles.size() / 3),
                  at + ".map.cell_triangles[" + std::to_string(i) + "]"))
       return;
 }
@@ -242,16 +300,18 @@ Status ValidateAsset(const CharacterAsset& asset) {
   Checker c;
   CheckSkeleton(asset.skeleton, c);
   const size_t joints = asset.skeleton.parents.size();
-  for (size_t i = 0; i < asset.clips.size() && !c.failed(); ++i) CheckClip(asset.clips[i], i, joints, c);
+  for (size_t i = 0; i < asset.clips.size() && !c.failed(); ++i)
+    CheckClip(asset.clips[i], i, joints, c);
   if (!c.failed()) CheckMesh(asset.mesh, joints, c);
   if (!c.failed()) CheckBodyMaps(asset.body_maps, asset.clips.size(), c);
-  for (size_t i = 0; i < asset.hulls.size() && !c.failed(); ++i) CheckHull(asset.hulls[i], i, joints, c);
+  for (size_t i = 0; i < asset.hulls.size() && !c.failed(); ++i)
+    CheckHull(asset.hulls[i], i, joints, c);
   for (size_t i = 0; i < asset.joint_spheres.size() && !c.failed(); ++i) {
     const JointSphereData& s = asset.joint_spheres[i];
     const std::string at = "joint_spheres[" + std::to_string(i) + "]";
     if (c.Index(s.joint, static_cast<int64_t>(joints), at + ".joint") &&
-        c.Require(s.parent_joint >= -1 && s.parent_joint < static_cast<int64_t>(joints), at + ".parent_joint",
-                  "is not -1 or a joint index") &&
+        c.Require(s.parent_joint >= -1 && s.parent_joint < static_cast<int64_t>(joints),
+                  at + ".parent_joint", "is not -1 or a joint index") &&
         c.Finite(s.center, at + ".center"))
       c.Require(std::isfinite(s.radius) && s.radius > 0.f, at + ".radius", "is not > 0");
   }

@@ -48,7 +48,8 @@ void SaveArray(Archive& ar, const std::vector<T>& values) {
     ar(cereal::binary_data(values.data(), values.size() * sizeof(T)));
   } else if constexpr (binary && kIsFlatFloats<T>) {
     static_assert(sizeof(T) % sizeof(float) == 0);
-    ar(cereal::binary_data(reinterpret_cast<const float*>(values.data()), values.size() * sizeof(T)));
+    ar(cereal::binary_data(reinterpret_cast<const float*>(values.data()),
+                           values.size() * sizeof(T)));
   } else {
     for (const T& v : values) ar(v);
   }
@@ -144,7 +145,8 @@ template <class Archive>
 void serialize(Archive& ar, ClipData& c, const uint32_t version) {
   detail::CheckVersion(version, 1, "ClipData");
   ar(cereal::make_nvp("name", c.name), cereal::make_nvp("duration", c.duration),
-     cereal::make_nvp("sample_rate", c.sample_rate), cereal::make_nvp("frame_count", c.frame_count));
+     cereal::make_nvp("sample_rate", c.sample_rate),
+     cereal::make_nvp("frame_count", c.frame_count));
   Array(ar, "keys", c.keys);
 }
 

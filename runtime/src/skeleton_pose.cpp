@@ -35,7 +35,8 @@ void SkeletonPose::SetBind() {
 Status SkeletonPose::SampleClip(const ClipData& clip, float time, bool loop) {
   const size_t joints = world_.size();
   if (clip.frame_count == 0 || clip.keys.size() != static_cast<size_t>(clip.frame_count) * joints) {
-    return Status(StatusCode::kInvalidArgument, "clip '" + clip.name + "' does not match the skeleton");
+    return Status(StatusCode::kInvalidArgument,
+                  "clip '" + clip.name + "' does not match the skeleton");
   }
   if (!std::isfinite(time)) return Status(StatusCode::kInvalidArgument, "clip time is not finite");
   if (loop && clip.duration > 0.f) {
@@ -62,9 +63,9 @@ Status SkeletonPose::SampleClip(const ClipData& clip, float time, bool loop) {
 
 Status SkeletonPose::SetJointWorldMatrices(std::span<const Mat34> world) {
   if (world.size() != world_.size()) {
-    return Status(StatusCode::kInvalidArgument,
-                  "expected " + std::to_string(world_.size()) + " joint matrices, got " +
-                      std::to_string(world.size()));
+    return Status(StatusCode::kInvalidArgument, "expected " + std::to_string(world_.size()) +
+                                                    " joint matrices, got " +
+                                                    std::to_string(world.size()));
   }
   for (size_t j = 0; j < world.size(); ++j) {
     for (float v : world[j].m) {

@@ -10,7 +10,8 @@ Status SkinMesh(const MeshData& mesh, std::span<const Mat34> skinning, std::span
   const size_t count = mesh.positions.size();
   if (posed.size() != count) {
     return Status(StatusCode::kInvalidArgument, "output holds " + std::to_string(posed.size()) +
-                                                    " positions, the mesh has " + std::to_string(count));
+                                                    " positions, the mesh has " +
+                                                    std::to_string(count));
   }
   const bool skinned = mesh.influence_offsets.size() == count + 1;
   const int64_t n = static_cast<int64_t>(count);

@@ -50,9 +50,12 @@ const char* DepthName(drape::DepthEncoding e) {
 }
 const char* NormalName(drape::NormalEncoding e) {
   switch (e) {
-    case drape::NormalEncoding::kFloat32: return "float32";
-    case drape::NormalEncoding::kOct16: return "oct16";
-    case drape::NormalEncoding::kRgb8: return "rgb8";
+    case drape::NormalEncoding::kFloat32:
+      return "float32";
+    case drape::NormalEncoding::kOct16:
+      return "oct16";
+    case drape::NormalEncoding::kRgb8:
+      return "rgb8";
   }
   return "?";
 }
@@ -60,9 +63,10 @@ const char* NormalName(drape::NormalEncoding e) {
 std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path) {
   std::ostringstream o;
   o << "{\n  \"file\": " << Quote(path) << ",\n  \"format_version\": " << drape::kAssetFormatVersion
-    << ",\n  \"source\": " << Quote(a.info.source_name) << ",\n  \"tool_version\": "
-    << Quote(a.info.tool_version) << ",\n  \"unit_scale\": " << a.info.unit_scale
-    << ",\n  \"up_axis\": " << Quote(a.info.up_axis) << ",\n  \"joints\": [";
+    << ",\n  \"source\": " << Quote(a.info.source_name)
+    << ",\n  \"tool_version\": " << Quote(a.info.tool_version)
+    << ",\n  \"unit_scale\": " << a.info.unit_scale << ",\n  \"up_axis\": " << Quote(a.info.up_axis)
+    << ",\n  \"joints\": [";
   for (size_t j = 0; j < a.skeleton.joint_names.size(); ++j) {
     o << (j ? ", " : "") << "{\"name\": " << Quote(a.skeleton.joint_names[j])
       << ", \"parent\": " << a.skeleton.parents[j] << "}";
@@ -75,8 +79,9 @@ std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path)
   }
   o << "],\n  \"mesh\": {\"vertices\": " << a.mesh.vertex_count()
     << ", \"triangles\": " << a.mesh.triangle_count()
-    << ", \"influences\": " << a.mesh.influence_joints.size() << "},\n  \"body_maps\": {\"epsilon\": "
-    << a.body_maps.epsilon << ", \"resolution\": " << a.body_maps.resolution << ", \"poses\": [";
+    << ", \"influences\": " << a.mesh.influence_joints.size()
+    << "},\n  \"body_maps\": {\"epsilon\": " << a.body_maps.epsilon
+    << ", \"resolution\": " << a.body_maps.resolution << ", \"poses\": [";
   for (size_t p = 0; p < a.body_maps.poses.size(); ++p) {
     const auto& pose = a.body_maps.poses[p];
     o << (p ? ", " : "") << "{\"clip\": " << pose.clip << ", \"time\": " << pose.time
@@ -133,8 +138,8 @@ void PrintText(const drape::CharacterAsset& a, const std::string& path) {
     std::printf("    %-28s %zu triangles, %zu planes, map %s %ux%u\n",
                 a.skeleton.joint_names[hull.joint].c_str(), hull.triangles.size() / 3,
                 hull.planes.size(),
-                hull.map.kind == drape::MapTableKind::kSphere ? "sphere" : "cylinder", hull.map.rows,
-                hull.map.cols);
+                hull.map.kind == drape::MapTableKind::kSphere ? "sphere" : "cylinder",
+                hull.map.rows, hull.map.cols);
   }
   std::printf("  joint spheres: %zu\n", a.joint_spheres.size());
   for (const auto& sphere : a.joint_spheres) {
@@ -176,7 +181,8 @@ int main(int argc, char** argv) {
   }
   for (const auto& clip : asset.clips) {
     if (drape::Status status = pose.SampleClip(clip, 0.f, false); !status.ok()) {
-      std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
+      std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(),
+                   status.message().c_str());
       return 1;
     }
   }

@@ -86,7 +86,8 @@ struct Reference {
 
   aiMatrix4x4 Global(const aiNode* node, const aiAnimation* anim, double tick) const {
     aiMatrix4x4 m = Local(node, anim, tick);
-    for (const aiNode* p = node->mParent; p != nullptr; p = p->mParent) m = Local(p, anim, tick) * m;
+    for (const aiNode* p = node->mParent; p != nullptr; p = p->mParent)
+      m = Local(p, anim, tick) * m;
     return m;
   }
 
@@ -109,7 +110,8 @@ struct Reference {
         std::vector<float> weight(m->mNumVertices, 0.f);
         for (unsigned b = 0; b < m->mNumBones; ++b) {
           const aiBone* bone = m->mBones[b];
-          const aiMatrix4x4 skin = Global(node_by_name.at(bone->mName.C_Str()), anim, tick) * bone->mOffsetMatrix;
+          const aiMatrix4x4 skin =
+              Global(node_by_name.at(bone->mName.C_Str()), anim, tick) * bone->mOffsetMatrix;
           for (unsigned w = 0; w < bone->mNumWeights; ++w) {
             const aiVertexWeight& vw = bone->mWeights[w];
             sum[vw.mVertexId] += (skin * m->mVertices[vw.mVertexId]) * vw.mWeight;
@@ -147,7 +149,8 @@ struct CharacterCase {
 class ImportEveryCharacter : public ::testing::TestWithParam<CharacterCase> {};
 
 TEST_P(ImportEveryCharacter, RuntimeSkinningMatchesAssimpHierarchy) {
-  const std::string path = *GetParam().path ? test::CharacterPath(GetParam().path) : test::MannequinPath();
+  const std::string path =
+      *GetParam().path ? test::CharacterPath(GetParam().path) : test::MannequinPath();
   DRAPE_REQUIRE_FILE(path);
   Character character;
   const Status status = ImportCharacter(path, ImportOptions{}, &character);
@@ -161,8 +164,9 @@ TEST_P(ImportEveryCharacter, RuntimeSkinningMatchesAssimpHierarchy) {
   ASSERT_TRUE(ValidateAsset(asset).ok()) << ValidateAsset(asset).message();
 
   Reference ref;
-  ref.scene = ref.importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                              aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+  ref.scene =
+      ref.importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                      aiProcess_SortByPType | aiProcess_ValidateDataStructure);
   ASSERT_NE(ref.scene, nullptr);
   ref.Index(ref.scene->mRootNode);
   const Mat34& to_asset = character.info.source_to_asset;
@@ -203,11 +207,14 @@ TEST_P(ImportEveryCharacter, RuntimeSkinningMatchesAssimpHierarchy) {
       ASSERT_TRUE(pose.SampleClip(clip, time, false).ok());
       anim = ref.scene->mAnimations[s.clip];
       const double tps = anim->mTicksPerSecond > 0 ? anim->mTicksPerSecond : 25.0;
-      tick = std::min(static_cast<double>(s.frame) / clip.sample_rate, static_cast<double>(clip.duration)) * tps;
+      tick = std::min(static_cast<double>(s.frame) / clip.sample_rate,
+                      static_cast<double>(clip.duration)) *
+             tps;
     }
     ASSERT_TRUE(SkinMesh(asset.mesh, pose.skinning(), posed).ok());
     std::vector<Float3> expected;
-    for (const aiVector3D& p : ref.Posed(anim, tick)) expected.push_back(TransformPoint(to_asset, {p.x, p.y, p.z}));
+    for (const aiVector3D& p : ref.Posed(anim, tick))
+      expected.push_back(TransformPoint(to_asset, {p.x, p.y, p.z}));
     const double forward = OneSidedHausdorff(posed, expected);
     const double backward = OneSidedHausdorff(expected, posed);
     EXPECT_LT(forward, tolerance) << path << " clip " << s.clip << " frame " << s.frame;
@@ -215,14 +222,15 @@ TEST_P(ImportEveryCharacter, RuntimeSkinningMatchesAssimpHierarchy) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(SharedCharacters, ImportEveryCharacter,
-                         ::testing::Values(CharacterCase{"", 17}, CharacterCase{"RiggedSimple/RiggedSimple.gltf", 2},
-                                           CharacterCase{"RiggedFigure/RiggedFigure.glb", 19},
-                                           CharacterCase{"CesiumMan/CesiumMan.glb", 19},
-                                           CharacterCase{"Fox/Fox.glb", 24},
-                                           CharacterCase{"RobotExpressive/RobotExpressive.glb", 43},
-                                           CharacterCase{"QuaterniusAnimatedHuman/Animated_Human.fbx", 41},
-                                           CharacterCase{"QuaterniusSpider/Spider.fbx", 39}));
+INSTANTIATE_TEST_SUITE_P(
+    SharedCharacters, ImportEveryCharacter,
+    ::testing::Values(CharacterCase{"", 17}, CharacterCase{"RiggedSimple/RiggedSimple.gltf", 2},
+                      CharacterCase{"RiggedFigure/RiggedFigure.glb", 19},
+                      CharacterCase{"CesiumMan/CesiumMan.glb", 19},
+                      CharacterCase{"Fox/Fox.glb", 24},
+                      CharacterCase{"RobotExpressive/RobotExpressive.glb", 43},
+                      CharacterCase{"QuaterniusAnimatedHuman/Animated_Human.fbx", 41},
+                      CharacterCase{"QuaterniusSpider/Spider.fbx", 39}));
 
 TEST(Importer, UnitsAndUpAxisDetected) {
   const std::string fox = test::CharacterPath("Fox/Fox.glb");
@@ -248,11 +256,13 @@ TEST(Importer, WeightsAreRenormalisedAndRigidPartsKept) {
   const MeshData& mesh = character.mesh;
   for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
     float sum = 0.f;
-    for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k) sum += mesh.influence_weights[k];
+    for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k)
+      sum += mesh.influence_weights[k];
     ASSERT_NEAR(sum, 1.f, 1e-5f) << "vertex " << v;
   }
   bool warned = false;
-  for (const std::string& w : character.warnings) warned |= w.find("weight sums outside") != std::string::npos;
+  for (const std::string& w : character.warnings)
+    warned |= w.find("weight sums outside") != std::string::npos;
   EXPECT_TRUE(warned) << "RobotExpressive's skinned hands have raw weight sums up to 1.755";
 }
 

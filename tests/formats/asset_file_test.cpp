@@ -60,7 +60,8 @@ CharacterAsset SmallAsset() {
   hull.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   hull.triangles = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
   hull.triangle_planes = {0, 1, 2, 3};
-  hull.planes = {{{0, 0, -1}, 0}, {{0, -1, 0}, 0}, {{-1, 0, 0}, 0}, {{0.577f, 0.577f, 0.577f}, 0.578f}};
+  hull.planes = {
+      {{0, 0, -1}, 0}, {{0, -1, 0}, 0}, {{-1, 0, 0}, 0}, {{0.577f, 0.577f, 0.577f}, 0.578f}};
   hull.upper.vertices_uv = {0, 0, 1, 0, 0, 1};
   hull.upper.node_triangles = {0, 1, 2, 0, 1, 2};
   hull.upper.child_offsets = {0, 0, 1};
@@ -151,7 +152,8 @@ TEST(AssetFile, TrailingBytesAreRefused) {
 TEST(AssetFile, WrongMagicIsRefused) {
   const std::string text = "{\"asset\": {\"version\": \"2.0\"}}";
   CharacterAsset out;
-  const Status s = DecodeAsset({reinterpret_cast<const uint8_t*>(text.data()), text.size()}, "model.gltf", &out);
+  const Status s =
+      DecodeAsset({reinterpret_cast<const uint8_t*>(text.data()), text.size()}, "model.gltf", &out);
   EXPECT_EQ(s.code(), StatusCode::kBadMagic);
   EXPECT_EQ(s.message(), "model.gltf: not a .drape file (wrong magic bytes)");
 }
@@ -164,7 +166,8 @@ TEST(AssetFile, NewerAndOlderFormatVersionsAreRefusedByName) {
     CharacterAsset out;
     const Status s = DecodeAsset(bytes, "v.drape", &out);
     EXPECT_EQ(s.code(), StatusCode::kUnsupportedVersion);
-    EXPECT_NE(s.message().find(version > kAssetFormatVersion ? "is newer" : "is older"), std::string::npos)
+    EXPECT_NE(s.message().find(version > kAssetFormatVersion ? "is newer" : "is older"),
+              std::string::npos)
         << s.message();
   }
 }
@@ -178,7 +181,8 @@ TEST(AssetFile, UnknownTypeVersionIsRefusedByTypeName) {
   CharacterAsset out;
   const Status s = DecodeAsset(bytes, "t.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_NE(s.message().find("unsupported version 2 of CharacterAsset"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("unsupported version 2 of CharacterAsset"), std::string::npos)
+      << s.message();
 }
 
 TEST(AssetFile, OutOfRangeIndicesAreRefusedWithTheField) {
@@ -187,7 +191,9 @@ TEST(AssetFile, OutOfRangeIndicesAreRefusedWithTheField) {
   std::vector<uint8_t> invalid;
   EXPECT_FALSE(EncodeAsset(a, &invalid).ok()) << "the writer must refuse an invalid asset";
   const Status v = ValidateAsset(a);
-  EXPECT_NE(v.message().find("hulls[0].triangles[4] = 99 is out of range [0, 4)"), std::string::npos) << v.message();
+  EXPECT_NE(v.message().find("hulls[0].triangles[4] = 99 is out of range [0, 4)"),
+            std::string::npos)
+      << v.message();
 
   CharacterAsset cyclic = SmallAsset();
   cyclic.hulls[0].upper.children[0] = 1;  // a node that is its own child: a walk would not end
@@ -227,7 +233,8 @@ TEST(AssetFile, WriterLeavesNoPartialFile) {
   EXPECT_EQ(s.code(), StatusCode::kIoError);
   EXPECT_NE(s.message().find(bad), std::string::npos);
   size_t files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) files += entry.is_regular_file();
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    files += entry.is_regular_file();
   EXPECT_EQ(files, 1u) << "only a.drape, no temporary left behind";
   const Status missing = ReadAssetFile(dir + "/none.drape", &back);
   EXPECT_EQ(missing.code(), StatusCode::kIoError);

@@ -18,7 +18,7 @@ inline std::string MannequinPath() { return SourceDir() + "/samples/mannequin/ma
 }  // namespace drape::test
 
 // Skips the current test with a clear message when a shared asset is absent.
-#define DRAPE_REQUIRE_FILE(path)                                                          \
-  do {                                                                                    \
+#define DRAPE_REQUIRE_FILE(path)                                                           \
+  do {                                                                                     \
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared asset absent: " << (path); \
   } while (0)

@@ -1,6 +1,6 @@
 #pragma once
-// assimp -> Character. Measured pitfalls handled here are listed in ../shared/notes/algorithms.md §1:
-// joints keyed by node name (preferring the node without meshes), rest != bind, unit scale and
+// assimp -> Character. Measured pitfalls handled here are listed in ../shared/notes/algorithms.md
+// §1: joints keyed by node name (preferring the node without meshes), rest != bind, unit scale and
 // up axis chosen explicitly, weights renormalised by us (never LimitBoneWeights), no
 // PreTransformVertices/OptimizeGraph, FBX pivots not preserved.
 

@@ -29,7 +29,7 @@ struct BodyMapPose {
   float origin_x = 0.f, origin_y = 0.f;  // metres, asset frame
   float texel_size = 0.f;                // metres, > 0
   float front_z = 0.f;                   // asset-frame z of the front camera plane
-  float depth_range = 0.f;               // metres between the front and back planes (paper's W'), > 0
+  float depth_range = 0.f;  // metres between the front and back planes (paper's W'), > 0
   DepthEncoding depth_encoding = DepthEncoding::kFloat32;
   NormalEncoding normal_encoding = NormalEncoding::kFloat32;
   // Index 0 is the front view (looking along -z), 1 the back view (looking along +z). The back
@@ -37,15 +37,16 @@ struct BodyMapPose {
   // each view's own camera plane. Exactly the arrays of the chosen encodings are filled.
   std::vector<float> depth_f32[2];
   std::vector<uint16_t> depth_u16[2];
-  std::vector<float> normal_f32[2];      // 3 per texel
-  std::vector<uint16_t> normal_oct16[2]; // 2 per texel
-  std::vector<uint8_t> normal_rgb8[2];   // 3 per texel
+  std::vector<float> normal_f32[2];       // 3 per texel
+  std::vector<uint16_t> normal_oct16[2];  // 2 per texel
+  std::vector<uint8_t> normal_rgb8[2];    // 3 per texel
 };
 
 struct BodyMapSet {
-  float epsilon = 0.f;         // metres the surface was offset along its normals before rendering
-  uint32_t resolution = 0;     // N of the N x N window the maps were rendered in
-  bool fitted_window = false;  // true: the window was fitted to the body's L x H (not the paper's square)
+  float epsilon = 0.f;      // metres the surface was offset along its normals before rendering
+  uint32_t resolution = 0;  // N of the N x N window the maps were rendered in
+  bool fitted_window =
+      false;  // true: the window was fitted to the body's L x H (not the paper's square)
   std::vector<BodyMapPose> poses;
 };
 

@@ -15,11 +15,11 @@
 namespace drape {
 
 struct AssetInfo {
-  std::string source_name;    // file name of the character the asset was baked from
-  std::string tool_version;   // drape version that baked it
-  float unit_scale = 1.f;     // metres per source unit that was applied
-  std::string up_axis = "+Y"; // the source's up axis that was mapped to +Y
-  Mat34 source_to_asset;      // source scene-root frame -> asset frame (scale and rotation)
+  std::string source_name;     // file name of the character the asset was baked from
+  std::string tool_version;    // drape version that baked it
+  float unit_scale = 1.f;      // metres per source unit that was applied
+  std::string up_axis = "+Y";  // the source's up axis that was mapped to +Y
+  Mat34 source_to_asset;       // source scene-root frame -> asset frame (scale and rotation)
 };
 
 struct CharacterAsset {

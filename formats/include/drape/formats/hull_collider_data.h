@@ -17,20 +17,20 @@ struct Plane {  // inside when dot(normal, p) <= offset; normal is unit length
 
 struct Obb {  // in the collider frame
   Float3 center;
-  Float3 axes[3];        // orthonormal, right-handed
-  Float3 half_extents;   // metres along axes[k], >= 0
+  Float3 axes[3];       // orthonormal, right-handed
+  Float3 half_extents;  // metres along axes[k], >= 0
 };
 
 // A planar triangulation and its Kirkpatrick hierarchy as flat arrays. Nodes of all levels are
 // stored finest level first, so every child index is smaller than its parent's index: a walk
 // from the roots always ends. Leaves are the nodes with no children.
 struct KirkpatrickHierarchy {
-  std::vector<float> vertices_uv;          // 2 floats per vertex, in the projection plane
-  std::vector<uint32_t> node_triangles;    // 3 vertex indices per node, counter-clockwise in (u, v)
-  std::vector<uint32_t> child_offsets;     // node_count + 1 entries (compressed rows)
-  std::vector<uint32_t> children;          // node indices of the next finer level that overlap
-  std::vector<int32_t> leaf_planes;        // per node: the hull plane a leaf lies on, -1 if none
-  uint32_t root_begin = 0, root_end = 0;   // the coarsest level's node range
+  std::vector<float> vertices_uv;         // 2 floats per vertex, in the projection plane
+  std::vector<uint32_t> node_triangles;   // 3 vertex indices per node, counter-clockwise in (u, v)
+  std::vector<uint32_t> child_offsets;    // node_count + 1 entries (compressed rows)
+  std::vector<uint32_t> children;         // node indices of the next finer level that overlap
+  std::vector<int32_t> leaf_planes;       // per node: the hull plane a leaf lies on, -1 if none
+  uint32_t root_begin = 0, root_end = 0;  // the coarsest level's node range
 
   uint32_t node_count() const { return static_cast<uint32_t>(node_triangles.size() / 3); }
 };
@@ -42,12 +42,12 @@ enum class MapTableKind : uint8_t {
 
 struct MapTableData {
   MapTableKind kind = MapTableKind::kSphere;
-  uint32_t rows = 0;  // sphere: theta cells over [0, pi]; cylinder: z cells over [0, length]
-  uint32_t cols = 0;  // phi cells over [0, 2 pi)
-  Float3 origin;      // sphere centre, or the cylinder axis point at z = 0 (collider frame)
-  Float3 axis;        // unit: polar axis (sphere) or cylinder axis
-  Float3 reference;   // unit, perpendicular to axis: phi = 0
-  float length = 0.f; // metres, cylinder axis length (0 for a sphere)
+  uint32_t rows = 0;   // sphere: theta cells over [0, pi]; cylinder: z cells over [0, length]
+  uint32_t cols = 0;   // phi cells over [0, 2 pi)
+  Float3 origin;       // sphere centre, or the cylinder axis point at z = 0 (collider frame)
+  Float3 axis;         // unit: polar axis (sphere) or cylinder axis
+  Float3 reference;    // unit, perpendicular to axis: phi = 0
+  float length = 0.f;  // metres, cylinder axis length (0 for a sphere)
   std::vector<uint32_t> cell_offsets;  // rows * cols + 1 entries (compressed rows)
   std::vector<uint32_t> cell_triangles;
 };
@@ -59,13 +59,13 @@ struct HullColliderData {
   // frame without scale). bind_frame itself is affine: where the bind pose is scaled against the
   // rest pose (Animated_Human.fbx: about 65x), it carries that scale.
   Mat34 bind_frame;
-  std::vector<Float3> vertices;            // collider surface, collider frame, metres
-  std::vector<uint32_t> triangles;         // 3 per triangle, counter-clockwise outside
-  std::vector<uint32_t> triangle_planes;   // plane index of each triangle
-  std::vector<Plane> planes;               // coplanar triangles share one plane
+  std::vector<Float3> vertices;           // collider surface, collider frame, metres
+  std::vector<uint32_t> triangles;        // 3 per triangle, counter-clockwise outside
+  std::vector<uint32_t> triangle_planes;  // plane index of each triangle
+  std::vector<Plane> planes;              // coplanar triangles share one plane
   Obb obb;
-  Float3 projection_axis;                  // unit; "upper" faces have dot(n, axis) > 0
-  Float3 projection_u, projection_v;       // unit, (u, v, axis) right-handed
+  Float3 projection_axis;             // unit; "upper" faces have dot(n, axis) > 0
+  Float3 projection_u, projection_v;  // unit, (u, v, axis) right-handed
   KirkpatrickHierarchy upper, lower;
   MapTableData map;
 };

@@ -1,5 +1,6 @@
 #pragma once
-// Status values: how every fallible formats/runtime call reports failure (no exceptions cross the API).
+// Status values: how every fallible formats/runtime call reports failure (no exceptions cross the
+// API).
 
 #include <cstdint>
 #include <string>

@@ -7,8 +7,8 @@
 
 namespace drape {
 
-// Paper A eq. 5: P' = C_p (+ separation * N), V_n = (V.N) N, V' = (V - V_n)(1 - friction) - V_n * restitution,
-// applied only when V.N < 0 (a separating particle keeps its velocity).
+// Paper A eq. 5: P' = C_p (+ separation * N), V_n = (V.N) N, V' = (V - V_n)(1 - friction) - V_n *
+// restitution, applied only when V.N < 0 (a separating particle keeps its velocity).
 struct ResponseParams {
   float friction = 0.2f;     // c_fric in [0, 1]
   float restitution = 0.0f;  // c_res in [0, 1]
@@ -18,11 +18,11 @@ struct ResponseParams {
 // Per-particle result flags of the batch collision calls.
 enum CollisionFlags : uint8_t {
   kCollisionNone = 0,
-  kCollisionContact = 1 << 0,      // a contact was found and the response applied
-  kCollisionStartedInside = 1 << 1,// the segment started inside: pushed out, not swept
-  kCollisionSideWall = 1 << 2,     // body maps: entered through a texel side wall (staircase)
-  kCollisionFallback = 1 << 3,     // hulls: the map-table ray missed; the push-out was used
-  kCollisionInvalidInput = 1 << 7, // a NaN or infinite position; the particle was left untouched
+  kCollisionContact = 1 << 0,        // a contact was found and the response applied
+  kCollisionStartedInside = 1 << 1,  // the segment started inside: pushed out, not swept
+  kCollisionSideWall = 1 << 2,       // body maps: entered through a texel side wall (staircase)
+  kCollisionFallback = 1 << 3,       // hulls: the map-table ray missed; the push-out was used
+  kCollisionInvalidInput = 1 << 7,   // a NaN or infinite position; the particle was left untouched
 };
 
 // The answer for one query segment p0 -> p1 (a point query is p0 == p1).
