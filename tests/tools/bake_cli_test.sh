@@ -10,9 +10,11 @@ failures=0 passed=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 
 # expect_error NAME INPUT_FILE EXPECTED_REASON_REGEX [extra args]
+# The message must name the bad file: NAMED (default INPUT_FILE).
 expect_error() {
   local name=$1 input=$2 reason=$3
   shift 3
+  local named=${NAMED:-$input}
   local out="$WORK/$name.drape"
   "$BAKE" "$input" -o "$out" --report "$WORK/$name.json" "$@" >"$WORK/$name.stdout" 2>"$WORK/$name.stderr"
   local rc=$?
@@ -20,7 +22,7 @@ expect_error() {
   lines=$(wc -l <"$WORK/$name.stderr")
   if [ $rc -eq 0 ]; then fail "$name: exit 0 on bad input"; return; fi
   if [ "$lines" -ne 1 ]; then fail "$name: expected one stderr line, got $lines: $(cat "$WORK/$name.stderr")"; return; fi
-  if ! grep -qF -- "$input" "$WORK/$name.stderr"; then fail "$name: message does not name the input: $(cat "$WORK/$name.stderr")"; return; fi
+  if ! grep -qF -- "$named" "$WORK/$name.stderr"; then fail "$name: message does not name the input: $(cat "$WORK/$name.stderr")"; return; fi
   if ! grep -qiE -- "$reason" "$WORK/$name.stderr"; then fail "$name: message lacks reason /$reason/: $(cat "$WORK/$name.stderr")"; return; fi
   if ls "$WORK" | grep -q "^$name\.drape"; then fail "$name: an output file was left behind"; return; fi
   if [ -e "$WORK/$name.json" ]; then fail "$name: a report was left behind"; return; fi
@@ -66,16 +68,16 @@ OBJ
 expect_error inf_vertex "$WORK/inf.obj" "not finite|corrupt"
 # Duplicate joint names: the mannequin with two joints renamed alike.
 sed 's/"name": "knee_r"/"name": "knee_l"/' "$MANNEQUIN" >"$WORK/duplicate.gltf"
-expect_error duplicate_joints "$WORK/duplicate.gltf" "duplicate joint name 'knee_l'"
+expect_error duplicate_joints "$WORK/duplicate.gltf" "duplicate joint name 'knee_l'|\"knee_l\" has the same name"
 # A cyclic hierarchy: node 0's child is node 0.
 cat >"$WORK/cycle.gltf" <<'JSON'
 {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"name": "a", "children": [0]}]}
 JSON
 expect_error cyclic "$WORK/cycle.gltf" "cyclic|corrupt|no meshes"
 echo '{"import": {"unit_scale": -1}}' >"$WORK/bad_config.json"
-expect_error bad_config_value "$MANNEQUIN" "unit_scale.*must be in" --config "$WORK/bad_config.json"
+NAMED="$WORK/bad_config.json" expect_error bad_config_value "$MANNEQUIN" "unit_scale.*must be in" --config "$WORK/bad_config.json"
 echo '{"import": {"no_such_key": 1}}' >"$WORK/unknown_key.json"
-expect_error bad_config_key "$MANNEQUIN" "no_such_key is not a parameter" --config "$WORK/unknown_key.json"
+NAMED="$WORK/unknown_key.json" expect_error bad_config_key "$MANNEQUIN" "no_such_key is not a parameter" --config "$WORK/unknown_key.json"
 
 # --- Good input: bake, inspect, the report has the contract fields.
 if "$BAKE" "$MANNEQUIN" -o "$WORK/mannequin.drape" --report "$WORK/mannequin.json" 2>"$WORK/good.stderr"; then
