@@ -1,0 +1,272 @@
+#pragma once
+// Paper A's image-space body collider at run time: the front/back depth and normal maps of one
+// posed body (drape/formats/body_map_data.h), turned into a per-texel "slab" of asset-frame z
+// values, with a discrete inside test, a continuous segment test (2D texel walk with a per-texel
+// slab solve, notes/algorithms.md §5.1) and a batch call that applies paper A's response (eq. 5).
+//
+// Conventions (see body_map_data.h): the view axis is z; texel (i, j) covers
+// x in [origin_x + i*s, +s) and y in [origin_y + j*s, +s) (s = texel size). In texel units a
+// point has u = (x - origin_x) / s, v = (y - origin_y) / s and lies in texel (floor u, floor v).
+// The point is inside at that texel iff both maps are valid there and
+//   front_z - D_front >= z >= (front_z - depth_range) + D_back,
+// i.e. bottom <= z <= top with top/bottom the asset-frame z of the front/back surfaces. Points
+// outside the stored rectangle are outside.
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "drape/formats/body_map_data.h"
+#include "drape/formats/status.h"
+#include "drape/formats/types.h"
+#include "drape/runtime/collision_types.h"
+#include "drape/runtime/math.h"
+
+namespace drape {
+
+// ---------------------------------------------------------------------------------------------
+// Octahedral normal encoding (Cigolle et al. 2014, "A Survey of Efficient Representations for
+// Independent Unit Vectors"), 2 x uint16 per normal. This is the encoding of
+// NormalEncoding::kOct16; the bake uses these two functions so both sides agree bit for bit.
+// Mapping: n is projected onto the octahedron |x|+|y|+|z| = 1; the lower hemisphere (z < 0) is
+// folded over the diagonals; the resulting (a, b) in [-1, 1]^2 is stored as
+// round((a * 0.5 + 0.5) * 65535). Decoding uses a = q * (2 / 65535) - 1. Round-trip error is below
+// 0.004 degrees (measured in the tests). A zero or non-finite input encodes +z.
+
+// +1 for x >= 0 (also for -0), -1 otherwise: the octahedral fold needs a sign that is never 0.
+inline float OctSignNotZero(float x) { return x >= 0.f ? 1.f : -1.f; }
+
+inline std::array<uint16_t, 2> EncodeOct16(Float3 n) {
+  const float l1 = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
+  if (!(l1 > 1e-30f) || !std::isfinite(l1)) return {32768, 32768};  // (0, 0) in [-1,1]^2: +z
+  float a = n.x / l1;
+  float b = n.y / l1;
+  if (n.z < 0.f) {
+    const float folded_a = (1.f - std::fabs(b)) * OctSignNotZero(a);
+    const float folded_b = (1.f - std::fabs(a)) * OctSignNotZero(b);
+    a = folded_a;
+    b = folded_b;
+  }
+  const auto quantise = [](float c) {
+    const float unit = std::fmin(std::fmax(c * 0.5f + 0.5f, 0.f), 1.f);
+    return static_cast<uint16_t>(std::lround(unit * 65535.f));
+  };
+  return {quantise(a), quantise(b)};
+}
+
+inline Float3 DecodeOct16(uint16_t qa, uint16_t qb) {
+  Float3 n;
+  constexpr float kScale = 2.f / 65535.f;  // a multiply, not a divide: on the contact path
+  n.x = static_cast<float>(qa) * kScale - 1.f;
+  n.y = static_cast<float>(qb) * kScale - 1.f;
+  n.z = 1.f - std::fabs(n.x) - std::fabs(n.y);
+  if (n.z < 0.f) {
+    const float unfolded_x = (1.f - std::fabs(n.y)) * OctSignNotZero(n.x);
+    const float unfolded_y = (1.f - std::fabs(n.x)) * OctSignNotZero(n.y);
+    n.x = unfolded_x;
+    n.y = unfolded_y;
+  }
+  return NormalizeOr(n, Float3{0.f, 0.f, 1.f});
+}
+
+// Paper A's colour encoding (NormalEncoding::kRgb8): n = c / 255 * 2 - 1, normalised.
+inline Float3 DecodeRgb8(uint8_t r, uint8_t g, uint8_t b) {
+  const Float3 n{static_cast<float>(r) / 255.f * 2.f - 1.f,
+                 static_cast<float>(g) / 255.f * 2.f - 1.f,
+                 static_cast<float>(b) / 255.f * 2.f - 1.f};
+  return NormalizeOr(n, Float3{0.f, 0.f, 1.f});
+}
+
+// ---------------------------------------------------------------------------------------------
+
+// How the depth between texel centres is reconstructed.
+//  kNearest: the slab is constant over each texel (paper A). The segment test is exact: z is
+//    linear along the segment, so each texel is one linear solve.
+//  kBilinear: inside every 2x2 block of texel centres that are all valid and whose front and back
+//    depths each spread less than 3 texel sizes, top and bottom are bilinear in (u, v); elsewhere
+//    nearest (notes/algorithms.md §5.1 step 4). Along a segment a bilinear surface is quadratic
+//    in t, and the segment test solves it exactly (in double) on a half-texel grid, so every
+//    visited cell is either one bilinear patch or one nearest texel. About 2x the cells of
+//    kNearest; the continuous test near a surface costs about 3.5x (the quadratics run in
+//    every half-texel the segment does not clearly clear), see body_map_query_bench.cpp.
+//    Depth error on a sphere of 0.3 m at 1/128 m texels: over 10x smaller than nearest (tested).
+enum class DepthSampling : uint8_t { kNearest = 0, kBilinear = 1 };
+
+// What Build found in the maps (texel counts over the stored rectangle).
+struct BodyMapStats {
+  uint32_t valid_texels = 0;      // both maps valid and top >= bottom
+  uint32_t one_sided_texels = 0;  // exactly one map valid (silhouette disagreement): background
+  uint32_t inverted_texels = 0;   // both valid but front surface below back surface: background
+  uint32_t bilinear_blocks = 0;   // 2x2 blocks eligible for bilinear depth (kBilinear only)
+};
+
+class BodyMapSequence;
+
+// One pose's collider. Immutable after Build (or after BodyMapSequence fills it). Queries are
+// const, allocation-free and thread-safe.
+//
+// Memory (per texel of the stored rectangle): 8 bytes of slab (top, bottom z as float) + 8 bytes
+// of normals (front and back, re-encoded as oct16 whatever the input encoding: float32 input loses
+// < 0.004 degrees) + 1 byte of bilinear eligibility in kBilinear mode, plus 8 bytes per 8x8 block
+// for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB (17.1 MiB bilinear). memory_bytes() reports
+// the exact figure.
+class BodyMapCollider {
+ public:
+  // Validates the pose and decodes it into the internal layout (allocates). On error the collider
+  // is left empty (every point outside). Rejected: zero/huge width or height, texel size or depth
+  // range not finite and > 0, non-finite origin or front_z, an unknown encoding, an array of the
+  // chosen encoding whose length is not width*height (x3 / x2 for normals), a filled array of an
+  // encoding that was not chosen, a NaN or negative depth, a non-finite float normal.
+  Status Build(const BodyMapPose& pose, DepthSampling sampling = DepthSampling::kNearest);
+
+  // Discrete test at one point (no allocation; about 3 ns per particle in cloth order, see
+  // tests/bench/body_map_query_bench.cpp).
+  bool IsInside(Float3 p) const {
+    if (sampling_ != DepthSampling::kNearest) return IsInsideBilinear(p);
+    const float u = (p.x - origin_x_) * inv_texel_size_;
+    const float v = (p.y - origin_y_) * inv_texel_size_;
+    if (!(u >= 0.f && v >= 0.f && u < width_f_ && v < height_f_)) return false;  // also NaN
+    const Slab& s = slabs_[static_cast<size_t>(v) * width_ + static_cast<size_t>(u)];
+    return (p.z <= s.top) & (p.z >= s.bottom);  // no branch: near a surface it is a coin toss
+  }
+
+  // Continuous test of the motion p0 -> p1 (a point query is p0 == p1).
+  //  - The segment is clipped (Liang-Barsky, in double) to the box of the valid texels, then the
+  //    texels it crosses are walked in order (Amanatides-Woo in 2D; the cell sequence runs from
+  //    the texel of the clipped start to the texel of the clipped end, so the last texel is
+  //    exactly the one IsInside(p1) reads). Long walks skip 8x8 blocks that the segment passes
+  //    entirely in front of, behind, or that are empty (min/max level).
+  //  - The first entry wins: through the front surface (normal from the front map), the back
+  //    surface (back map), or a texel side wall (kCollisionSideWall; the entered texel's normal
+  //    from the map whose surface is nearer in z). t is the entry parameter in [0, 1]; point is
+  //    on the sampled surface (front/back) or on the texel wall.
+  //  - Started inside (p0 inside): entries after the segment has left the body still count. If
+  //    the segment never leaves and p1 is inside, p1 is pushed out along +z or -z to the nearer
+  //    surface with that map's normal: t = 0, kCollisionStartedInside, point = that surface
+  //    point above/below p1. If it leaves and does not re-enter: no contact.
+  //  - depth = penetration of p1 along z (min of its distances to the two surfaces), 0 outside.
+  //  - Non-finite input: contact = false, flags = kCollisionInvalidInput.
+  ContactQuery Query(Float3 p0, Float3 p1) const;
+
+  // Batch collision of particles moving previous[i] -> positions[i]: on contact applies
+  // ApplyResponse (paper A eq. 5; the velocity changes only when V.N < 0) in place to
+  // positions[i], velocities[i]. flags[i] is always written (CollisionFlags). A particle with a
+  // non-finite previous/current position or velocity gets kCollisionInvalidInput and is left
+  // untouched. OpenMP over particles, no allocation, bitwise identical at any thread count.
+  // All four spans must have the same size; params must be finite. contact_count (optional)
+  // receives the number of particles with kCollisionContact.
+  Status CollideBatch(std::span<const Float3> previous, std::span<Float3> positions,
+                      std::span<Float3> velocities, std::span<uint8_t> flags,
+                      const ResponseParams& params, uint32_t* contact_count = nullptr) const;
+
+  // Discrete batch: inside[i] = IsInside(points[i]) ? 1 : 0. Sizes must match.
+  Status InsideBatch(std::span<const Float3> points, std::span<uint8_t> inside) const;
+
+  bool empty() const { return width_ == 0; }
+  uint32_t width() const { return width_; }         // texels
+  uint32_t height() const { return height_; }       // texels
+  float texel_size() const { return texel_size_; }  // metres
+  float origin_x() const { return origin_x_; }
+  float origin_y() const { return origin_y_; }
+  DepthSampling sampling() const { return sampling_; }
+  int32_t clip() const { return clip_; }
+  float time() const { return time_; }
+  // Asset-frame box of the valid texels (x, y: texel edges; z: lowest back / highest front
+  // surface). Every inside point lies in it. Empty map: min > max.
+  Float3 bounds_min() const { return bounds_min_; }
+  Float3 bounds_max() const { return bounds_max_; }
+  const BodyMapStats& stats() const { return stats_; }
+  size_t memory_bytes() const;
+
+  // Per-texel access (tests, tools): false for background; top/bottom are asset-frame z.
+  bool TexelSlab(uint32_t i, uint32_t j, float* top, float* bottom) const;
+  Float3 TexelNormal(uint32_t i, uint32_t j, bool back) const;
+
+ private:
+  friend class BodyMapSequence;
+  friend struct BodyMapWalk;
+
+  struct Slab {
+    float top;     // z of the front surface; -inf on background
+    float bottom;  // z of the back surface; +inf on background
+  };
+  struct TexelNormals {
+    uint16_t front[2];  // oct16
+    uint16_t back[2];
+  };
+  struct BlockBounds {  // one 8x8 block of texels, widened by one texel on every side
+    float max_top;      // padded up; -inf when no valid texel
+    float min_bottom;   // padded down; +inf when no valid texel
+  };
+  static constexpr uint32_t kBlockShift = 3;  // 8x8 texels per min/max block
+  static constexpr uint32_t kBlockTexels = 1u << kBlockShift;
+
+  bool IsInsideBilinear(Float3 p) const;
+  void InsideRange(const Float3* points, uint8_t* inside, size_t count) const;  // kNearest
+  // top/bottom at texel coordinates (u, v) >= 0 inside the grid, in half-texel cell (ci, cj) =
+  // (floor 2u, floor 2v): bilinear in an eligible block, else the nearest texel.
+  void SampleSlab(int ci, int cj, float u, float v, float* top, float* bottom) const;
+  bool BilinearBlock(int i0, int j0) const;  // block with texel (i0, j0) as its lower corner
+  Float3 SampleNormal(int ci, int cj, float u, float v, bool back) const;
+  // Recomputes bounds, stats.valid_texels, bilinear eligibility and the min/max blocks from
+  // slabs_ (used by Build and by sequence blending).
+  void Finish();
+  void Clear();
+
+  uint32_t width_ = 0, height_ = 0;
+  float width_f_ = 0.f, height_f_ = 0.f;
+  float origin_x_ = 0.f, origin_y_ = 0.f;
+  float texel_size_ = 0.f, inv_texel_size_ = 0.f;  // metres, 1/metres
+  DepthSampling sampling_ = DepthSampling::kNearest;
+  int32_t clip_ = -1;
+  float time_ = 0.f;
+  Float3 bounds_min_{1.f, 1.f, 1.f}, bounds_max_{-1.f, -1.f, -1.f};
+  double clip_lo_[3] = {0.0, 0.0, 0.0}, clip_hi_[3] = {-1.0, -1.0, -1.0};  // Liang-Barsky box
+  uint32_t blocks_w_ = 0, blocks_h_ = 0;
+  BodyMapStats stats_;
+  std::vector<Slab> slabs_;            // width*height, row-major
+  std::vector<TexelNormals> normals_;  // width*height
+  std::vector<uint8_t> bilinear_ok_;   // width*height (kBilinear only): block (i, j)..(i+1, j+1)
+  std::vector<BlockBounds> blocks_;    // blocks_w_ * blocks_h_
+};
+
+// How a sequence answers times between its baked poses.
+//  kNearest: the baked pose nearest in time (ties: the earlier one).
+//  kBracket: the two poses bracketing the time, blended per texel into a caller-owned scratch
+//    collider when they share the same grid (width, height, origin, texel size): top and bottom
+//    z are interpolated linearly where both poses are valid; a texel valid in one pose only keeps
+//    that pose's slab while that pose is the nearer one in time (the silhouette switches halfway);
+//    normals come from the nearer pose. Different grids, a time on or outside the baked keys, or
+//    no scratch: nearest.
+enum class PoseBlend : uint8_t { kNearest = 0, kBracket = 1 };
+
+// The baked poses of one clip (or the bind pose alone).
+class BodyMapSequence {
+ public:
+  // poses: one clip's poses, sorted by non-decreasing finite time, all with the same clip index;
+  // at least one. Every pose is built with `sampling`; the first failure is returned with the
+  // pose index in its message and leaves the sequence empty.
+  Status Build(std::span<const BodyMapPose> poses, DepthSampling sampling = DepthSampling::kNearest,
+               PoseBlend blend = PoseBlend::kNearest);
+
+  // The collider for `time` (seconds, clamped to the baked range). With kBracket and a non-null
+  // scratch the answer may be *scratch, refilled by this call: the first fill allocates, later
+  // fills of the same grid size do not. O(texels) per blended call. An empty sequence returns an
+  // empty collider. Not thread-safe on the same scratch.
+  const BodyMapCollider& At(float time, BodyMapCollider* scratch = nullptr) const;
+
+  size_t size() const { return poses_.size(); }
+  const BodyMapCollider& pose(size_t index) const { return poses_[index]; }
+  PoseBlend blend() const { return blend_; }
+  size_t memory_bytes() const;
+
+ private:
+  std::vector<BodyMapCollider> poses_;
+  PoseBlend blend_ = PoseBlend::kNearest;
+  BodyMapCollider empty_;
+};
+
+}  // namespace drape

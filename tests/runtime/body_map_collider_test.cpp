@@ -1,0 +1,832 @@
+// Paper A's image-space collider at run time, on analytic maps built here (no bake dependency):
+// a sphere, a texel-aligned box, a slab thinner than one step, two boxes with a gap.
+
+#include "drape/runtime/body_map_collider.h"
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace drape {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr float kTexel = 1.f / 128.f;  // metres; a power of two, so texel edges are exact floats
+
+struct SurfaceSample {
+  bool valid = false;
+  double top = 0.0, bottom = 0.0;  // asset-frame z of the front / back surface
+  Float3 front_normal{0.f, 0.f, 1.f}, back_normal{0.f, 0.f, -1.f};
+};
+using SurfaceFn = std::function<SurfaceSample(double x, double y)>;
+
+struct GridSpec {
+  uint32_t width = 0, height = 0;
+  float origin_x = 0.f, origin_y = 0.f;
+  float texel = kTexel;
+  float front_z = 0.5f;
+  float depth_range = 1.f;
+};
+
+// Fills a pose by evaluating the surface at every texel centre, in the requested encodings.
+BodyMapPose MakePose(const GridSpec& g, const SurfaceFn& surface,
+                     DepthEncoding depth_encoding = DepthEncoding::kFloat32,
+                     NormalEncoding normal_encoding = NormalEncoding::kFloat32) {
+  BodyMapPose pose;
+  pose.width = g.width;
+  pose.height = g.height;
+  pose.origin_x = g.origin_x;
+  pose.origin_y = g.origin_y;
+  pose.texel_size = g.texel;
+  pose.front_z = g.front_z;
+  pose.depth_range = g.depth_range;
+  pose.depth_encoding = depth_encoding;
+  pose.normal_encoding = normal_encoding;
+  const size_t n = static_cast<size_t>(g.width) * g.height;
+  for (int view = 0; view < 2; ++view) {
+    if (depth_encoding == DepthEncoding::kFloat32) pose.depth_f32[view].resize(n);
+    if (depth_encoding == DepthEncoding::kUnorm16) pose.depth_u16[view].resize(n);
+    if (normal_encoding == NormalEncoding::kFloat32) pose.normal_f32[view].resize(3 * n);
+    if (normal_encoding == NormalEncoding::kOct16) pose.normal_oct16[view].resize(2 * n);
+    if (normal_encoding == NormalEncoding::kRgb8) pose.normal_rgb8[view].resize(3 * n);
+  }
+  const double back_plane = static_cast<double>(g.front_z) - g.depth_range;
+  for (uint32_t j = 0; j < g.height; ++j) {
+    for (uint32_t i = 0; i < g.width; ++i) {
+      const size_t k = static_cast<size_t>(j) * g.width + i;
+      const double x = g.origin_x + (i + 0.5) * g.texel;
+      const double y = g.origin_y + (j + 0.5) * g.texel;
+      const SurfaceSample s = surface(x, y);
+      const double depth[2] = {g.front_z - s.top, s.bottom - back_plane};
+      const Float3 normal[2] = {s.front_normal, s.back_normal};
+      for (int view = 0; view < 2; ++view) {
+        if (depth_encoding == DepthEncoding::kFloat32) {
+          pose.depth_f32[view][k] = s.valid ? static_cast<float>(depth[view]) : g.depth_range;
+        } else {
+          const double q = std::round(depth[view] / g.depth_range * 65535.0);
+          pose.depth_u16[view][k] =
+              s.valid ? static_cast<uint16_t>(std::clamp(q, 0.0, 65534.0)) : uint16_t{65535};
+        }
+        const Float3 nv = s.valid ? normal[view] : Float3{};
+        if (normal_encoding == NormalEncoding::kFloat32) {
+          pose.normal_f32[view][3 * k] = nv.x;
+          pose.normal_f32[view][3 * k + 1] = nv.y;
+          pose.normal_f32[view][3 * k + 2] = nv.z;
+        } else if (normal_encoding == NormalEncoding::kOct16) {
+          const std::array<uint16_t, 2> q = EncodeOct16(nv);
+          pose.normal_oct16[view][2 * k] = q[0];
+          pose.normal_oct16[view][2 * k + 1] = q[1];
+        } else {
+          const float c[3] = {nv.x, nv.y, nv.z};
+          for (int a = 0; a < 3; ++a) {
+            pose.normal_rgb8[view][3 * k + a] =
+                static_cast<uint8_t>(std::lround((c[a] * 0.5f + 0.5f) * 255.f));
+          }
+        }
+      }
+    }
+  }
+  return pose;
+}
+
+// Sphere of radius 0.3 m at the origin on an 88 x 88 grid of 1/128 m texels.
+constexpr double kSphereRadius = 0.3;
+GridSpec SphereGrid() {
+  GridSpec g;
+  g.width = g.height = 88;
+  g.origin_x = g.origin_y = -44.f * kTexel;
+  return g;
+}
+double SphereHeight(double x, double y) {
+  const double r2 = x * x + y * y;
+  return r2 < kSphereRadius * kSphereRadius ? std::sqrt(kSphereRadius * kSphereRadius - r2) : -1.0;
+}
+SurfaceSample Sphere(double x, double y) {
+  SurfaceSample s;
+  const double h = SphereHeight(x, y);
+  if (h < 0.0) return s;
+  s.valid = true;
+  s.top = h;
+  s.bottom = -h;
+  const auto r = static_cast<float>(kSphereRadius);
+  s.front_normal = {static_cast<float>(x) / r, static_cast<float>(y) / r,
+                    static_cast<float>(h) / r};
+  s.back_normal = {static_cast<float>(x) / r, static_cast<float>(y) / r,
+                   static_cast<float>(-h) / r};
+  return s;
+}
+
+// Texel-aligned box: x in [-25, 25) texels, y in [-12, 12) texels, z in [-1/16, 1/16] (exact
+// through the float depth encoding with front_z = 0.5, depth_range = 1).
+constexpr float kBoxTop = 0.0625f, kBoxBottom = -0.0625f;
+GridSpec BoxGrid() {
+  GridSpec g;
+  g.width = 64;
+  g.height = 40;
+  g.origin_x = -32.f * kTexel;
+  g.origin_y = -20.f * kTexel;
+  return g;
+}
+SurfaceSample Box(double x, double y) {
+  SurfaceSample s;
+  if (std::fabs(x) >= 25 * kTexel || std::fabs(y) >= 12 * kTexel) return s;
+  s.valid = true;
+  s.top = kBoxTop;
+  s.bottom = kBoxBottom;
+  return s;
+}
+
+// A horizontal slab 2 mm thick (z in [0, 0.002]), far thinner than the 10 cm steps thrown at it.
+constexpr float kSlabThickness = 0.002f;
+SurfaceSample ThinSlab(double x, double y) {
+  SurfaceSample s;
+  if (std::fabs(x) > 0.25 || std::fabs(y) > 0.25) return s;
+  s.valid = true;
+  s.top = kSlabThickness;
+  s.bottom = 0.0;
+  return s;
+}
+
+BodyMapCollider BuildOrDie(const BodyMapPose& pose,
+                           DepthSampling sampling = DepthSampling::kNearest) {
+  BodyMapCollider collider;
+  const Status status = collider.Build(pose, sampling);
+  EXPECT_TRUE(status.ok()) << status.message();
+  return collider;
+}
+
+// In double via atan2(|a x b|, a.b): acos of a float dot product cannot resolve 0.01 degrees.
+double AngleDegrees(Float3 a, Float3 b) {
+  const double ax = a.x, ay = a.y, az = a.z, bx = b.x, by = b.y, bz = b.z;
+  const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
+  const double cross = std::sqrt(cx * cx + cy * cy + cz * cz);
+  return std::atan2(cross, ax * bx + ay * by + az * bz) * 180.0 / kPi;
+}
+
+// Exact first entry of p0 -> p1 into the union of the collider's texel columns
+// [x_i, x_i + s] x [y_j, y_j + s] x [bottom, top] (nearest sampling), by brute force in double
+// over every texel. Returns -1 when the segment misses all of them.
+double ReferenceFirstEntry(const BodyMapCollider& c, Float3 p0, Float3 p1) {
+  double best = -1.0;
+  const double s = c.texel_size();
+  for (uint32_t j = 0; j < c.height(); ++j) {
+    for (uint32_t i = 0; i < c.width(); ++i) {
+      float top, bottom;
+      if (!c.TexelSlab(i, j, &top, &bottom)) continue;
+      const double lo[3] = {c.origin_x() + i * s, c.origin_y() + j * s, bottom};
+      const double hi[3] = {c.origin_x() + (i + 1) * s, c.origin_y() + (j + 1) * s, top};
+      const double a[3] = {p0.x, p0.y, p0.z};
+      const double d[3] = {static_cast<double>(p1.x) - p0.x, static_cast<double>(p1.y) - p0.y,
+                           static_cast<double>(p1.z) - p0.z};
+      double t0 = 0.0, t1 = 1.0;
+      bool miss = false;
+      for (int k = 0; k < 3 && !miss; ++k) {
+        if (d[k] == 0.0) {
+          miss = a[k] < lo[k] || a[k] > hi[k];
+          continue;
+        }
+        double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        miss = t0 > t1;
+      }
+      if (!miss && (best < 0.0 || t0 < best)) best = t0;
+    }
+  }
+  return best;
+}
+
+Float3 RandomPoint(std::mt19937& rng, float lo, float hi, float z_lo, float z_hi) {
+  std::uniform_real_distribution<float> xy(lo, hi), z(z_lo, z_hi);
+  const float x = xy(rng), y = xy(rng);
+  return {x, y, z(rng)};
+}
+
+// Even k: a long segment from anywhere in a 0.8 m cube through a point near the shapes (many
+// texels, the 8x8 block walk). Odd k: a short one (up to ~3 texels) near the surfaces.
+void RandomSegment(std::mt19937& rng, int k, Float3* p0, Float3* p1) {
+  const Float3 target = RandomPoint(rng, -0.25f, 0.25f, -0.2f, 0.2f);
+  if (k % 2 == 0) {
+    *p0 = RandomPoint(rng, -0.4f, 0.4f, -0.4f, 0.4f);
+    *p1 = *p0 + (target - *p0) * 1.6f;
+  } else {
+    *p0 = target + RandomPoint(rng, -0.01f, 0.01f, -0.01f, 0.01f);
+    *p1 = *p0 + RandomPoint(rng, -0.012f, 0.012f, -0.012f, 0.012f);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(Oct16, RoundTripErrorBelowFiveThousandthsOfADegree) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> gauss;
+  double worst = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    const Float3 n = NormalizeOr({gauss(rng), gauss(rng), gauss(rng)}, {0.f, 0.f, 1.f});
+    const std::array<uint16_t, 2> q = EncodeOct16(n);
+    worst = std::max(worst, AngleDegrees(n, DecodeOct16(q[0], q[1])));
+  }
+  EXPECT_LT(worst, 0.005);  // notes/algorithms.md §0: 0.0037 degrees max
+  const Float3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const Float3& a : axes) {
+    const std::array<uint16_t, 2> q = EncodeOct16(a);
+    EXPECT_LT(AngleDegrees(a, DecodeOct16(q[0], q[1])), 0.005);
+  }
+  EXPECT_LT(AngleDegrees(DecodeRgb8(128, 128, 255), {0.f, 0.f, 1.f}), 0.5);
+}
+
+TEST(BodyMapCollider, SphereClassificationAtTexelCentresIsTheSameForEveryEncoding) {
+  const GridSpec g = SphereGrid();
+  // 0.1 mm from either surface: well above the unorm16 step (1 m / 65535 = 15 um).
+  constexpr double kMargin = 1e-4;
+  const DepthEncoding depths[2] = {DepthEncoding::kFloat32, DepthEncoding::kUnorm16};
+  const NormalEncoding normals[3] = {NormalEncoding::kFloat32, NormalEncoding::kOct16,
+                                     NormalEncoding::kRgb8};
+  for (DepthEncoding de : depths) {
+    for (NormalEncoding ne : normals) {
+      const BodyMapCollider c = BuildOrDie(MakePose(g, Sphere, de, ne));
+      int checked = 0;
+      for (uint32_t j = 0; j < g.height; ++j) {
+        for (uint32_t i = 0; i < g.width; ++i) {
+          const double x = g.origin_x + (i + 0.5) * g.texel, y = g.origin_y + (j + 0.5) * g.texel;
+          const double h = SphereHeight(x, y);
+          const auto at = [&](double z) {
+            return c.IsInside(
+                {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)});
+          };
+          if (h < 0.0) {
+            EXPECT_FALSE(at(0.0)) << i << "," << j;
+            continue;
+          }
+          if (h < 2 * kMargin) continue;
+          EXPECT_TRUE(at(h - kMargin)) << i << "," << j;
+          EXPECT_FALSE(at(h + kMargin)) << i << "," << j;
+          EXPECT_TRUE(at(-h + kMargin)) << i << "," << j;
+          EXPECT_FALSE(at(-h - kMargin)) << i << "," << j;
+          EXPECT_TRUE(at(0.0));
+          ++checked;
+        }
+      }
+      EXPECT_GT(checked, 4000);
+      EXPECT_FALSE(c.IsInside({0.f, 0.f, 0.31f}));
+      EXPECT_FALSE(c.IsInside({1.f, 0.f, 0.f}));  // outside the stored rectangle
+      EXPECT_FALSE(c.IsInside({-1.f, -1.f, 0.f}));
+      // Normals within the encoding's error (rgb8: 0.385 degrees, oct16: 0.004).
+      const double tolerance = ne == NormalEncoding::kRgb8 ? 0.8 : 0.01;  // degrees
+      for (uint32_t t : {20u, 44u, 60u}) {
+        const SurfaceSample s =
+            Sphere(g.origin_x + (t + 0.5) * g.texel, g.origin_y + (44 + 0.5) * g.texel);
+        EXPECT_LT(AngleDegrees(c.TexelNormal(t, 44, false), s.front_normal), tolerance);
+        EXPECT_LT(AngleDegrees(c.TexelNormal(t, 44, true), s.back_normal), tolerance);
+      }
+    }
+  }
+}
+
+TEST(BodyMapCollider, StraightDownOnSphereGivesSurfacePointAndNormal) {
+  const BodyMapCollider c = BuildOrDie(MakePose(SphereGrid(), Sphere));
+  EXPECT_EQ(c.width(), 88u);
+  EXPECT_FLOAT_EQ(c.texel_size(), kTexel);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> xy(-0.25f, 0.25f);
+  int contacts = 0;
+  for (int k = 0; k < 500; ++k) {
+    const float x = xy(rng), y = xy(rng);
+    if (std::sqrt(x * x + y * y) > 0.8 * kSphereRadius) continue;
+    // Pure z motion: a zero-length 2D segment visits one texel.
+    const ContactQuery q = c.Query({x, y, 0.5f}, {x, y, 0.f});
+    ASSERT_TRUE(q.contact);
+    ++contacts;
+    EXPECT_TRUE(q.inside_end);
+    EXPECT_EQ(q.flags, kCollisionNone);
+    // Nearest sampling: the surface is the height at the texel centre, at most |grad h| * s/sqrt2
+    // (slope <= 0.8/0.6 here) from the true height.
+    const double slope_bound = 0.8 / 0.6 * kTexel * 0.7072 + 1e-6;
+    EXPECT_NEAR(q.point.z, SphereHeight(x, y), slope_bound);
+    EXPECT_FLOAT_EQ(q.point.x, x);
+    EXPECT_FLOAT_EQ(q.point.y, y);
+    EXPECT_NEAR(q.t, (0.5 - q.point.z) / 0.5, 1e-6);
+    // Normal: the texel centre's analytic normal (oct16 re-encoded float: < 0.005 degrees).
+    const double xc = c.origin_x() + (std::floor((x - c.origin_x()) / kTexel) + 0.5) * kTexel;
+    const double yc = c.origin_y() + (std::floor((y - c.origin_y()) / kTexel) + 0.5) * kTexel;
+    const Float3 expected = NormalizeOr(
+        {static_cast<float>(xc), static_cast<float>(yc), static_cast<float>(SphereHeight(xc, yc))},
+        {});
+    EXPECT_LT(AngleDegrees(q.normal, expected), 0.01);
+    EXPECT_NEAR(q.depth, q.point.z, 1e-6);  // p1 at z = 0, nearer surface is the front one
+    // From below: enters through the back surface, back normal.
+    const ContactQuery b = c.Query({x, y, -0.5f}, {x, y, 0.f});
+    ASSERT_TRUE(b.contact);
+    EXPECT_LT(b.point.z, 0.f);
+    EXPECT_LT(b.normal.z, 0.f);
+    EXPECT_NEAR(b.point.z, -q.point.z, 1e-6);
+  }
+  EXPECT_GT(contacts, 200);
+}
+
+// The walk against an exact brute-force reference over every texel column, for random segments
+// of every length (short ones walk texel by texel, long ones use the 8x8 min/max blocks).
+TEST(BodyMapCollider, WalkMatchesExactReferenceOnRandomSegments) {
+  for (int shape = 0; shape < 2; ++shape) {
+    const BodyMapCollider c = shape == 0 ? BuildOrDie(MakePose(SphereGrid(), Sphere))
+                                         : BuildOrDie(MakePose(BoxGrid(), Box));
+    std::mt19937 rng(11 + shape);
+    int hits = 0, misses = 0, side_walls = 0;
+    for (int k = 0; k < 1200; ++k) {
+      Float3 p0, p1;
+      RandomSegment(rng, k, &p0, &p1);
+      if (c.IsInside(p0)) continue;
+      const ContactQuery q = c.Query(p0, p1);
+      const double reference = ReferenceFirstEntry(c, p0, p1);
+      EXPECT_EQ(q.inside_end, c.IsInside(p1));
+      EXPECT_TRUE(!q.inside_end || q.contact);
+      ASSERT_EQ(q.contact, reference >= 0.0) << "segment " << k << " ref " << reference;
+      if (!q.contact) {
+        ++misses;
+        continue;
+      }
+      ++hits;
+      if (q.flags & kCollisionSideWall) ++side_walls;
+      // t resolution: float positions (~1e-7 m here) over the segment's length.
+      EXPECT_NEAR(q.t, reference, 2e-6 + 2e-7 / Length(p1 - p0)) << "segment " << k;
+      // The point lies on the segment (x, y exactly up to rounding) and on the surface (z).
+      const Float3 on_segment = Lerp(p0, p1, q.t);
+      EXPECT_NEAR(q.point.x, on_segment.x, 1e-5);
+      EXPECT_NEAR(q.point.y, on_segment.y, 1e-5);
+      EXPECT_NEAR(q.point.z, on_segment.z, 1e-5);
+      EXPECT_NEAR(Length(q.normal), 1.f, 1e-5);
+    }
+    std::printf("shape %d: %d hits (%d side walls), %d misses\n", shape, hits, side_walls, misses);
+    EXPECT_GT(hits, 200) << shape;
+    EXPECT_GT(misses, 50) << shape;
+    EXPECT_GT(side_walls, 20) << shape;
+  }
+}
+
+TEST(BodyMapCollider, FastParticleThroughThinSlabIsCaught) {
+  const BodyMapCollider c = BuildOrDie(MakePose(SphereGrid(), ThinSlab));
+  // 10 cm per step across a 2 mm slab: both end points are outside.
+  const Float3 p0{0.01f, 0.02f, 0.05f}, p1{0.01f, 0.02f, -0.05f};
+  EXPECT_FALSE(c.IsInside(p0));
+  EXPECT_FALSE(c.IsInside(p1));  // an endpoint-only test (paper A literal) misses this one
+  const ContactQuery q = c.Query(p0, p1);
+  ASSERT_TRUE(q.contact);
+  EXPECT_FALSE(q.inside_end);
+  EXPECT_FLOAT_EQ(q.depth, 0.f);
+  EXPECT_NEAR(q.t, (0.05 - kSlabThickness) / 0.1, 1e-6);
+  EXPECT_NEAR(q.point.z, kSlabThickness, 1e-7);
+  EXPECT_LT(AngleDegrees(q.normal, {0.f, 0.f, 1.f}), 0.01);
+  // From below, entering through the back surface, with the back normal (-z), not an average.
+  const ContactQuery b = c.Query(p1, p0);
+  ASSERT_TRUE(b.contact);
+  EXPECT_NEAR(b.t, 0.5, 1e-6);
+  EXPECT_LT(AngleDegrees(b.normal, {0.f, 0.f, -1.f}), 0.01);
+  // Diagonally across many texels: caught in the texel where z crosses the slab.
+  const Float3 d0{-0.2f, -0.1f, 0.04f}, d1{0.2f, 0.15f, -0.04f};
+  const ContactQuery diagonal = c.Query(d0, d1);
+  ASSERT_TRUE(diagonal.contact);
+  EXPECT_NEAR(diagonal.t, (0.04 - kSlabThickness) / 0.08, 1e-5);
+  EXPECT_EQ(diagonal.flags, kCollisionNone);
+}
+
+TEST(BodyMapCollider, SideWallEntryIsFlaggedWithTheNearerSurfacesNormal) {
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
+  const float edge = -25.f * kTexel;  // the box's -x side, a texel edge
+  const ContactQuery q = c.Query({-0.3f, 0.f, 0.03f}, {-0.1f, 0.f, 0.03f});
+  ASSERT_TRUE(q.contact);
+  EXPECT_TRUE(q.flags & kCollisionSideWall);
+  EXPECT_NEAR(q.point.x, edge, 1e-6);
+  EXPECT_NEAR(q.t, (edge + 0.3) / 0.2, 1e-5);
+  EXPECT_LT(AngleDegrees(q.normal, {0.f, 0.f, 1.f}), 0.01);  // z = 0.03 is nearer the front
+  const ContactQuery low = c.Query({-0.3f, 0.f, -0.03f}, {-0.1f, 0.f, -0.03f});
+  ASSERT_TRUE(low.contact);
+  EXPECT_LT(AngleDegrees(low.normal, {0.f, 0.f, -1.f}), 0.01);
+}
+
+TEST(BodyMapCollider, GrazingSegments) {
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
+  // Sinking by 2 um over 40 texels: crosses the top surface half way, through the front.
+  const ContactQuery q = c.Query({-0.15f, 0.f, kBoxTop + 1e-6f}, {0.15f, 0.f, kBoxTop - 1e-6f});
+  ASSERT_TRUE(q.contact);
+  EXPECT_EQ(q.flags, kCollisionNone);
+  EXPECT_NEAR(q.t, 0.5, 0.02);
+  EXPECT_FLOAT_EQ(q.point.z, kBoxTop);
+  EXPECT_GE(q.t, 0.f);
+  EXPECT_LE(q.t, 1.f);
+  // Parallel, 1 um above: no contact. Parallel exactly on the surface (z = top is inside):
+  // entered through the box's side wall.
+  EXPECT_FALSE(c.Query({-0.3f, 0.f, kBoxTop + 1e-6f}, {0.3f, 0.f, kBoxTop + 1e-6f}).contact);
+  const ContactQuery on = c.Query({-0.3f, 0.f, kBoxTop}, {0.3f, 0.f, kBoxTop});
+  ASSERT_TRUE(on.contact);
+  EXPECT_TRUE(on.flags & kCollisionSideWall);
+  EXPECT_NEAR(on.point.x, -25.f * kTexel, 1e-6);
+}
+
+TEST(BodyMapCollider, PointsExactlyOnTexelBoundaries) {
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
+  // Texel (i) covers [x_i, x_i + s): the box's low edges belong to it, its high edges do not.
+  const float lo = -25.f * kTexel, hi = 25.f * kTexel;
+  EXPECT_TRUE(c.IsInside({lo, 0.f, 0.f}));
+  EXPECT_FALSE(c.IsInside({hi, 0.f, 0.f}));
+  EXPECT_TRUE(c.IsInside({0.f, -12.f * kTexel, 0.f}));
+  EXPECT_FALSE(c.IsInside({0.f, 12.f * kTexel, 0.f}));
+  EXPECT_TRUE(c.IsInside({0.f, 0.f, kBoxTop}));  // both surfaces are inside (closed slab)
+  EXPECT_TRUE(c.IsInside({0.f, 0.f, kBoxBottom}));
+  // Segments running exactly along a texel edge agree with the point test.
+  EXPECT_FALSE(c.Query({hi, -0.2f, 0.f}, {hi, 0.2f, 0.f}).contact);
+  const ContactQuery along = c.Query({lo, -0.2f, 0.f}, {lo, 0.2f, 0.f});
+  ASSERT_TRUE(along.contact);
+  EXPECT_NEAR(along.point.y, -12.f * kTexel, 1e-6);
+  EXPECT_TRUE(along.flags & kCollisionSideWall);
+  // Ending exactly on the high edge (just outside), coming along x: no contact.
+  EXPECT_FALSE(c.Query({0.3f, 0.f, 0.f}, {hi, 0.f, 0.f}).contact);
+  // Exactly through a texel corner of the box.
+  const ContactQuery corner =
+      c.Query({lo - 0.05f, -12.f * kTexel - 0.05f, 0.f}, {lo, -12.f * kTexel, 0.f});
+  ASSERT_TRUE(corner.contact);
+  EXPECT_NEAR(corner.t, 1.0, 1e-6);
+}
+
+TEST(BodyMapCollider, StartInsidePushesOutToTheNearerSurface) {
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
+  const ContactQuery up = c.Query({0.01f, 0.01f, 0.03f}, {0.02f, 0.01f, 0.03f});
+  ASSERT_TRUE(up.contact);
+  EXPECT_EQ(up.flags, kCollisionStartedInside);
+  EXPECT_FLOAT_EQ(up.t, 0.f);
+  EXPECT_FLOAT_EQ(up.point.x, 0.02f);  // p1 is pushed out along z
+  EXPECT_FLOAT_EQ(up.point.z, kBoxTop);
+  EXPECT_NEAR(up.depth, kBoxTop - 0.03f, 1e-7);
+  EXPECT_LT(AngleDegrees(up.normal, {0.f, 0.f, 1.f}), 0.01);
+  const ContactQuery down = c.Query({0.f, 0.f, -0.04f}, {0.f, 0.f, -0.04f});
+  ASSERT_TRUE(down.contact);
+  EXPECT_EQ(down.flags, kCollisionStartedInside);
+  EXPECT_FLOAT_EQ(down.point.z, kBoxBottom);
+  EXPECT_NEAR(down.depth, -0.04f - kBoxBottom, 1e-7);
+  EXPECT_LT(AngleDegrees(down.normal, {0.f, 0.f, -1.f}), 0.01);
+  // Leaving the body by itself: no contact.
+  EXPECT_FALSE(c.Query({0.f, 0.f, 0.f}, {0.f, 0.f, 0.2f}).contact);
+}
+
+TEST(BodyMapCollider, StartInsideThenReEnteringAnotherPartIsASweptContact) {
+  // Two boxes with a 10-texel gap: x in [-25, -5) and [5, 25) texels.
+  const auto two_boxes = [](double x, double y) {
+    SurfaceSample s = Box(x, y);
+    if (std::fabs(x) < 5 * kTexel) s.valid = false;
+    return s;
+  };
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), two_boxes));
+  const ContactQuery q = c.Query({-0.1f, 0.f, 0.f}, {0.1f, 0.f, 0.f});
+  ASSERT_TRUE(q.contact);
+  EXPECT_EQ(q.flags, kCollisionSideWall);  // not kCollisionStartedInside
+  EXPECT_NEAR(q.point.x, 5.f * kTexel, 1e-6);
+}
+
+TEST(BodyMapCollider, ResponseFollowsPaperEquation5) {
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
+  ResponseParams params;
+  params.friction = 0.3f;
+  params.restitution = 0.5f;
+  params.separation = 1e-4f;
+  // 0: falls onto the top. 1: same motion but a separating velocity (+z). 2: free, untouched.
+  // 3: NaN position. 4: infinite velocity.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<Float3> previous = {
+      {0.f, 0.f, 0.1f}, {0.f, 0.f, 0.1f}, {0.f, 0.f, 0.3f}, {0.f, 0.f, 0.1f}, {0.f, 0.f, 0.1f}};
+  std::vector<Float3> positions = {
+      {0.f, 0.f, 0.f}, {0.f, 0.f, 0.f}, {0.f, 0.f, 0.2f}, {nan, 0.f, 0.f}, {0.f, 0.f, 0.f}};
+  std::vector<Float3> velocities = {{1.f, 0.f, -2.f},
+                                    {1.f, 0.f, 1.f},
+                                    {1.f, 2.f, -3.f},
+                                    {1.f, 0.f, -2.f},
+                                    {std::numeric_limits<float>::infinity(), 0.f, 0.f}};
+  std::vector<uint8_t> flags(5, 0xff);
+  uint32_t contacts = 0;
+  ASSERT_TRUE(c.CollideBatch(previous, positions, velocities, flags, params, &contacts).ok());
+  EXPECT_EQ(contacts, 2u);
+  // V.N = -2 < 0: V_n = (0, 0, -2), V' = (V - V_n)(1 - 0.3) - V_n * 0.5 = (0.7, 0, 1), up to the
+  // oct16 normal (+z is 0.0012 degrees off: 65535 steps have no exact midpoint).
+  EXPECT_EQ(flags[0], kCollisionContact);
+  EXPECT_NEAR(positions[0].z, kBoxTop + params.separation, 1e-6);
+  EXPECT_NEAR(velocities[0].x, 0.7f, 1e-4);
+  EXPECT_NEAR(velocities[0].y, 0.f, 1e-4);
+  EXPECT_NEAR(velocities[0].z, 1.f, 1e-4);
+  {  // exactly eq. 5 with the contact's own normal
+    const ContactQuery q = c.Query(previous[0], {0.f, 0.f, 0.f});
+    const Float3 v{1.f, 0.f, -2.f};
+    const Float3 vn = q.normal * Dot(v, q.normal);
+    const Float3 expected = (v - vn) * (1.f - params.friction) - vn * params.restitution;
+    EXPECT_NEAR(velocities[0].x, expected.x, 1e-6);
+    EXPECT_NEAR(velocities[0].y, expected.y, 1e-6);
+    EXPECT_NEAR(velocities[0].z, expected.z, 1e-6);
+    EXPECT_NEAR(positions[0].x, q.point.x + q.normal.x * params.separation, 1e-7);
+  }
+  // Separating (V.N > 0): the position is put on the surface, the velocity is kept.
+  EXPECT_EQ(flags[1], kCollisionContact);
+  EXPECT_NEAR(positions[1].z, kBoxTop + params.separation, 1e-6);
+  EXPECT_EQ(velocities[1].x, 1.f);
+  EXPECT_EQ(velocities[1].z, 1.f);
+  EXPECT_EQ(flags[2], kCollisionNone);
+  EXPECT_EQ(positions[2].z, 0.2f);
+  EXPECT_EQ(velocities[2].y, 2.f);
+  EXPECT_EQ(flags[3], kCollisionInvalidInput);
+  EXPECT_TRUE(std::isnan(positions[3].x));
+  EXPECT_EQ(velocities[3].z, -2.f);
+  EXPECT_EQ(flags[4], kCollisionInvalidInput);
+  EXPECT_EQ(positions[4].z, 0.f);
+  // A query with NaN reports invalid input and no contact.
+  const ContactQuery bad = c.Query({nan, 0.f, 0.f}, {0.f, 0.f, 0.f});
+  EXPECT_FALSE(bad.contact);
+  EXPECT_EQ(bad.flags, kCollisionInvalidInput);
+  // Mismatched spans are an error, not a crash.
+  std::vector<uint8_t> short_flags(2);
+  EXPECT_EQ(c.CollideBatch(previous, positions, velocities, short_flags, params).code(),
+            StatusCode::kInvalidArgument);
+}
+
+TEST(BodyMapCollider, HugeCoordinatesAreClippedNotOverflowed) {
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
+  const ContactQuery q = c.Query({1e30f, 0.f, 0.f}, {-1e30f, 0.f, 0.f});
+  ASSERT_TRUE(q.contact);
+  EXPECT_TRUE(q.flags & kCollisionSideWall);
+  EXPECT_NEAR(q.point.x, 25.f * kTexel, 2e-3);  // the +x side (float t resolution at 1e30)
+  EXPECT_NEAR(q.t, 0.5, 1e-6);
+  const float big = 3e38f;
+  EXPECT_FALSE(c.Query({big, big, big}, {big, -big, big}).contact);
+  // Through the origin from +-3e38: the double clip cannot place the crossing to the metre, but
+  // the walk stays bounded by the map and the answer is well formed.
+  const ContactQuery through = c.Query({big, big, big}, {-big, -big, -big});
+  EXPECT_GE(through.t, 0.f);
+  EXPECT_LE(through.t, 1.f);
+  EXPECT_TRUE(IsFinite(through.point));
+  EXPECT_FALSE(c.IsInside({big, 0.f, 0.f}));
+  // Found by fuzzing: the exit parameter rounds to exactly 1 in double although p1 is 9e9 m
+  // outside the box; the end must still be clamped (an unclamped end overflowed the walk).
+  const ContactQuery far = c.Query({0.3f, 4.4e27f, 0.f}, {-0.39f, -8.9e9f, 0.45f});
+  EXPECT_FALSE(far.inside_end);
+  EXPECT_GE(far.t, 0.f);
+  EXPECT_LE(far.t, 1.f);
+  EXPECT_TRUE(IsFinite(far.point));
+}
+
+TEST(BodyMapCollider, BilinearDepthIsMoreAccurateThanNearestOnASphere) {
+  const BodyMapPose pose = MakePose(SphereGrid(), Sphere);
+  const BodyMapCollider nearest = BuildOrDie(pose, DepthSampling::kNearest);
+  const BodyMapCollider bilinear = BuildOrDie(pose, DepthSampling::kBilinear);
+  EXPECT_GT(bilinear.stats().bilinear_blocks, 3500u);  // of ~4600 texels on the disc
+  EXPECT_EQ(nearest.stats().bilinear_blocks, 0u);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> xy(-0.25f, 0.25f);
+  double sum[2] = {0, 0}, worst[2] = {0, 0}, normal_sum[2] = {0, 0};
+  int n = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const float x = xy(rng), y = xy(rng);
+    const double h = SphereHeight(x, y);
+    if (std::sqrt(x * x + y * y) > 0.8 * kSphereRadius) continue;
+    const Float3 truth_normal{x, y, static_cast<float>(h)};
+    const BodyMapCollider* colliders[2] = {&nearest, &bilinear};
+    for (int m = 0; m < 2; ++m) {
+      const ContactQuery q = colliders[m]->Query({x, y, 0.5f}, {x, y, 0.f});
+      ASSERT_TRUE(q.contact);
+      const double error = std::fabs(q.point.z - h);
+      sum[m] += error;
+      worst[m] = std::max(worst[m], error);
+      normal_sum[m] += AngleDegrees(q.normal, truth_normal);
+    }
+    ++n;
+  }
+  ASSERT_GT(n, 500);
+  // Nearest: error ~ slope * s / 2 (mm). Bilinear: ~ curvature * s^2 / 8 (um).
+  std::printf("depth error mean/max: nearest %.3g/%.3g m, bilinear %.3g/%.3g m\n", sum[0] / n,
+              worst[0], sum[1] / n, worst[1]);
+  EXPECT_LT(sum[1], 0.1 * sum[0]) << "mean nearest " << sum[0] / n << " bilinear " << sum[1] / n;
+  EXPECT_LT(worst[1], worst[0]);
+  EXPECT_LT(worst[1], 4e-4);  // s^2 / 8 * |h''| * 2 at r = 0.8 R
+  EXPECT_LT(normal_sum[1], normal_sum[0]);
+}
+
+TEST(BodyMapCollider, BilinearWalkAgreesWithBilinearPointTest) {
+  const BodyMapCollider c = BuildOrDie(MakePose(SphereGrid(), Sphere), DepthSampling::kBilinear);
+  std::mt19937 rng(21);
+  int hits = 0;
+  for (int k = 0; k < 600; ++k) {
+    Float3 p0, p1;
+    RandomSegment(rng, k, &p0, &p1);
+    if (c.IsInside(p0)) continue;
+    const ContactQuery q = c.Query(p0, p1);
+    EXPECT_EQ(q.inside_end, c.IsInside(p1));
+    EXPECT_TRUE(!q.inside_end || q.contact);
+    // Dense sampling of the point test: the walk never reports its entry later than the first
+    // inside sample, and every swept contact lies on the segment.
+    constexpr int kSamples = 20000;
+    int first = -1;
+    for (int s = 0; s <= kSamples && first < 0; ++s) {
+      if (c.IsInside(Lerp(p0, p1, static_cast<float>(s) / kSamples))) first = s;
+    }
+    if (first >= 0) {
+      ASSERT_TRUE(q.contact) << k;
+      EXPECT_LE(q.t, static_cast<double>(first) / kSamples + 1e-5) << k;
+      ++hits;
+    }
+    if (q.contact) {
+      const Float3 on_segment = Lerp(p0, p1, q.t);
+      EXPECT_NEAR(q.point.x, on_segment.x, 1e-5);
+      EXPECT_NEAR(q.point.y, on_segment.y, 1e-5);
+      EXPECT_NEAR(q.point.z, on_segment.z, 1e-4);
+      // On the true sphere within the bilinear error (the silhouette blocks are nearest).
+      if (!(q.flags & kCollisionSideWall)) {
+        EXPECT_NEAR(Length(q.point), kSphereRadius, 2.0 * kTexel) << k;
+      }
+    }
+  }
+  EXPECT_GT(hits, 150);
+}
+
+TEST(BodyMapCollider, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
+  const BodyMapCollider c = BuildOrDie(MakePose(SphereGrid(), Sphere));
+  std::mt19937 rng(9);
+  constexpr size_t kCount = 20000;
+  std::vector<Float3> previous(kCount), positions(kCount), velocities(kCount);
+  for (size_t k = 0; k < kCount; ++k) {
+    previous[k] = RandomPoint(rng, -0.35f, 0.35f, -0.35f, 0.35f);
+    positions[k] = previous[k] + RandomPoint(rng, -0.05f, 0.05f, -0.05f, 0.05f);
+    velocities[k] = RandomPoint(rng, -1.f, 1.f, -1.f, 1.f);
+  }
+  const ResponseParams params;
+  std::vector<Float3> result_positions[2], result_velocities[2];
+  std::vector<uint8_t> result_flags[2];
+  uint32_t contacts[2] = {0, 0};
+  const int saved_threads = omp_get_max_threads();
+  for (int run = 0; run < 2; ++run) {
+    omp_set_num_threads(run + 1);
+    result_positions[run] = positions;
+    result_velocities[run] = velocities;
+    result_flags[run].assign(kCount, 0);
+    ASSERT_TRUE(c.CollideBatch(previous, result_positions[run], result_velocities[run],
+                               result_flags[run], params, &contacts[run])
+                    .ok());
+  }
+  omp_set_num_threads(saved_threads);
+  EXPECT_GT(contacts[0], 1000u);
+  EXPECT_EQ(contacts[0], contacts[1]);
+  EXPECT_EQ(0, std::memcmp(result_positions[0].data(), result_positions[1].data(),
+                           kCount * sizeof(Float3)));
+  EXPECT_EQ(0, std::memcmp(result_velocities[0].data(), result_velocities[1].data(),
+                           kCount * sizeof(Float3)));
+  EXPECT_EQ(result_flags[0], result_flags[1]);
+  // And each equals the single query.
+  for (size_t k = 0; k < kCount; k += 97) {
+    const ContactQuery q = c.Query(previous[k], positions[k]);
+    EXPECT_EQ(q.contact, (result_flags[0][k] & kCollisionContact) != 0);
+  }
+}
+
+TEST(BodyMapCollider, BuildRejectsInconsistentData) {
+  const BodyMapPose good = MakePose(BoxGrid(), Box);
+  const auto expect_rejected = [](const BodyMapPose& pose, const char* what) {
+    BodyMapCollider c;
+    const Status status = c.Build(pose);
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << what;
+    EXPECT_FALSE(status.message().empty()) << what;
+    EXPECT_TRUE(c.empty()) << what;
+    EXPECT_FALSE(c.IsInside({0.f, 0.f, 0.f})) << what;
+    EXPECT_FALSE(c.Query({0.f, 0.f, 1.f}, {0.f, 0.f, -1.f}).contact) << what;
+  };
+  BodyMapPose p = good;
+  p.depth_f32[1].pop_back();
+  expect_rejected(p, "short back depth");
+  p = good;
+  p.normal_f32[0].push_back(0.f);
+  expect_rejected(p, "long front normals");
+  p = good;
+  p.texel_size = 0.f;
+  expect_rejected(p, "zero texel size");
+  p = good;
+  p.texel_size = std::numeric_limits<float>::quiet_NaN();
+  expect_rejected(p, "NaN texel size");
+  p = good;
+  p.depth_range = -1.f;
+  expect_rejected(p, "negative depth range");
+  p = good;
+  p.depth_f32[0][100] = std::numeric_limits<float>::quiet_NaN();
+  expect_rejected(p, "NaN depth");
+  p = good;
+  p.depth_f32[1][7] = -0.5f;
+  expect_rejected(p, "negative depth");
+  p = good;
+  p.normal_f32[1][5] = std::numeric_limits<float>::infinity();
+  expect_rejected(p, "infinite normal");
+  p = good;
+  p.width = 0;
+  expect_rejected(p, "zero width");
+  p = good;
+  p.origin_x = std::numeric_limits<float>::infinity();
+  expect_rejected(p, "infinite origin");
+  p = good;
+  p.depth_u16[0].resize(p.depth_f32[0].size());
+  expect_rejected(p, "an unchosen encoding filled");
+  p = good;
+  p.depth_encoding = static_cast<DepthEncoding>(9);
+  expect_rejected(p, "unknown encoding");
+  // Not built: the batch says so.
+  BodyMapCollider unbuilt;
+  std::vector<Float3> a(1), b(1), v(1);
+  std::vector<uint8_t> f(1);
+  EXPECT_EQ(unbuilt.CollideBatch(a, b, v, f, ResponseParams{}).code(), StatusCode::kInvalidState);
+}
+
+TEST(BodyMapCollider, SilhouetteDisagreementIsBackgroundAndCounted) {
+  BodyMapPose p = MakePose(BoxGrid(), Box);
+  const size_t k = 20 * 64 + 32;      // texel (32, 20): inside the box
+  p.depth_f32[1][k] = p.depth_range;  // the back map says background there
+  const BodyMapCollider c = BuildOrDie(p);
+  EXPECT_EQ(c.stats().one_sided_texels, 1u);
+  EXPECT_FALSE(c.IsInside({0.5f * kTexel, 0.5f * kTexel, 0.f}));
+  EXPECT_TRUE(c.IsInside({1.5f * kTexel, 0.5f * kTexel, 0.f}));
+  EXPECT_EQ(c.stats().valid_texels, 50u * 24u - 1u);
+  // 16 bytes per texel plus small change.
+  EXPECT_GE(c.memory_bytes(), 64u * 40u * 16u);
+  EXPECT_LT(c.memory_bytes(), 64u * 40u * 16u + 2048u);
+}
+
+TEST(BodyMapSequence, NearestAndBracketingPoses) {
+  // The sphere raised by 0.1 m between t = 0 and t = 1.
+  const auto raised = [](double dz) {
+    return [dz](double x, double y) {
+      SurfaceSample s = Sphere(x, y);
+      s.top += dz;
+      s.bottom += dz;
+      return s;
+    };
+  };
+  std::vector<BodyMapPose> poses = {MakePose(SphereGrid(), raised(0.0)),
+                                    MakePose(SphereGrid(), raised(0.1))};
+  poses[0].clip = poses[1].clip = 2;
+  poses[0].time = 0.f;
+  poses[1].time = 1.f;
+  BodyMapSequence nearest;
+  ASSERT_TRUE(nearest.Build(poses).ok());
+  EXPECT_EQ(nearest.size(), 2u);
+  EXPECT_EQ(&nearest.At(-5.f), &nearest.pose(0));
+  EXPECT_EQ(&nearest.At(0.3f), &nearest.pose(0));
+  EXPECT_EQ(&nearest.At(0.5f), &nearest.pose(0));  // ties go to the earlier pose
+  EXPECT_EQ(&nearest.At(0.7f), &nearest.pose(1));
+  EXPECT_EQ(&nearest.At(9.f), &nearest.pose(1));
+
+  BodyMapSequence bracket;
+  ASSERT_TRUE(bracket.Build(poses, DepthSampling::kNearest, PoseBlend::kBracket).ok());
+  BodyMapCollider scratch;
+  const BodyMapCollider& blended = bracket.At(0.25f, &scratch);
+  EXPECT_EQ(&blended, &scratch);
+  EXPECT_FLOAT_EQ(blended.time(), 0.25f);
+  float top, bottom, top0, bottom0;
+  ASSERT_TRUE(blended.TexelSlab(44, 44, &top, &bottom));
+  ASSERT_TRUE(bracket.pose(0).TexelSlab(44, 44, &top0, &bottom0));
+  EXPECT_NEAR(top, top0 + 0.025f, 1e-6);
+  EXPECT_NEAR(bottom, bottom0 + 0.025f, 1e-6);
+  const ContactQuery q = blended.Query({0.f, 0.f, 0.5f}, {0.f, 0.f, 0.f});
+  ASSERT_TRUE(q.contact);
+  EXPECT_NEAR(q.point.z, top, 1e-6);
+  // Refilling the same scratch with another time does not allocate more.
+  const size_t bytes = scratch.memory_bytes();
+  bracket.At(0.75f, &scratch);
+  EXPECT_EQ(scratch.memory_bytes(), bytes);
+  EXPECT_EQ(&bracket.At(0.75f), &bracket.pose(1));          // no scratch: nearest
+  EXPECT_EQ(&bracket.At(0.f, &scratch), &bracket.pose(0));  // on a key: that pose
+
+  // Different grids: nearest.
+  std::vector<BodyMapPose> mixed = poses;
+  mixed[1] = MakePose(BoxGrid(), Box);
+  mixed[1].clip = 2;
+  mixed[1].time = 1.f;
+  BodyMapSequence different;
+  ASSERT_TRUE(different.Build(mixed, DepthSampling::kNearest, PoseBlend::kBracket).ok());
+  EXPECT_EQ(&different.At(0.6f, &scratch), &different.pose(1));
+
+  // Invalid sequences.
+  BodyMapSequence bad;
+  std::vector<BodyMapPose> unsorted = poses;
+  std::swap(unsorted[0].time, unsorted[1].time);
+  EXPECT_EQ(bad.Build(unsorted).code(), StatusCode::kInvalidArgument);
+  std::vector<BodyMapPose> two_clips = poses;
+  two_clips[1].clip = 3;
+  EXPECT_EQ(bad.Build(two_clips).code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(bad.Build({}).code(), StatusCode::kInvalidArgument);
+  std::vector<BodyMapPose> broken = poses;
+  broken[1].texel_size = 0.f;
+  const Status status = bad.Build(broken);
+  EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(status.message().find("pose 1"), std::string::npos) << status.message();
+  EXPECT_TRUE(bad.At(0.f).empty());
+}
+
+}  // namespace
+}  // namespace drape
