@@ -8,13 +8,14 @@
 namespace drape {
 
 enum class DepthEncoding : uint8_t {
-  kFloat32 = 0,  // metres from the camera plane; >= depth_range is background
-  kUnorm16 = 1,  // depth / depth_range * 65535, rounded to nearest; 65535 is background
+  kFloat32 = 0,  // metres from the camera plane; background is exactly depth_range (test >=)
+  kUnorm16 = 1,  // min(round(depth / depth_range * 65535), 65534); 65535 is background
 };
 
 enum class NormalEncoding : uint8_t {
   kFloat32 = 0,  // 3 floats per texel, unit length (0,0,0 on background)
-  kOct16 = 1,    // octahedral, 2 x uint16 per texel (about 0.004 degrees)
+  kOct16 = 1,    // octahedral, 2 x uint16 per texel (about 0.004 degrees); the exact
+                 // encode/decode is documented in bake/include/drape/bake/body_map_baker.h
   kRgb8 = 2,     // paper A's colour encoding, 3 x uint8 per texel (about 0.4 degrees)
 };
 

@@ -1,0 +1,271 @@
+#include "cpu_rasterizer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace drape::bake {
+namespace {
+
+constexpr uint32_t kNoFace = std::numeric_limits<uint32_t>::max();
+// Triangles whose bounding box is narrower than this many texels are tested texel by texel.
+constexpr int64_t kNarrowTriangleTexels = 12;
+
+// One edge of a triangle, evaluated canonically: always from the lower to the higher vertex
+// index, so the two triangles sharing an edge compute bit-identical values, and the sign is
+// applied afterwards (exact). `top_left` marks the edges that own texel centres lying exactly on
+// them (interior to the right of a downward edge, or below a horizontal edge).
+struct Edge {
+  double ax, ay;      // canonical start vertex, texel units
+  double dx, dy;      // canonical end minus start
+  double inverse_dy;  // 1 / dy (0 when dy == 0); only for estimating span boundaries
+  double sign;        // +1 or -1: makes the value positive inside the triangle
+  bool top_left;
+  // (dx*(py-ay)) is constant along a row; keep the expression's evaluation order identical for
+  // every triangle so that shared edges give exactly negated values.
+  double RowTerm(double py) const { return dx * (py - ay); }
+  double Value(double row_term, double px) const { return sign * (row_term - dy * (px - ax)); }
+  bool Inside(double value) const { return value > 0.0 || (value == 0.0 && top_left); }
+};
+
+struct TriangleSetup {
+  Edge edge[3];   // edge k is opposite vertex k
+  double area2;   // twice the signed area in texel units, != 0
+  double x0, y0;  // vertex 0, texel units
+  // Barycentrics of vertices 1 and 2 as linear functions of the texel centre (normals pass):
+  // lambda_k = lk_x * (px - x0) + lk_y * (py - y0).
+  double l1_x, l1_y, l2_x, l2_y;
+};
+
+// The three edges of a triangle; false for zero area in the window (it covers no texel).
+bool SetUpEdges(const MapRasterInput& in, const uint32_t v[3], TriangleSetup* setup) {
+  const double x0 = in.window_x[v[0]], y0 = in.window_y[v[0]];
+  const double x1 = in.window_x[v[1]], y1 = in.window_y[v[1]];
+  const double x2 = in.window_x[v[2]], y2 = in.window_y[v[2]];
+  const double area2 = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
+  if (!(area2 != 0.0)) return false;
+  const double orientation = area2 > 0.0 ? 1.0 : -1.0;
+  for (int k = 0; k < 3; ++k) {
+    // Oriented edge v[k+1] -> v[k+2]: for a counter-clockwise triangle the interior is on its left.
+    uint32_t from = v[(k + 1) % 3], to = v[(k + 2) % 3];
+    double sign = orientation;
+    if (from > to) {
+      std::swap(from, to);
+      sign = -sign;
+    }
+    Edge& e = setup->edge[k];
+    e.ax = in.window_x[from];
+    e.ay = in.window_y[from];
+    e.dx = in.window_x[to] - e.ax;
+    e.dy = in.window_y[to] - e.ay;
+    e.inverse_dy = 0.0;  // filled by PrepareSpans() when the triangle uses spans
+    e.sign = sign;
+    // Direction of the edge with the interior on its left.
+    const double dir_x = sign * e.dx, dir_y = sign * e.dy;
+    e.top_left = dir_y < 0.0 || (dir_y == 0.0 && dir_x < 0.0);
+  }
+  setup->area2 = area2;
+  setup->x0 = x0;
+  setup->y0 = y0;
+  return true;
+}
+
+void PrepareSpans(TriangleSetup* setup) {
+  for (Edge& e : setup->edge) e.inverse_dy = e.dy != 0.0 ? 1.0 / e.dy : 0.0;
+}
+
+// floor() and ceil() of a window coordinate (|x| < 2^52) without a libm call.
+int64_t FloorToInt(double x) {
+  const int64_t i = static_cast<int64_t>(x);  // truncates toward zero
+  return i - (static_cast<double>(i) > x ? 1 : 0);
+}
+int64_t CeilToInt(double x) {
+  const int64_t i = static_cast<int64_t>(x);
+  return i + (static_cast<double>(i) < x ? 1 : 0);
+}
+
+void NormalizeOr(double n[3], double fx, double fy, double fz) {
+  const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (len > 1e-300 && std::isfinite(len)) {
+    const double inverse = 1.0 / len;
+    n[0] *= inverse;
+    n[1] *= inverse;
+    n[2] *= inverse;
+  } else {
+    n[0] = fx;
+    n[1] = fy;
+    n[2] = fz;
+  }
+}
+
+// Only the barycentric planes of a triangle (for the normals pass); false for zero area.
+bool SetUpBarycentrics(const MapRasterInput& in, const uint32_t v[3], TriangleSetup* setup) {
+  const double x0 = in.window_x[v[0]], y0 = in.window_y[v[0]];
+  const double x1 = in.window_x[v[1]], y1 = in.window_y[v[1]];
+  const double x2 = in.window_x[v[2]], y2 = in.window_y[v[2]];
+  const double area2 = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0);
+  if (!(area2 != 0.0)) return false;
+  const double inverse_area2 = 1.0 / area2;
+  setup->x0 = x0;
+  setup->y0 = y0;
+  setup->l1_x = (y2 - y0) * inverse_area2;
+  setup->l1_y = -(x2 - x0) * inverse_area2;
+  setup->l2_x = -(y1 - y0) * inverse_area2;
+  setup->l2_y = (x1 - x0) * inverse_area2;
+  return true;
+}
+
+// Narrows the texel span [*lo, *hi] of one row to the texels whose centres are inside edge `e`.
+// Along a row the edge value is a monotone function of px (every rounded operation in Value()
+// is monotone), so the inside texels form a prefix or a suffix of the row: estimate the boundary
+// analytically, then settle it with the exact predicate, so the span is exactly the set the
+// per-texel test would accept. Returns false when the span becomes empty.
+bool ClipSpan(const Edge& e, double row_term, int64_t* lo, int64_t* hi) {
+  auto inside = [&](int64_t i) {
+    return e.Inside(e.Value(row_term, static_cast<double>(i) + 0.5));
+  };
+  if (e.dy == 0.0) return inside(*lo);  // the value does not depend on px
+  // row_term - dy * (px - ax) = 0 at px = ax + row_term / dy; texel i is sampled at i + 1/2.
+  double boundary = e.ax + row_term * e.inverse_dy - 0.5;
+  const double lo_d = static_cast<double>(*lo) - 1.0, hi_d = static_cast<double>(*hi) + 1.0;
+  if (!(boundary >= lo_d)) boundary = lo_d;  // also catches NaN
+  if (!(boundary <= hi_d)) boundary = hi_d;
+  if (-e.sign * e.dy > 0.0) {  // the value grows with px: inside for i >= boundary
+    int64_t i = std::clamp(CeilToInt(boundary), *lo, *hi + 1);
+    while (i > *lo && inside(i - 1)) --i;
+    while (i <= *hi && !inside(i)) ++i;
+    *lo = i;
+  } else {  // inside for i <= boundary
+    int64_t i = std::clamp(FloorToInt(boundary), *lo - 1, *hi);
+    while (i < *hi && inside(i + 1)) ++i;
+    while (i >= *lo && !inside(i)) --i;
+    *hi = i;
+  }
+  return *lo <= *hi;
+}
+
+}  // namespace
+
+void RasterizeViewCpu(const MapRasterInput& in, int view, CpuRasterScratch* scratch,
+                      MapViewImage* image) {
+  const size_t texels = static_cast<size_t>(in.width) * in.height;
+  std::vector<double>& depth = scratch->depth;
+  std::vector<uint32_t>& face = scratch->face;
+  depth.assign(texels, std::numeric_limits<double>::infinity());
+  face.assign(texels, kNoFace);
+  const std::span<const double> vertex_depth = in.view_depth[view];
+  const size_t triangle_count = in.triangles.size() / 3;
+  const int64_t max_i = static_cast<int64_t>(in.width) - 1;
+  const int64_t max_j = static_cast<int64_t>(in.height) - 1;
+
+  for (size_t t = 0; t < triangle_count; ++t) {
+    const uint32_t v[3] = {in.triangles[3 * t], in.triangles[3 * t + 1], in.triangles[3 * t + 2]};
+    const double x0 = in.window_x[v[0]], x1 = in.window_x[v[1]], x2 = in.window_x[v[2]];
+    const double y0 = in.window_y[v[0]], y1 = in.window_y[v[1]], y2 = in.window_y[v[2]];
+    // Texel centres i + 1/2 inside the bounding box; most small triangles stop here.
+    const int64_t i0 = std::max<int64_t>(0, CeilToInt(std::min({x0, x1, x2}) - 0.5));
+    const int64_t i1 = std::min(max_i, FloorToInt(std::max({x0, x1, x2}) - 0.5));
+    if (i0 > i1) continue;
+    const int64_t j0 = std::max<int64_t>(0, CeilToInt(std::min({y0, y1, y2}) - 0.5));
+    const int64_t j1 = std::min(max_j, FloorToInt(std::max({y0, y1, y2}) - 0.5));
+    if (j0 > j1) continue;
+    TriangleSetup s;
+    if (!SetUpEdges(in, v, &s)) continue;
+    // Barycentric depth as a plane over the texel centres, clamped to the vertex depths (a
+    // sliver's huge gradient cannot extrapolate, and a NaN from it becomes the minimum).
+    const double d0 = vertex_depth[v[0]], d1 = vertex_depth[v[1]], d2 = vertex_depth[v[2]];
+    const double inverse_area2 = 1.0 / s.area2;
+    const double grad_x = ((d1 - d0) * (y2 - y0) - (d2 - d0) * (y1 - y0)) * inverse_area2;
+    const double grad_y = ((d2 - d0) * (x1 - x0) - (d1 - d0) * (x2 - x0)) * inverse_area2;
+    const double d_min = std::min({d0, d1, d2}), d_max = std::max({d0, d1, d2});
+    const uint32_t face_id = static_cast<uint32_t>(t);
+    // Narrow triangles test every texel of the bounding box; wider ones find each row's span
+    // (the same predicate, so both give the same coverage; a span costs 3 boundary estimates
+    // and 3-6 exact edge tests a row, which only pays off for wide rows).
+    const bool narrow = i1 - i0 < kNarrowTriangleTexels;
+    if (!narrow) PrepareSpans(&s);
+    for (int64_t j = j0; j <= j1; ++j) {
+      const double py = static_cast<double>(j) + 0.5;
+      const double row0 = s.edge[0].RowTerm(py);
+      const double row1 = s.edge[1].RowTerm(py);
+      const double row2 = s.edge[2].RowTerm(py);
+      const double row_depth = d0 + grad_y * (py - s.y0);
+      double* depth_row = depth.data() + static_cast<size_t>(j) * in.width;
+      uint32_t* face_row = face.data() + static_cast<size_t>(j) * in.width;
+      int64_t lo = i0, hi = i1;
+      if (!narrow &&
+          (!ClipSpan(s.edge[0], row0, &lo, &hi) || !ClipSpan(s.edge[1], row1, &lo, &hi) ||
+           !ClipSpan(s.edge[2], row2, &lo, &hi))) {
+        continue;
+      }
+      for (int64_t i = lo; i <= hi; ++i) {
+        const double px = static_cast<double>(i) + 0.5;
+        if (narrow && !(s.edge[0].Inside(s.edge[0].Value(row0, px)) &&
+                        s.edge[1].Inside(s.edge[1].Value(row1, px)) &&
+                        s.edge[2].Inside(s.edge[2].Value(row2, px)))) {
+          continue;
+        }
+        // max(d_min, min(d, d_max)) also maps a NaN to d_min (the operand order matters).
+        const double d = std::max(d_min, std::min(row_depth + grad_x * (px - s.x0), d_max));
+        if (d < depth_row[i]) {
+          depth_row[i] = d;
+          face_row[i] = face_id;
+        }
+      }
+    }
+  }
+
+  image->valid.assign(texels, 0);
+  image->depth.assign(texels, 0.f);
+  image->normal.assign(3 * texels, 0.f);
+  const double view_axis_z = view == 0 ? 1.0 : -1.0;
+  uint32_t cached_face = kNoFace;
+  bool cached_ok = false;
+  TriangleSetup s{};
+  const double* n0 = nullptr;
+  const double* n1 = nullptr;
+  const double* n2 = nullptr;
+  for (uint32_t j = 0; j < in.height; ++j) {
+    const double py = j + 0.5;
+    for (uint32_t i = 0; i < in.width; ++i) {
+      const size_t index = static_cast<size_t>(j) * in.width + i;
+      const uint32_t t = face[index];
+      if (t == kNoFace) continue;
+      const uint32_t v[3] = {in.triangles[3 * t], in.triangles[3 * t + 1], in.triangles[3 * t + 2]};
+      if (t != cached_face) {
+        cached_face = t;
+        cached_ok = SetUpBarycentrics(in, v, &s);
+        n0 = &in.normals[3 * v[0]];
+        n1 = &in.normals[3 * v[1]];
+        n2 = &in.normals[3 * v[2]];
+      }
+      double lambda1 = 1.0 / 3.0, lambda2 = 1.0 / 3.0;
+      if (cached_ok) {
+        const double dx = (i + 0.5) - s.x0, dy = py - s.y0;
+        lambda1 = std::clamp(s.l1_x * dx + s.l1_y * dy, 0.0, 1.0);
+        lambda2 = std::clamp(s.l2_x * dx + s.l2_y * dy, 0.0, 1.0 - lambda1);
+      }
+      const double lambda0 = 1.0 - lambda1 - lambda2;
+      double n[3];
+      for (int c = 0; c < 3; ++c) n[c] = lambda0 * n0[c] + lambda1 * n1[c] + lambda2 * n2[c];
+      const double len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+      if (!(len2 > 1e-24)) {
+        // Face normal of the offset triangle, then the view axis.
+        const double* p0 = &in.positions[3 * v[0]];
+        const double* p1 = &in.positions[3 * v[1]];
+        const double* p2 = &in.positions[3 * v[2]];
+        const double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+        const double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+      }
+      NormalizeOr(n, 0.0, 0.0, view_axis_z);
+      image->valid[index] = 1;
+      image->depth[index] = static_cast<float>(depth[index]);
+      for (int c = 0; c < 3; ++c) image->normal[3 * index + c] = static_cast<float>(n[c]);
+    }
+  }
+}
+
+}  // namespace drape::bake

@@ -1,0 +1,45 @@
+#pragma once
+// Private to the body map baker: the render request both renderers take, and the in-house
+// orthographic rasterizer (notes/algorithms.md section 4.4), the deterministic reference.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace drape::bake {
+
+// The offset mesh expressed in the frame of the raster rectangle (the part of the window that
+// is rendered): texel (i, j) covers [i, i+1) x [j, j+1) and is sampled at its centre.
+struct MapRasterInput {
+  uint32_t width = 0, height = 0;         // texels of the raster rectangle, > 0
+  double depth_range = 0.0;               // metres between the two camera planes, > 0
+  std::span<const double> window_x;       // per vertex, texel units
+  std::span<const double> window_y;       // per vertex, texel units, increasing with asset y
+  std::span<const double> view_depth[2];  // per vertex, metres from view 0 (front) / 1 (back) plane
+  std::span<const double> normals;        // 3 per vertex, unit length or zero
+  std::span<const double> positions;      // 3 per vertex, offset surface (for face normals)
+  std::span<const uint32_t> triangles;    // 3 indices each, all < vertex count
+};
+
+// One rendered view over the raster rectangle, row-major j * width + i.
+struct MapViewImage {
+  std::vector<uint8_t> valid;  // 1 where some triangle covers the texel centre
+  std::vector<float> depth;    // metres from the view's plane; meaningful where valid
+  std::vector<float> normal;   // 3 per texel, unit length where valid, 0 elsewhere
+};
+
+// Per-texel working buffers of the CPU rasterizer, reused from one view to the next.
+struct CpuRasterScratch {
+  std::vector<double> depth;   // nearest depth so far, metres
+  std::vector<uint32_t> face;  // triangle index of that depth, or ~0u
+};
+
+// Rasterizes view `view` (0 front, 1 back): double-precision edge functions evaluated at texel
+// centres, canonical per-edge evaluation plus the top-left rule (a texel centre on an edge shared
+// by two triangles belongs to exactly one), no culling, barycentric depth, the minimum depth wins
+// (ties: the lower triangle index, like GL_LESS). Normals are the winning triangle's vertex
+// normals interpolated with its barycentrics, normalised. Single-threaded and deterministic.
+void RasterizeViewCpu(const MapRasterInput& input, int view, CpuRasterScratch* scratch,
+                      MapViewImage* image);
+
+}  // namespace drape::bake

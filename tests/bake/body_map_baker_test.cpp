@@ -1,0 +1,962 @@
+// Tests of paper A's body map bake (drape/bake/body_map_baker.h) against analytic shapes: depth
+// at texel centres, normals, coverage, the un-mirrored back map, encodings, the OSMesa path
+// against the CPU reference, degenerate input, determinism and the PNG previews.
+
+#include "drape/bake/body_map_baker.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace drape::bake {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegree = kPi / 180.0;
+
+struct Mesh {
+  std::vector<Float3> positions;
+  std::vector<uint32_t> triangles;
+};
+
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+};
+Vec3d ToD(Float3 p) { return {p.x, p.y, p.z}; }
+Vec3d Sub(Vec3d a, Vec3d b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Vec3d Add(Vec3d a, Vec3d b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Vec3d Scale(Vec3d a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+double Dot(Vec3d a, Vec3d b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Vec3d Cross(Vec3d a, Vec3d b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double Len(Vec3d a) { return std::sqrt(Dot(a, a)); }
+double AngleDeg(Vec3d a, Vec3d b) {
+  const double c = Dot(a, b) / (Len(a) * Len(b));
+  return std::acos(std::clamp(c, -1.0, 1.0)) / kDegree;
+}
+
+// Appends a triangle wound counter-clockwise seen from outside, where "outside" is the direction
+// `outward` (the shapes here are convex, so centroid minus an interior point works).
+void AddOutwardTriangle(Mesh* m, uint32_t a, uint32_t b, uint32_t c, Vec3d outward) {
+  const Vec3d pa = ToD(m->positions[a]), pb = ToD(m->positions[b]), pc = ToD(m->positions[c]);
+  const Vec3d n = Cross(Sub(pb, pa), Sub(pc, pa));
+  if (Dot(n, outward) >= 0.0) {
+    m->triangles.insert(m->triangles.end(), {a, b, c});
+  } else {
+    m->triangles.insert(m->triangles.end(), {a, c, b});
+  }
+}
+
+// A UV capsule around the y axis through `centre`: hemispheres of radius r joined by a cylinder
+// of half-length `half_length` (0 gives a UV sphere). `stacks` (even) rings from pole to pole,
+// `slices` around. Triangles: 2 * slices * (stacks - 1) for the sphere, + 2 * slices for the
+// cylinder band.
+Mesh MakeCapsule(Vec3d centre, double r, double half_length, int stacks, int slices) {
+  Mesh m;
+  std::vector<double> ring_theta, ring_shift;
+  for (int k = 1; k < stacks; ++k) {
+    const double theta = kPi * k / stacks;
+    if (half_length > 0.0 && 2 * k == stacks) {
+      ring_theta.insert(ring_theta.end(), {theta, theta});
+      ring_shift.insert(ring_shift.end(), {half_length, -half_length});
+    } else {
+      ring_theta.push_back(theta);
+      ring_shift.push_back(2 * k < stacks ? half_length : -half_length);
+    }
+  }
+  auto add = [&](double x, double y, double z) {
+    m.positions.push_back({static_cast<float>(centre.x + x), static_cast<float>(centre.y + y),
+                           static_cast<float>(centre.z + z)});
+  };
+  add(0, r + half_length, 0);  // top pole
+  for (size_t k = 0; k < ring_theta.size(); ++k) {
+    for (int s = 0; s < slices; ++s) {
+      const double phi = 2 * kPi * s / slices;
+      add(r * std::sin(ring_theta[k]) * std::cos(phi), r * std::cos(ring_theta[k]) + ring_shift[k],
+          r * std::sin(ring_theta[k]) * std::sin(phi));
+    }
+  }
+  add(0, -r - half_length, 0);  // bottom pole
+  const uint32_t rings = static_cast<uint32_t>(ring_theta.size());
+  const uint32_t bottom = 1 + rings * static_cast<uint32_t>(slices);
+  auto ring_vertex = [&](uint32_t k, int s) {
+    return 1 + k * static_cast<uint32_t>(slices) + static_cast<uint32_t>(s % slices);
+  };
+  // Outward direction: from the closest point of the axis segment to the triangle centroid.
+  auto outward = [&](uint32_t a, uint32_t b, uint32_t c) {
+    const Vec3d g =
+        Scale(Add(Add(ToD(m.positions[a]), ToD(m.positions[b])), ToD(m.positions[c])), 1.0 / 3.0);
+    const double axis_y = std::clamp(g.y - centre.y, -half_length, half_length) + centre.y;
+    return Sub(g, Vec3d{centre.x, axis_y, centre.z});
+  };
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+    AddOutwardTriangle(&m, a, b, c, outward(a, b, c));
+  };
+  for (int s = 0; s < slices; ++s) tri(0, ring_vertex(0, s), ring_vertex(0, s + 1));
+  for (uint32_t k = 0; k + 1 < rings; ++k) {
+    for (int s = 0; s < slices; ++s) {
+      tri(ring_vertex(k, s), ring_vertex(k + 1, s), ring_vertex(k + 1, s + 1));
+      tri(ring_vertex(k, s), ring_vertex(k + 1, s + 1), ring_vertex(k, s + 1));
+    }
+  }
+  for (int s = 0; s < slices; ++s)
+    tri(bottom, ring_vertex(rings - 1, s + 1), ring_vertex(rings - 1, s));
+  return m;
+}
+
+Mesh MakeSphere(Vec3d centre, double r, int stacks, int slices) {
+  return MakeCapsule(centre, r, 0.0, stacks, slices);
+}
+
+// An axis-aligned box with separate vertices per face (24 vertices, 12 triangles), so every
+// vertex normal is exactly its face normal and the epsilon offset moves each face by epsilon.
+void AddSplitBox(Mesh* m, Vec3d lo, Vec3d hi) {
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      const uint32_t base = static_cast<uint32_t>(m->positions.size());
+      for (int corner = 0; corner < 4; ++corner) {
+        double c[3];
+        const double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+        c[axis] = side ? h[axis] : l[axis];
+        const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+        c[u] = (corner == 1 || corner == 2) ? h[u] : l[u];
+        c[v] = (corner >= 2) ? h[v] : l[v];
+        m->positions.push_back(
+            {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])});
+      }
+      Vec3d out;
+      (axis == 0 ? out.x : axis == 1 ? out.y : out.z) = side ? 1.0 : -1.0;
+      AddOutwardTriangle(m, base, base + 1, base + 2, out);
+      AddOutwardTriangle(m, base, base + 2, base + 3, out);
+    }
+  }
+}
+
+// The epsilon-offset vertices, computed as body_map_baker.h specifies (area-weighted normals).
+std::vector<Vec3d> OffsetVertices(const Mesh& m, double epsilon, std::vector<Vec3d>* normals) {
+  std::vector<Vec3d> n(m.positions.size());
+  for (size_t t = 0; t < m.triangles.size(); t += 3) {
+    const Vec3d a = ToD(m.positions[m.triangles[t]]), b = ToD(m.positions[m.triangles[t + 1]]),
+                c = ToD(m.positions[m.triangles[t + 2]]);
+    const Vec3d f = Cross(Sub(b, a), Sub(c, a));
+    for (int k = 0; k < 3; ++k) n[m.triangles[t + k]] = Add(n[m.triangles[t + k]], f);
+  }
+  std::vector<Vec3d> q(m.positions.size());
+  for (size_t v = 0; v < n.size(); ++v) {
+    const double l = Len(n[v]);
+    n[v] = l > 0 ? Scale(n[v], 1.0 / l) : Vec3d{};
+    q[v] = Add(ToD(m.positions[v]), Scale(n[v], epsilon));
+  }
+  if (normals != nullptr) *normals = n;
+  return q;
+}
+
+// Distance from point p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5).
+double PointTriangleDistance(Vec3d p, Vec3d a, Vec3d b, Vec3d c) {
+  const Vec3d ab = Sub(b, a), ac = Sub(c, a), ap = Sub(p, a);
+  const double d1 = Dot(ab, ap), d2 = Dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return Len(ap);
+  const Vec3d bp = Sub(p, b);
+  const double d3 = Dot(ab, bp), d4 = Dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return Len(bp);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return Len(Sub(p, Add(a, Scale(ab, d1 / (d1 - d3)))));
+  const Vec3d cp = Sub(p, c);
+  const double d5 = Dot(ab, cp), d6 = Dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return Len(cp);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return Len(Sub(p, Add(a, Scale(ac, d2 / (d2 - d6)))));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return Len(Sub(p, Add(b, Scale(Sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))))));
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  return Len(Sub(p, Add(a, Add(Scale(ab, vb * denom), Scale(ac, vc * denom)))));
+}
+
+// Sag of the offset sphere mesh below the sphere of radius r_outer: r_outer minus the smallest
+// distance from the centre to any offset triangle.
+double SphereSag(const Mesh& m, const std::vector<Vec3d>& q, Vec3d centre, double r_outer) {
+  double min_distance = std::numeric_limits<double>::infinity();
+  for (size_t t = 0; t < m.triangles.size(); t += 3) {
+    min_distance =
+        std::min(min_distance, PointTriangleDistance(centre, q[m.triangles[t]],
+                                                     q[m.triangles[t + 1]], q[m.triangles[t + 2]]));
+  }
+  return r_outer - min_distance;
+}
+
+// Largest angle between a vertex normal and the analytic normal at that (offset) vertex,
+// degrees. `axis_point` maps a point to the centre of its osculating sphere or cylinder.
+template <typename AxisPoint>
+double MaxVertexNormalDeviationDeg(const std::vector<Vec3d>& q, const std::vector<Vec3d>& normals,
+                                   AxisPoint axis_point) {
+  double deviation = 0.0;
+  for (size_t v = 0; v < q.size(); ++v) {
+    deviation = std::max(deviation, AngleDeg(normals[v], Sub(q[v], axis_point(q[v]))));
+  }
+  return deviation;
+}
+
+// Why the normal tolerance is what it is: when every vertex normal is radial, the interpolated
+// normal sum(lambda_k n_k) is parallel to p_tri - centre, the radial direction of the rasterized
+// point p_tri itself. The analytic normal is taken at the outer surface point above the same
+// texel, which differs from p_tri only along z, by at most z_outer - z_inner: an angle of at most
+// (z_outer - z_inner) / r_inner as seen from the centre. Non-radial vertex normals add at most
+// their deviation. So: tolerance = deviation + (z_outer - z_inner) / r_inner + float rounding.
+double NormalToleranceDeg(double vertex_deviation_deg, double z_outer, double z_inner,
+                          double r_inner) {
+  return vertex_deviation_deg + (z_outer - z_inner) / r_inner / kDegree + 0.01;
+}
+
+Vec3d TexelCentre(const BodyMapPose& pose, uint32_t i, uint32_t j) {
+  return {pose.origin_x + (i + 0.5) * double(pose.texel_size),
+          pose.origin_y + (j + 0.5) * double(pose.texel_size), 0.0};
+}
+Vec3d ToD3(Float3 n) { return {n.x, n.y, n.z}; }
+
+BodyMapOptions FloatOptions(uint32_t resolution) {
+  BodyMapOptions o;
+  o.resolution = resolution;
+  o.depth_encoding = DepthEncoding::kFloat32;
+  o.normal_encoding = NormalEncoding::kFloat32;
+  return o;
+}
+
+BodyMapPose BakeOrDie(const Mesh& m, const BodyMapOptions& o, BodyMapPoseStats* stats = nullptr) {
+  BodyMapPose pose;
+  const Status status = BakeBodyMapPose(m.positions, m.triangles, o, &pose, stats);
+  EXPECT_TRUE(status.ok()) << status.message();
+  return pose;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST(BodyMapBaker, SphereDepthCoverageAndNormalsMatchAnalytic) {
+  const Vec3d c{0.05, 1.0, -0.02};
+  const double r = 0.3;
+  const Mesh sphere = MakeSphere(c, r, 50, 50);  // 4900 triangles
+  ASSERT_EQ(sphere.triangles.size() / 3, 4900u);
+  BodyMapOptions o = FloatOptions(512);
+  BodyMapPoseStats stats;
+  const BodyMapPose pose = BakeOrDie(sphere, o, &stats);
+  ASSERT_GT(pose.width, 0u);
+
+  std::vector<Vec3d> normals;
+  const std::vector<Vec3d> q = OffsetVertices(sphere, o.epsilon, &normals);
+  const double r_outer = r + o.epsilon;
+  const double sag = SphereSag(sphere, q, c, r_outer);
+  const double vertex_deviation_deg =
+      MaxVertexNormalDeviationDeg(q, normals, [&](Vec3d) { return c; });
+  ASSERT_GT(sag, 0.0);
+  ASSERT_LT(sag, 2e-3);  // the tessellation is what we think it is
+  const double r_inner = r_outer - sag;
+  const double back_z = double(pose.front_z) - double(pose.depth_range);
+  const double t = pose.texel_size;
+
+  // The square window of paper A: side = 2 r' + 2 margin, N texels.
+  EXPECT_NEAR(t, (2 * r_outer + 2 * o.margin) / o.resolution, 1e-4 * t);
+  EXPECT_EQ(stats.window_width, o.resolution);
+  EXPECT_EQ(stats.window_height, o.resolution);
+  EXPECT_EQ(stats.silhouette_conflicts, 0u);  // one rasterizer, same texel centres: no conflict
+
+  size_t checked_depth = 0, checked_normals = 0, valid = 0;
+  double max_central_depth_error = 0.0, max_normal_error_deg = 0.0;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const Vec3d p = TexelCentre(pose, i, j);
+      const double rho = std::hypot(p.x - c.x, p.y - c.y);
+      const BodyMapTexel front = ReadBodyMapTexel(pose, 0, i, j);
+      const BodyMapTexel back = ReadBodyMapTexel(pose, 1, i, j);
+      ASSERT_EQ(front.valid, back.valid) << i << "," << j;
+      valid += front.valid ? 1 : 0;
+      // Coverage: the inner ball always projects under the mesh, nothing lies beyond r'.
+      if (rho < r_inner - 1e-6) {
+        EXPECT_TRUE(front.valid) << i << "," << j << " rho " << rho;
+      }
+      if (rho > r_outer + 1e-6) {
+        EXPECT_FALSE(front.valid) << i << "," << j << " rho " << rho;
+      }
+      if (!front.valid || rho >= r_inner - 1e-6) continue;
+      // The visible surface lies between the inner and the outer sphere along z.
+      const double z_outer = std::sqrt(r_outer * r_outer - rho * rho);
+      const double z_inner = std::sqrt(r_inner * r_inner - rho * rho);
+      const double front_lo = double(pose.front_z) - (c.z + z_outer);
+      const double front_hi = double(pose.front_z) - (c.z + z_inner);
+      const double back_lo = (c.z - z_outer) - back_z;
+      const double back_hi = (c.z - z_inner) - back_z;
+      constexpr double kRounding = 2e-6;  // float storage of metres-scale values and origins
+      EXPECT_GE(front.depth, front_lo - kRounding) << i << "," << j;
+      EXPECT_LE(front.depth, front_hi + kRounding) << i << "," << j;
+      EXPECT_GE(back.depth, back_lo - kRounding) << i << "," << j;
+      EXPECT_LE(back.depth, back_hi + kRounding) << i << "," << j;
+      if (z_outer >= 0.9 * r_outer) {
+        max_central_depth_error =
+            std::max(max_central_depth_error, std::fabs(front.depth - front_lo));
+      }
+      ++checked_depth;
+      // Normals: the analytic outward normal at the analytic surface point above the texel.
+      const Vec3d n_front{p.x - c.x, p.y - c.y, z_outer};
+      const Vec3d n_back{p.x - c.x, p.y - c.y, -z_outer};
+      if (n_front.z / r_outer >= 0.3) {
+        const double tolerance_deg =
+            NormalToleranceDeg(vertex_deviation_deg, z_outer, z_inner, r_inner);
+        const double front_error = AngleDeg(ToD3(front.normal), n_front);
+        const double back_error = AngleDeg(ToD3(back.normal), n_back);
+        EXPECT_LE(front_error, tolerance_deg) << i << "," << j;
+        EXPECT_LE(back_error, tolerance_deg) << i << "," << j;
+        max_normal_error_deg = std::max({max_normal_error_deg, front_error, back_error});
+        EXPECT_NEAR(Len(ToD3(front.normal)), 1.0, 1e-6);
+        ++checked_normals;
+      }
+    }
+  }
+  // The covered area is between the inner and the outer disc (plus a texel of outline).
+  const double area_texels = double(valid) * t * t;
+  EXPECT_GE(area_texels, kPi * r_inner * r_inner - 2 * kPi * r_inner * t);
+  EXPECT_LE(area_texels, kPi * r_outer * r_outer + 2 * kPi * r_outer * t);
+  EXPECT_NEAR(stats.coverage, double(valid) / (double(o.resolution) * o.resolution), 1e-6);
+  EXPECT_EQ(stats.valid_texels, valid);
+  EXPECT_GT(checked_depth, 0.8 * kPi * r * r / (t * t));
+  EXPECT_GT(checked_normals, 0.5 * kPi * r * r / (t * t));
+  // Near the view axis (n.z >= 0.9) the depth is within sag / 0.9 of the analytic sphere.
+  EXPECT_LE(max_central_depth_error, sag / 0.9 + 2e-6);
+  EXPECT_LT(max_normal_error_deg, 2.0);  // "within a few degrees" (measured about 0.6)
+  std::printf(
+      "[ sphere 4.9k N=512 ] sag %.3g m, vertex normal deviation %.3f deg, max normal "
+      "error %.3f deg, max central depth error %.3g m\n",
+      sag, vertex_deviation_deg, max_normal_error_deg, max_central_depth_error);
+}
+
+TEST(BodyMapBaker, NothingIsClippedAndThePlanesEncloseTheOffsetSurface) {
+  const Vec3d c{0.0, 0.0, 0.4};
+  const double r = 0.3;
+  const Mesh sphere = MakeSphere(c, r, 50, 50);
+  BodyMapOptions o = FloatOptions(256);
+  o.epsilon = 0.02f;  // a large offset makes clipping visible if the box were not enlarged
+  const BodyMapPose pose = BakeOrDie(sphere, o);
+  const std::vector<Vec3d> q = OffsetVertices(sphere, o.epsilon, nullptr);
+  double z_min = 1e9, z_max = -1e9;
+  for (const Vec3d& p : q) {
+    z_min = std::min(z_min, p.z);
+    z_max = std::max(z_max, p.z);
+  }
+  // The planes sit margin beyond the offset surface, rounded outward to float.
+  EXPECT_GE(double(pose.front_z), z_max + o.margin);
+  EXPECT_LE(double(pose.front_z), z_max + o.margin + 1e-6);
+  const double back_z = double(pose.front_z) - double(pose.depth_range);
+  EXPECT_LE(back_z, z_min - o.margin);
+  EXPECT_GE(back_z, z_min - o.margin - 2e-6);
+  float min_front = 1e9f, min_back = 1e9f, max_depth = 0.f;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      for (int view = 0; view < 2; ++view) {
+        const BodyMapTexel texel = ReadBodyMapTexel(pose, view, i, j);
+        if (!texel.valid) continue;
+        (view == 0 ? min_front : min_back) =
+            std::min(view == 0 ? min_front : min_back, texel.depth);
+        max_depth = std::max(max_depth, texel.depth);
+      }
+    }
+  }
+  // The extreme points of the offset sphere are in the maps, a margin away from each plane.
+  const double sag = SphereSag(sphere, q, c, r + o.epsilon);
+  EXPECT_GE(min_front, o.margin - 1e-6);
+  EXPECT_LE(min_front, o.margin + sag + 1e-5);
+  EXPECT_GE(min_back, o.margin - 1e-6);
+  EXPECT_LE(min_back, o.margin + sag + 1e-5);
+  EXPECT_LT(max_depth, pose.depth_range);
+  // One texel of background border all around the stored rectangle, and covered texels next to it.
+  bool border_valid = false, inner_row_valid = false;
+  for (uint32_t i = 0; i < pose.width; ++i) {
+    border_valid |= ReadBodyMapTexel(pose, 0, i, 0).valid;
+    border_valid |= ReadBodyMapTexel(pose, 0, i, pose.height - 1).valid;
+    inner_row_valid |= ReadBodyMapTexel(pose, 0, i, 1).valid;
+  }
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    border_valid |= ReadBodyMapTexel(pose, 0, 0, j).valid;
+    border_valid |= ReadBodyMapTexel(pose, 0, pose.width - 1, j).valid;
+  }
+  EXPECT_FALSE(border_valid);
+  EXPECT_TRUE(inner_row_valid);
+}
+
+TEST(BodyMapBaker, SplitBoxGivesExactDepthNormalsAndCoverage) {
+  Mesh box;
+  const Vec3d lo{-0.2013, -0.3107, 0.1031}, hi{0.1517, 0.4291, 0.3543};
+  AddSplitBox(&box, lo, hi);
+  BodyMapOptions o = FloatOptions(300);
+  BodyMapPoseStats stats;
+  const BodyMapPose pose = BakeOrDie(box, o, &stats);
+  const double eps = o.epsilon;
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9, z0 = 1e9, z1 = -1e9;
+  for (Float3 p : box.positions) {
+    x0 = std::min(x0, double(p.x));
+    x1 = std::max(x1, double(p.x));
+    y0 = std::min(y0, double(p.y));
+    y1 = std::max(y1, double(p.y));
+    z0 = std::min(z0, double(p.z));
+    z1 = std::max(z1, double(p.z));
+  }
+  // Window: square, side max(L', H') with L' = L + 2 eps + 2 margin.
+  const double side = std::max(x1 - x0, y1 - y0) + 2 * eps + 2 * o.margin;
+  EXPECT_NEAR(pose.texel_size, side / o.resolution, 1e-6 * side / o.resolution);
+  const double t = pose.texel_size;
+  const double back_z = double(pose.front_z) - double(pose.depth_range);
+  size_t valid = 0;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const Vec3d p = TexelCentre(pose, i, j);
+      const BodyMapTexel front = ReadBodyMapTexel(pose, 0, i, j);
+      const BodyMapTexel back = ReadBodyMapTexel(pose, 1, i, j);
+      // The side faces are edge-on: exactly the texel centres over the x,y rectangle are covered.
+      const double inset = std::min({p.x - x0, x1 - p.x, p.y - y0, y1 - p.y});
+      if (std::fabs(inset) < 1e-4 * t) continue;  // centre on the outline: either answer is fine
+      ASSERT_EQ(front.valid, inset > 0) << i << "," << j;
+      ASSERT_EQ(back.valid, inset > 0) << i << "," << j;
+      if (!front.valid) continue;
+      ++valid;
+      EXPECT_NEAR(front.depth, double(pose.front_z) - (z1 + eps), 1e-6);
+      EXPECT_NEAR(back.depth, (z0 - eps) - back_z, 1e-6);
+      EXPECT_NEAR(front.normal.z, 1.0, 1e-6);
+      EXPECT_NEAR(back.normal.z, -1.0, 1e-6);
+    }
+  }
+  const double expected = (x1 - x0) * (y1 - y0) / (t * t);
+  EXPECT_NEAR(double(valid), expected, 2 * ((x1 - x0) + (y1 - y0)) / t + 4);
+  EXPECT_EQ(stats.valid_texels, valid);
+  EXPECT_EQ(stats.bytes, 2 * size_t(pose.width) * pose.height * (4 + 12));
+}
+
+TEST(BodyMapBaker, BackMapIsNotMirrored) {
+  // Two boxes, the small one off to +x, nearer the front and deeper than the big one.
+  Mesh mesh;
+  const Vec3d big_lo{-0.3, -0.4, -0.1}, big_hi{-0.05, 0.4, 0.1};
+  const Vec3d small_lo{0.1, 0.2, 0.0}, small_hi{0.2, 0.3, 0.3};
+  AddSplitBox(&mesh, big_lo, big_hi);
+  AddSplitBox(&mesh, small_lo, small_hi);
+  const BodyMapOptions o = FloatOptions(256);
+  const BodyMapPose pose = BakeOrDie(mesh, o);
+  const double t = pose.texel_size, eps = o.epsilon;
+  const double back_z = double(pose.front_z) - double(pose.depth_range);
+  auto texel_at = [&](double x, double y, uint32_t* i, uint32_t* j) {
+    *i = static_cast<uint32_t>(std::floor((x - pose.origin_x) / t));
+    *j = static_cast<uint32_t>(std::floor((y - pose.origin_y) / t));
+  };
+  uint32_t i = 0, j = 0;
+  texel_at(0.15, 0.25, &i, &j);  // over the small box
+  BodyMapTexel front = ReadBodyMapTexel(pose, 0, i, j), back = ReadBodyMapTexel(pose, 1, i, j);
+  ASSERT_TRUE(front.valid && back.valid);
+  EXPECT_NEAR(front.depth, double(pose.front_z) - (0.3 + eps), 2e-6);
+  EXPECT_NEAR(back.depth, (0.0 - eps) - back_z, 2e-6);
+  EXPECT_LT(back.normal.z, -0.999f);
+  texel_at(-0.2, -0.3, &i, &j);  // over the big box
+  front = ReadBodyMapTexel(pose, 0, i, j);
+  back = ReadBodyMapTexel(pose, 1, i, j);
+  ASSERT_TRUE(front.valid && back.valid);
+  EXPECT_NEAR(front.depth, double(pose.front_z) - (0.1 + eps), 2e-6);
+  EXPECT_NEAR(back.depth, (-0.1 - eps) - back_z, 2e-6);
+  // A back map mirrored about the box centre (x -> 2 c_x - x, c_x = -0.05) would show the small
+  // box at x = -0.25; un-mirrored, that texel shows the big box's back face.
+  texel_at(-0.25, 0.25, &i, &j);
+  back = ReadBodyMapTexel(pose, 1, i, j);
+  ASSERT_TRUE(back.valid);
+  EXPECT_NEAR(back.depth, (-0.1 - eps) - back_z, 2e-6);
+  // Every texel is valid in both maps or in neither.
+  for (uint32_t jj = 0; jj < pose.height; ++jj) {
+    for (uint32_t ii = 0; ii < pose.width; ++ii) {
+      ASSERT_EQ(ReadBodyMapTexel(pose, 0, ii, jj).valid, ReadBodyMapTexel(pose, 1, ii, jj).valid);
+    }
+  }
+  // The gap between the boxes at y = 0.25 is background in both maps.
+  texel_at(0.025, 0.25, &i, &j);
+  EXPECT_FALSE(ReadBodyMapTexel(pose, 0, i, j).valid);
+  EXPECT_FALSE(ReadBodyMapTexel(pose, 1, i, j).valid);
+}
+
+TEST(BodyMapBaker, CapsuleDepthAndNormalsMatchAnalytic) {
+  const Vec3d c{0.0, 0.9, 0.05};
+  const double r = 0.12, half = 0.35;
+  const Mesh capsule = MakeCapsule(c, r, half, 32, 64);
+  BodyMapOptions o = FloatOptions(512);
+  o.fitted_window = true;
+  BodyMapPoseStats stats;
+  const BodyMapPose pose = BakeOrDie(capsule, o, &stats);
+  std::vector<Vec3d> normals;
+  const std::vector<Vec3d> q = OffsetVertices(capsule, o.epsilon, &normals);
+  const double r_outer = r + o.epsilon;
+  // Sag: r' minus the smallest distance of any offset triangle to the axis segment (sampled).
+  double min_axis_distance = 1e9;
+  for (size_t tri = 0; tri < capsule.triangles.size(); tri += 3) {
+    const Vec3d a = q[capsule.triangles[tri]], b = q[capsule.triangles[tri + 1]],
+                cc = q[capsule.triangles[tri + 2]];
+    for (int u = 0; u <= 16; ++u) {
+      for (int v = 0; u + v <= 16; ++v) {
+        const Vec3d p = Add(a, Add(Scale(Sub(b, a), u / 16.0), Scale(Sub(cc, a), v / 16.0)));
+        const Vec3d axis{c.x, std::clamp(p.y - c.y, -half, half) + c.y, c.z};
+        min_axis_distance = std::min(min_axis_distance, Len(Sub(p, axis)));
+      }
+    }
+  }
+  const double sag = (r_outer - min_axis_distance) * 1.1 + 1e-6;  // sampling slack
+  const double r_inner = r_outer - sag;
+  const double vertex_deviation_deg = MaxVertexNormalDeviationDeg(q, normals, [&](Vec3d p) {
+    return Vec3d{c.x, std::clamp(p.y - c.y, -half, half) + c.y, c.z};
+  });
+  double max_normal_error_deg = 0.0;
+  const double back_z = double(pose.front_z) - double(pose.depth_range);
+
+  // Fitted window: the same texel budget as N x N, smaller texels than the square window.
+  const double box_l = 2 * r_outer + 2 * o.margin, box_h = 2 * (r_outer + half) + 2 * o.margin;
+  EXPECT_NEAR(pose.texel_size, std::sqrt(box_l * box_h) / o.resolution, 1e-6);
+  EXPECT_LT(pose.texel_size, std::max(box_l, box_h) / o.resolution);
+  EXPECT_LE(double(stats.window_width) * stats.window_height,
+            double(o.resolution) * o.resolution + stats.window_width + stats.window_height + 1);
+
+  size_t checked = 0;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const Vec3d p = TexelCentre(pose, i, j);
+      const double axis_y = std::clamp(p.y - c.y, -half, half) + c.y;
+      const double rho = std::hypot(p.x - c.x, p.y - axis_y);
+      const BodyMapTexel front = ReadBodyMapTexel(pose, 0, i, j);
+      const BodyMapTexel back = ReadBodyMapTexel(pose, 1, i, j);
+      ASSERT_EQ(front.valid, back.valid);
+      if (rho < r_inner - 1e-6) {
+        EXPECT_TRUE(front.valid) << i << "," << j;
+      }
+      if (rho > r_outer + 1e-6) {
+        EXPECT_FALSE(front.valid) << i << "," << j;
+      }
+      if (!front.valid || rho >= r_inner - 1e-6) continue;
+      const double z_outer = std::sqrt(r_outer * r_outer - rho * rho);
+      const double z_inner = std::sqrt(r_inner * r_inner - rho * rho);
+      EXPECT_GE(front.depth, double(pose.front_z) - (c.z + z_outer) - 2e-6);
+      EXPECT_LE(front.depth, double(pose.front_z) - (c.z + z_inner) + 2e-6);
+      EXPECT_GE(back.depth, (c.z - z_outer) - back_z - 2e-6);
+      EXPECT_LE(back.depth, (c.z - z_inner) - back_z + 2e-6);
+      if (z_outer / r_outer >= 0.3) {
+        const Vec3d n_front{p.x - c.x, p.y - axis_y, z_outer};
+        const Vec3d n_back{p.x - c.x, p.y - axis_y, -z_outer};
+        const double tolerance_deg =
+            NormalToleranceDeg(vertex_deviation_deg, z_outer, z_inner, r_inner);
+        const double front_error = AngleDeg(ToD3(front.normal), n_front);
+        const double back_error = AngleDeg(ToD3(back.normal), n_back);
+        EXPECT_LE(front_error, tolerance_deg) << i << "," << j;
+        EXPECT_LE(back_error, tolerance_deg) << i << "," << j;
+        max_normal_error_deg = std::max({max_normal_error_deg, front_error, back_error});
+        ++checked;
+      }
+    }
+  }
+  EXPECT_LT(max_normal_error_deg, 3.0);  // "within a few degrees"
+  std::printf(
+      "[ capsule N=512 fitted ] sag %.3g m, vertex normal deviation %.3f deg, max normal "
+      "error %.3f deg\n",
+      sag, vertex_deviation_deg, max_normal_error_deg);
+  EXPECT_GT(checked, 1000u);
+}
+
+TEST(BodyMapBaker, FittedWindowGivesSmallerTexelsForTheSameBudget) {
+  const Mesh capsule = MakeCapsule({0.0, 0.9, 0.0}, 0.15, 0.6, 16, 32);
+  BodyMapOptions square = FloatOptions(256), fitted = FloatOptions(256);
+  fitted.fitted_window = true;
+  BodyMapPoseStats square_stats, fitted_stats;
+  const BodyMapPose a = BakeOrDie(capsule, square, &square_stats);
+  const BodyMapPose b = BakeOrDie(capsule, fitted, &fitted_stats);
+  EXPECT_LT(b.texel_size, 0.7f * a.texel_size);  // box 0.33 x 1.53 m: sqrt(0.33/1.53) = 0.46
+  EXPECT_GT(fitted_stats.coverage, 1.5f * square_stats.coverage);
+  EXPECT_GT(fitted_stats.valid_texels, 3 * square_stats.valid_texels);
+}
+
+// Compares two bakes of the same window texel by texel over the union of their rectangles.
+struct MapDifference {
+  size_t window_texels = 0, coverage_mismatch = 0, both_valid = 0;
+  double max_depth_diff = 0.0, p999_depth_diff = 0.0, max_normal_deg = 0.0;
+  size_t depth_over_1um = 0;
+  // Largest depth difference relative to the surface slope: diff / (texel * tan(theta)), theta
+  // the angle between the normal (of bake a) and the view axis. Vertex snapping moves a triangle
+  // by a fraction of a texel; the depth then changes by that fraction times the slope.
+  double max_diff_per_slope_texel = 0.0;
+  double max_cos_over_1um = 0.0;  // max |n.z| over texels whose depth differs by > 1e-6 m
+};
+MapDifference Compare(const BodyMapPose& a, const BodyMapPose& b, size_t window_texels) {
+  MapDifference d;
+  d.window_texels = window_texels;
+  const double t = a.texel_size;
+  const long di = std::lround((double(b.origin_x) - a.origin_x) / t);
+  const long dj = std::lround((double(b.origin_y) - a.origin_y) / t);
+  const long i_lo = std::min(0L, di), j_lo = std::min(0L, dj);
+  const long i_hi = std::max<long>(a.width, di + long(b.width));
+  const long j_hi = std::max<long>(a.height, dj + long(b.height));
+  std::vector<double> diffs;
+  for (long j = j_lo; j < j_hi; ++j) {
+    for (long i = i_lo; i < i_hi; ++i) {
+      for (int view = 0; view < 2; ++view) {
+        const bool in_a = i >= 0 && j >= 0 && i < long(a.width) && j < long(a.height);
+        const bool in_b =
+            i - di >= 0 && j - dj >= 0 && i - di < long(b.width) && j - dj < long(b.height);
+        const BodyMapTexel ta =
+            in_a ? ReadBodyMapTexel(a, view, uint32_t(i), uint32_t(j)) : BodyMapTexel{};
+        const BodyMapTexel tb =
+            in_b ? ReadBodyMapTexel(b, view, uint32_t(i - di), uint32_t(j - dj)) : BodyMapTexel{};
+        if (ta.valid != tb.valid) {
+          if (view == 0) ++d.coverage_mismatch;
+          continue;
+        }
+        if (!ta.valid) continue;
+        if (view == 0) ++d.both_valid;
+        const double diff = std::fabs(double(ta.depth) - tb.depth);
+        diffs.push_back(diff);
+        d.max_depth_diff = std::max(d.max_depth_diff, diff);
+        const double nz = std::min(1.0, std::fabs(double(ta.normal.z)));
+        const double tan_theta = std::sqrt(std::max(0.0, 1.0 - nz * nz)) / std::max(nz, 1e-9);
+        if (diff > 1e-6) {
+          ++d.depth_over_1um;
+          d.max_cos_over_1um = std::max(d.max_cos_over_1um, nz);
+          d.max_diff_per_slope_texel =
+              std::max(d.max_diff_per_slope_texel, (diff - 1e-6) / (t * tan_theta));
+        }
+        d.max_normal_deg = std::max(d.max_normal_deg, AngleDeg(ToD3(ta.normal), ToD3(tb.normal)));
+      }
+    }
+  }
+  if (!diffs.empty()) {
+    std::sort(diffs.begin(), diffs.end());
+    d.p999_depth_diff = diffs[std::min(diffs.size() - 1, size_t(0.999 * double(diffs.size())))];
+  }
+  return d;
+}
+
+void ExpectOsMesaMatchesCpu(const Mesh& mesh, uint32_t resolution, const char* label) {
+  if (!OsMesaRendererAvailable()) GTEST_SKIP() << "OSMesa renderer not available in this build";
+  BodyMapOptions cpu = FloatOptions(resolution), gl = FloatOptions(resolution);
+  gl.renderer = MapRenderer::kOsMesa;
+  BodyMapPoseStats cpu_stats, gl_stats;
+  const BodyMapPose a = BakeOrDie(mesh, cpu, &cpu_stats);
+  const BodyMapPose b = BakeOrDie(mesh, gl, &gl_stats);
+  ASSERT_EQ(a.texel_size, b.texel_size);
+  ASSERT_EQ(a.front_z, b.front_z);
+  ASSERT_EQ(a.depth_range, b.depth_range);
+  const MapDifference d = Compare(a, b, size_t(resolution) * resolution);
+  const double mismatch_fraction = double(d.coverage_mismatch) / double(d.window_texels);
+  const double over_fraction = double(d.depth_over_1um) / double(2 * d.both_valid);
+  std::printf(
+      "[ osmesa vs cpu ] %s N=%u: renderer '%s', coverage mismatch %zu texels (%.5f %%), "
+      "silhouette conflicts %u, both valid %zu, depth |diff| max %.3g m, p99.9 %.3g m, "
+      "> 1e-6 m on %zu texel-views (%.4f %%, all with |n.z| <= %.3f), max (diff - 1e-6) / "
+      "(texel * tan theta) %.4f, normal max %.3f deg\n",
+      label, resolution, gl_stats.renderer, d.coverage_mismatch, 100.0 * mismatch_fraction,
+      gl_stats.silhouette_conflicts, d.both_valid, d.max_depth_diff, d.p999_depth_diff,
+      d.depth_over_1um, 100.0 * over_fraction, d.max_cos_over_1um, d.max_diff_per_slope_texel,
+      d.max_normal_deg);
+  EXPECT_LE(mismatch_fraction, 1e-4);  // 0.01 % of the window's texels
+  // Depth: within 1e-6 m on texels valid in both, except on steep texels next to the outline,
+  // where llvmpipe's vertex snapping (8 sub-pixel bits: a vertex moves by <= 1/512 texel per
+  // axis) shifts a triangle whose depth changes by tan(theta) per unit of x,y. There the bound
+  // is 1e-6 m + texel * tan(theta) / 256. Measured (printed above): p99.9 under 1e-6 m, the
+  // larger differences all at |n.z| < 0.14, and at most 0.0008 texel * tan(theta).
+  EXPECT_LE(d.p999_depth_diff, 1e-6);
+  EXPECT_LE(over_fraction, 1e-3);
+  EXPECT_LE(d.max_diff_per_slope_texel, 1.0 / 256.0);
+  EXPECT_LE(d.max_normal_deg, 0.1);
+}
+
+TEST(BodyMapBaker, OsMesaAgreesWithCpuOnSphere) {
+  ExpectOsMesaMatchesCpu(MakeSphere({0.05, 1.0, -0.02}, 0.3, 50, 50), 1024, "sphere 4.9k");
+}
+
+TEST(BodyMapBaker, OsMesaAgreesWithCpuOn80kTriangles) {
+  ExpectOsMesaMatchesCpu(MakeSphere({0.0, 0.0, 0.0}, 0.3, 200, 200), 1024, "sphere 79.6k");
+}
+
+TEST(BodyMapBaker, OsMesaIsUnavailableOrDeterministic) {
+  const Mesh sphere = MakeSphere({0.0, 0.0, 0.0}, 0.3, 30, 30);
+  BodyMapOptions o = FloatOptions(256);
+  o.renderer = MapRenderer::kOsMesa;
+  BodyMapPose a, b;
+  const Status status = BakeBodyMapPose(sphere.positions, sphere.triangles, o, &a);
+  if (!OsMesaRendererAvailable()) {
+    EXPECT_EQ(status.code(), StatusCode::kInvalidState);
+    EXPECT_NE(status.message().find("OSMesa renderer not available"), std::string::npos);
+    return;
+  }
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_TRUE(BakeBodyMapPose(sphere.positions, sphere.triangles, o, &b).ok());
+  EXPECT_EQ(a.depth_f32[0], b.depth_f32[0]);
+  EXPECT_EQ(a.depth_f32[1], b.depth_f32[1]);
+  EXPECT_EQ(a.normal_f32[0], b.normal_f32[0]);
+}
+
+TEST(BodyMapBaker, OsMesaTilesAgreeWithCpuOnATallFittedWindow) {
+  // 0.33 m x 1.53 m: at N = 2048 the fitted window is about 950 x 4400 texels, so the OSMesa
+  // path renders it in several 2048-texel tiles; the seams must not show.
+  const Mesh capsule = MakeCapsule({0.0, 0.9, 0.0}, 0.15, 0.6, 32, 64);
+  if (!OsMesaRendererAvailable()) GTEST_SKIP() << "OSMesa renderer not available in this build";
+  BodyMapOptions cpu = FloatOptions(2048), gl = FloatOptions(2048);
+  cpu.fitted_window = gl.fitted_window = true;
+  gl.renderer = MapRenderer::kOsMesa;
+  BodyMapPoseStats stats;
+  const BodyMapPose a = BakeOrDie(capsule, cpu, &stats);
+  const BodyMapPose b = BakeOrDie(capsule, gl);
+  ASSERT_GT(stats.window_height, 4096u);
+  const MapDifference d = Compare(a, b, size_t(stats.window_width) * size_t(stats.window_height));
+  std::printf(
+      "[ osmesa vs cpu ] tall capsule, fitted %u x %u: coverage mismatch %zu, depth max "
+      "%.3g m, p99.9 %.3g m, max (diff - 1e-6) / (texel * tan theta) %.4f\n",
+      stats.window_width, stats.window_height, d.coverage_mismatch, d.max_depth_diff,
+      d.p999_depth_diff, d.max_diff_per_slope_texel);
+  EXPECT_LE(double(d.coverage_mismatch) / double(d.window_texels), 1e-4);
+  EXPECT_LE(d.p999_depth_diff, 1e-6);
+  EXPECT_LE(d.max_diff_per_slope_texel, 1.0 / 256.0);
+}
+
+TEST(BodyMapBaker, SharedEdgesLeaveNoCracks) {
+  // A flat, jittered 40 x 40 grid of quads (3200 triangles sharing edges, mixed orientations):
+  // every texel centre inside the outer square is covered, none outside. A crack in the
+  // rasterizer's edge rule would leave background texels inside.
+  Mesh grid;
+  constexpr int kCells = 40;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  const double cell = 0.02;
+  for (int y = 0; y <= kCells; ++y) {
+    for (int x = 0; x <= kCells; ++x) {
+      const bool interior = x > 0 && y > 0 && x < kCells && y < kCells;
+      const double px = (x + (interior ? jitter(rng) : 0.0)) * cell;
+      const double py = (y + (interior ? jitter(rng) : 0.0)) * cell;
+      grid.positions.push_back({static_cast<float>(px), static_cast<float>(py), 0.25f});
+    }
+  }
+  for (int y = 0; y < kCells; ++y) {
+    for (int x = 0; x < kCells; ++x) {
+      const uint32_t a = uint32_t(y * (kCells + 1) + x), b = a + 1, c = a + kCells + 1, e = c + 1;
+      if ((x + y) % 2 == 0) {
+        grid.triangles.insert(grid.triangles.end(), {a, b, e, a, e, c});
+      } else {
+        grid.triangles.insert(grid.triangles.end(), {a, c, b, b, c, e});  // clockwise ones too
+      }
+    }
+  }
+  BodyMapOptions o = FloatOptions(997);  // an odd N puts texel centres at arbitrary offsets
+  o.epsilon = 0.f;                       // keep the grid flat (the normals are all +z anyway)
+  BodyMapPoseStats stats;
+  const BodyMapPose pose = BakeOrDie(grid, o, &stats);
+  const double t = pose.texel_size, side = kCells * cell;
+  const double lo_x = double(grid.positions.front().x), hi_x = double(grid.positions.back().x);
+  const double lo_y = double(grid.positions.front().y), hi_y = double(grid.positions.back().y);
+  ASSERT_NEAR(hi_x - lo_x, side, 1e-6);
+  size_t inside = 0;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const Vec3d p = TexelCentre(pose, i, j);
+      const double inset = std::min({p.x - lo_x, hi_x - p.x, p.y - lo_y, hi_y - p.y});
+      if (std::fabs(inset) < 1e-4 * t) continue;
+      const BodyMapTexel texel = ReadBodyMapTexel(pose, 0, i, j);
+      ASSERT_EQ(texel.valid, inset > 0) << i << "," << j;
+      inside += inset > 0 ? 1 : 0;
+      if (texel.valid) {
+        ASSERT_NEAR(texel.depth, double(pose.front_z) - 0.25, 1e-6);
+      }
+    }
+  }
+  EXPECT_GT(inside, size_t(0.9 * side * side / (t * t)));
+  EXPECT_EQ(stats.silhouette_conflicts, 0u);
+}
+
+TEST(BodyMapBaker, CodecsRoundTripWithinTheirDocumentedErrors) {
+  std::mt19937 rng(12345);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<Vec3d> directions = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},   {0, -1, 0},       {0, 0, 1},
+                                   {0, 0, -1}, {1, 1, 1},  {-1, 1, -1}, {0.3, -0.2, -0.9}};
+  for (int k = 0; k < 20000; ++k) directions.push_back({gauss(rng), gauss(rng), gauss(rng)});
+  double max_oct = 0.0, max_rgb = 0.0;
+  for (const Vec3d& d : directions) {
+    const Vec3d n = Scale(d, 1.0 / Len(d));
+    const Float3 nf{float(n.x), float(n.y), float(n.z)};
+    max_oct = std::max(max_oct, AngleDeg(ToD3(DecodeNormalOct16(EncodeNormalOct16(nf))), n));
+    uint8_t rgb[3];
+    EncodeNormalRgb8(nf, rgb);
+    max_rgb = std::max(max_rgb, AngleDeg(ToD3(DecodeNormalRgb8(rgb)), n));
+  }
+  EXPECT_LE(max_oct, 0.01);
+  EXPECT_LE(max_rgb, 0.5);
+  // The rgb8 formula is paper A's: round((n * 0.5 + 0.5) * 255).
+  uint8_t rgb[3];
+  EncodeNormalRgb8({0.f, -1.f, 0.6f}, rgb);
+  EXPECT_EQ(rgb[0], 128);
+  EXPECT_EQ(rgb[1], 0);
+  EXPECT_EQ(rgb[2], 204);
+  // Depth: unorm16 error <= depth_range / 65535, 65535 reserved for background.
+  const float range = 0.73f;
+  for (int k = 0; k <= 1000; ++k) {
+    const float depth = range * float(k) / 1000.f * 0.99999f;
+    const uint16_t code = EncodeDepthUnorm16(depth, range);
+    EXPECT_LE(code, 65534);
+    EXPECT_LE(std::fabs(DecodeDepthUnorm16(code, range) - depth), range / 65535.0);
+  }
+  EXPECT_EQ(EncodeDepthUnorm16(range, range), 65534);
+}
+
+TEST(BodyMapBaker, EncodedBakesMatchTheFloatBake) {
+  const Mesh sphere = MakeSphere({0.0, 0.0, 0.0}, 0.3, 40, 40);
+  const BodyMapPose reference = BakeOrDie(sphere, FloatOptions(256));
+  BodyMapOptions compact = FloatOptions(256), paper = FloatOptions(256);
+  compact.depth_encoding = DepthEncoding::kUnorm16;
+  compact.normal_encoding = NormalEncoding::kOct16;
+  paper.normal_encoding = NormalEncoding::kRgb8;
+  BodyMapPoseStats compact_stats;
+  const BodyMapPose a = BakeOrDie(sphere, compact, &compact_stats);
+  const BodyMapPose b = BakeOrDie(sphere, paper);
+  ASSERT_EQ(a.width, reference.width);
+  ASSERT_EQ(a.height, reference.height);
+  EXPECT_TRUE(a.depth_f32[0].empty() && a.normal_f32[0].empty() && a.normal_rgb8[0].empty());
+  EXPECT_EQ(a.depth_u16[1].size(), size_t(a.width) * a.height);
+  EXPECT_EQ(a.normal_oct16[1].size(), 2 * size_t(a.width) * a.height);
+  EXPECT_EQ(compact_stats.bytes, 2 * size_t(a.width) * a.height * (2 + 4));
+  double max_depth = 0.0, max_oct = 0.0, max_rgb = 0.0;
+  size_t valid = 0;
+  for (uint32_t j = 0; j < a.height; ++j) {
+    for (uint32_t i = 0; i < a.width; ++i) {
+      for (int view = 0; view < 2; ++view) {
+        const BodyMapTexel r = ReadBodyMapTexel(reference, view, i, j);
+        const BodyMapTexel ta = ReadBodyMapTexel(a, view, i, j);
+        const BodyMapTexel tb = ReadBodyMapTexel(b, view, i, j);
+        ASSERT_EQ(r.valid, ta.valid);
+        ASSERT_EQ(r.valid, tb.valid);
+        if (!r.valid) {
+          EXPECT_EQ(a.depth_u16[view][size_t(j) * a.width + i], 65535);
+          EXPECT_EQ(reference.depth_f32[view][size_t(j) * a.width + i], reference.depth_range);
+          continue;
+        }
+        ++valid;
+        max_depth = std::max(max_depth, std::fabs(double(ta.depth) - r.depth));
+        max_oct = std::max(max_oct, AngleDeg(ToD3(ta.normal), ToD3(r.normal)));
+        max_rgb = std::max(max_rgb, AngleDeg(ToD3(tb.normal), ToD3(r.normal)));
+      }
+    }
+  }
+  EXPECT_GT(valid, 1000u);
+  EXPECT_LE(max_depth, double(reference.depth_range) / 65535.0);
+  EXPECT_LE(max_oct, 0.01);
+  EXPECT_LE(max_rgb, 0.5);
+}
+
+TEST(BodyMapBaker, CpuBakesAreByteIdentical) {
+  const Mesh sphere = MakeSphere({0.01, 0.02, 0.03}, 0.3, 50, 50);
+  BodyMapOptions o;  // defaults: float depth, oct16 normals, N = 1024
+  o.resolution = 512;
+  const BodyMapPose a = BakeOrDie(sphere, o), b = BakeOrDie(sphere, o);
+  for (int view = 0; view < 2; ++view) {
+    ASSERT_EQ(a.depth_f32[view].size(), b.depth_f32[view].size());
+    EXPECT_EQ(0, std::memcmp(a.depth_f32[view].data(), b.depth_f32[view].data(),
+                             a.depth_f32[view].size() * sizeof(float)));
+    EXPECT_EQ(a.normal_oct16[view], b.normal_oct16[view]);
+  }
+  EXPECT_EQ(0, std::memcmp(&a.origin_x, &b.origin_x, sizeof(float)));
+  EXPECT_EQ(0, std::memcmp(&a.front_z, &b.front_z, sizeof(float)));
+}
+
+TEST(BodyMapBaker, DegenerateInputReturnsAnErrorAndLeavesThePoseUnchanged) {
+  const Mesh sphere = MakeSphere({0.0, 0.0, 0.0}, 0.3, 8, 8);
+  BodyMapPose pose;
+  pose.clip = 7;
+  pose.width = 42;
+  auto expect_error = [&](std::span<const Float3> positions, std::span<const uint32_t> tris,
+                          const BodyMapOptions& o, const char* fragment) {
+    const Status status = BakeBodyMapPose(positions, tris, o, &pose);
+    EXPECT_FALSE(status.ok()) << fragment;
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << status.message();
+    EXPECT_NE(status.message().find(fragment), std::string::npos) << status.message();
+    EXPECT_EQ(pose.width, 42u);
+    EXPECT_EQ(pose.clip, 7);
+  };
+  const BodyMapOptions o;
+  expect_error(sphere.positions, {}, o, "no triangles");
+  const std::vector<uint32_t> two = {0, 1};
+  expect_error(sphere.positions, two, o, "multiple of 3");
+  const std::vector<uint32_t> out_of_range = {0, 1, 9999};
+  expect_error(sphere.positions, out_of_range, o, "vertex 9999");
+  Mesh nan_mesh = sphere;
+  nan_mesh.positions[5].y = std::numeric_limits<float>::quiet_NaN();
+  expect_error(nan_mesh.positions, nan_mesh.triangles, o, "vertex 5");
+  nan_mesh.positions[5].y = std::numeric_limits<float>::infinity();
+  expect_error(nan_mesh.positions, nan_mesh.triangles, o, "non-finite");
+  BodyMapOptions bad = o;
+  bad.resolution = 8;
+  expect_error(sphere.positions, sphere.triangles, bad, "resolution");
+  bad.resolution = 9000;
+  expect_error(sphere.positions, sphere.triangles, bad, "resolution");
+  bad = o;
+  bad.epsilon = -0.001f;
+  expect_error(sphere.positions, sphere.triangles, bad, "epsilon");
+  bad.epsilon = std::numeric_limits<float>::quiet_NaN();
+  expect_error(sphere.positions, sphere.triangles, bad, "epsilon");
+  bad = o;
+  bad.margin = -1.f;
+  expect_error(sphere.positions, sphere.triangles, bad, "margin");
+  bad = o;
+  bad.normal_encoding = static_cast<NormalEncoding>(9);
+  expect_error(sphere.positions, sphere.triangles, bad, "normal encoding");
+  // All triangles degenerate (collinear points): nothing is covered.
+  const std::vector<Float3> line = {{0, 0, 0}, {0.1f, 0.1f, 0.1f}, {0.2f, 0.2f, 0.2f}};
+  const std::vector<uint32_t> line_tri = {0, 1, 2, 2, 1, 0};
+  expect_error(line, line_tri, o, "covers no texel");
+  // A flat mesh with no offset and no margin has no depth range.
+  const std::vector<Float3> flat = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<uint32_t> flat_tri = {0, 1, 2};
+  BodyMapOptions zero = o;
+  zero.epsilon = 0.f;
+  zero.margin = 0.f;
+  expect_error(flat, flat_tri, zero, "depth_range");
+  // ... but with a margin it bakes (a single triangle), both views valid on the same texels.
+  zero.margin = 0.01f;
+  zero.resolution = 64;
+  BodyMapPoseStats stats;
+  const Status ok = BakeBodyMapPose(flat, flat_tri, zero, &pose, &stats);
+  ASSERT_TRUE(ok.ok()) << ok.message();
+  EXPECT_NEAR(stats.coverage, 0.5 * (1.0 / 1.02) * (1.0 / 1.02), 0.02);
+  EXPECT_EQ(pose.clip, 7);  // clip and time are the caller's
+  EXPECT_EQ(BakeBodyMapPose(flat, flat_tri, zero, nullptr).code(), StatusCode::kInvalidArgument);
+}
+
+TEST(BodyMapBaker, PreviewWritesFourPngs) {
+  const Mesh capsule = MakeCapsule({0.0, 0.0, 0.0}, 0.2, 0.3, 16, 32);
+  BodyMapOptions o;
+  o.resolution = 128;
+  o.normal_encoding = NormalEncoding::kOct16;
+  o.depth_encoding = DepthEncoding::kUnorm16;
+  const BodyMapPose pose = BakeOrDie(capsule, o);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("drape_body_map_preview_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const Status status = WriteBodyMapPreview(pose, dir.string(), "capsule");
+  ASSERT_TRUE(status.ok()) << status.message();
+  for (const char* name : {"capsule_front_depth.png", "capsule_back_depth.png",
+                           "capsule_front_normal.png", "capsule_back_normal.png"}) {
+    const std::filesystem::path file = dir / name;
+    ASSERT_TRUE(std::filesystem::exists(file)) << file;
+    EXPECT_GT(std::filesystem::file_size(file), 100u) << file;
+  }
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    files += entry.is_regular_file();
+  EXPECT_EQ(files, 4u);
+  std::filesystem::remove_all(dir);
+  // A directory that does not exist is an I/O error, not a crash.
+  EXPECT_EQ(WriteBodyMapPreview(pose, (dir / "missing" / "deeper").string(), "x").code(),
+            StatusCode::kIoError);
+}
+
+}  // namespace
+}  // namespace drape::bake
