@@ -1,0 +1,195 @@
+// drape-query FILE.drape [--clip NAME --time T] (--points F | --segments F)
+//             [--method maps|hulls|spheres|all] [--mesh F.obj]
+// The runtime's collision answers from the command line, for pipeline checks and debugging.
+// Input rows: "x y z" (points) or "x0 y0 z0 x1 y1 z1" (previous and current position), asset
+// frame, metres; '#' starts a comment. Output: CSV on stdout, one row per input row and method.
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "drape/formats/asset_file.h"
+#include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/collision_types.h"
+#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/skeleton_pose.h"
+#include "drape/runtime/skinning.h"
+
+namespace {
+
+int Usage() {
+  std::fprintf(stderr,
+               "usage: drape-query FILE.drape [--clip NAME --time T] (--points F | --segments F)\n"
+               "                   [--method maps|hulls|spheres|all] [--mesh F.obj]\n");
+  return 2;
+}
+
+int Fail(const std::string& message) {
+  std::fprintf(stderr, "drape-query: error: %s\n", message.c_str());
+  return 1;
+}
+
+struct Segment {
+  drape::Float3 p0, p1;
+};
+
+bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows, std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    *error = path + ": cannot open";
+    return false;
+  }
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream fields(line);
+    std::vector<double> values;
+    for (double v; fields >> v;) values.push_back(v);
+    if (!fields.eof()) {
+      *error = path + ":" + std::to_string(number) + ": not a number";
+      return false;
+    }
+    if (values.empty()) continue;
+    const size_t expected = segments ? 6 : 3;
+    if (values.size() != expected) {
+      *error = path + ":" + std::to_string(number) + ": expected " + std::to_string(expected) + " numbers, got " +
+               std::to_string(values.size());
+      return false;
+    }
+    auto f = [&](size_t k) { return static_cast<float>(values[k]); };
+    Segment s{{f(0), f(1), f(2)}, {f(0), f(1), f(2)}};
+    if (segments) s.p1 = {f(3), f(4), f(5)};
+    rows->push_back(s);
+  }
+  return true;
+}
+
+void PrintRow(size_t row, const char* method, const drape::ContactQuery& q, const Segment& s) {
+  // Position after response: the particle moved p0 -> p1 with velocity (p1 - p0) per unit time.
+  drape::Float3 position = s.p1;
+  drape::Float3 velocity = s.p1 - s.p0;
+  if (q.contact) drape::ApplyResponse(q, drape::ResponseParams{}, &position, &velocity);
+  std::printf("%zu,%s,%d,%d,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g\n", row, method, q.inside_end ? 1 : 0,
+              q.contact ? 1 : 0, q.t, q.point.x, q.point.y, q.point.z, q.normal.x, q.normal.y, q.normal.z, q.depth,
+              position.x, position.y, position.z);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string path, clip_name, points_path, segments_path, method = "all", mesh_path;
+  float time = 0.f;
+  bool time_given = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&](std::string* out) {
+      if (i + 1 >= argc) return false;
+      *out = argv[++i];
+      return true;
+    };
+    std::string v;
+    if (a == "--clip") {
+      if (!value(&clip_name)) return Usage();
+    } else if (a == "--time") {
+      if (!value(&v)) return Usage();
+      char* end = nullptr;
+      time = std::strtof(v.c_str(), &end);
+      if (*end != '\0' || !std::isfinite(time)) return Fail("--time '" + v + "' is not a number");
+      time_given = true;
+    } else if (a == "--points") {
+      if (!value(&points_path)) return Usage();
+    } else if (a == "--segments") {
+      if (!value(&segments_path)) return Usage();
+    } else if (a == "--method") {
+      if (!value(&method)) return Usage();
+    } else if (a == "--mesh") {
+      if (!value(&mesh_path)) return Usage();
+    } else if (a == "-h" || a == "--help") {
+      Usage();
+      return 0;
+    } else if (a[0] == '-' || !path.empty()) {
+      return Usage();
+    } else {
+      path = a;
+    }
+  }
+  if (path.empty() || (points_path.empty() == segments_path.empty() && mesh_path.empty())) return Usage();
+  if (method != "maps" && method != "hulls" && method != "spheres" && method != "all") {
+    return Fail("--method '" + method + "' is not maps, hulls, spheres or all");
+  }
+  if (time_given && clip_name.empty()) return Fail("--time needs --clip");
+
+  drape::CharacterAsset asset;
+  if (drape::Status s = drape::ReadAssetFile(path, &asset); !s.ok()) return Fail(s.message());
+  drape::SkeletonPose pose;
+  if (drape::Status s = pose.Init(asset.skeleton); !s.ok()) return Fail(path + ": " + s.message());
+  int32_t clip_index = -1;
+  if (!clip_name.empty()) {
+    for (size_t c = 0; c < asset.clips.size(); ++c)
+      if (asset.clips[c].name == clip_name) clip_index = static_cast<int32_t>(c);
+    if (clip_index < 0) return Fail(path + ": no clip named '" + clip_name + "'");
+    if (drape::Status s = pose.SampleClip(asset.clips[clip_index], time, false); !s.ok()) {
+      return Fail(path + ": " + s.message());
+    }
+  }
+
+  if (!mesh_path.empty()) {
+    std::vector<drape::Float3> posed(asset.mesh.vertex_count());
+    if (drape::Status s = drape::SkinMesh(asset.mesh, pose.skinning(), posed); !s.ok()) return Fail(s.message());
+    std::ofstream obj(mesh_path);
+    obj << "# posed body mesh of " << path << (clip_name.empty() ? " (rest pose)" : " clip " + clip_name) << "\n";
+    for (const drape::Float3& p : posed) obj << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    for (size_t t = 0; t + 2 < asset.mesh.triangles.size(); t += 3) {
+      obj << "f " << asset.mesh.triangles[t] + 1 << ' ' << asset.mesh.triangles[t + 1] + 1 << ' '
+          << asset.mesh.triangles[t + 2] + 1 << '\n';
+    }
+    if (!obj) return Fail(mesh_path + ": cannot write");
+  }
+  if (points_path.empty() && segments_path.empty()) return 0;
+
+  std::vector<Segment> rows;
+  std::string error;
+  if (!ReadRows(points_path.empty() ? segments_path : points_path, !segments_path.empty(), &rows, &error)) {
+    return Fail(error);
+  }
+
+  const bool want_maps = method == "maps" || method == "all";
+  const bool want_hulls = method == "hulls" || method == "all";
+  const bool want_spheres = method == "spheres" || method == "all";
+  drape::BodyMapCollider maps;
+  if (want_maps) {
+    // The baked pose for this clip time: the nearest one of that clip (or the rest pose).
+    const drape::BodyMapPose* best = nullptr;
+    for (const drape::BodyMapPose& p : asset.body_maps.poses) {
+      if (p.clip != clip_index) continue;
+      if (best == nullptr || std::fabs(p.time - time) < std::fabs(best->time - time)) best = &p;
+    }
+    if (best == nullptr) {
+      if (method == "maps") {
+        return Fail(path + ": no body maps baked for " + (clip_name.empty() ? "the rest pose" : "clip '" + clip_name + "'"));
+      }
+    } else if (drape::Status s = maps.Build(*best); !s.ok()) {
+      return Fail(path + ": " + s.message());
+    }
+  }
+  drape::HullColliderSet hulls;
+  if (want_hulls || want_spheres) {
+    if (drape::Status s = hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count()); !s.ok()) {
+      return Fail(path + ": " + s.message());
+    }
+    if (drape::Status s = hulls.SetPose(pose.skinning(), pose.skinning()); !s.ok()) return Fail(path + ": " + s.message());
+  }
+
+  std::printf("row,method,inside,contact,t,px,py,pz,nx,ny,nz,depth,x_after,y_after,z_after\n");
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const Segment& s = rows[r];
+    if (want_maps && !maps.empty()) PrintRow(r, "maps", maps.Query(s.p0, s.p1), s);
+    if (want_hulls) PrintRow(r, "hulls", hulls.Query(s.p0, s.p1, drape::kColliderHulls), s);
+    if (want_spheres) PrintRow(r, "spheres", hulls.Query(s.p0, s.p1, drape::kColliderSpheres), s);
+  }
+  return 0;
+}
