@@ -3,7 +3,9 @@
 #  1. the full build (bake + runtime + tools) and its tests;
 #  2. formats + runtime alone with -DDRAPE_BUILD_BAKE=OFF: builds, passes its tests, and its link
 #     lines name no assimp, CGAL or OSMesa;
-#  3. cmake --install of that build, and a tiny consumer that find_package(drape)s it.
+#  3. cmake --install of that build, and a tiny consumer that find_package(drape)s it;
+#  4. formats + runtime tests again under AddressSanitizer + UndefinedBehaviorSanitizer;
+#  5. each libFuzzer target for a bounded time (DRAPE_FUZZ_SECONDS, default 60) over its seeds.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -69,6 +71,16 @@ install_consumer() {
   return $rc
 }
 check "installed drape::runtime links into a consumer" install_consumer
+
+echo "== 4. formats + runtime under ASan + UBSan"
+if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 run_ctest build-sanitize
+else
+  check "sanitizer build" false
+fi
+
+echo "== 5. fuzzing"
+check "fuzz targets run clean for ${DRAPE_FUZZ_SECONDS:-60} s each" scripts/fuzz.sh "${DRAPE_FUZZ_SECONDS:-60}"
 
 echo "tests: $total_passed passed, $total_failed failed"
 [ "$total_failed" -eq 0 ]

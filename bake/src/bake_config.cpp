@@ -86,6 +86,66 @@ Parameter MakeChoice(std::string section, std::string key, std::vector<std::stri
   return p;
 }
 
+Parameter MakeString(std::string section, std::string key, std::string description,
+                     std::function<std::string&(BakeConfig&)> field) {
+  Parameter p{std::move(section),     std::move(key), "",     "any string",
+              std::move(description), nullptr,        nullptr};
+  p.get = [field](const BakeConfig& c) { return json(field(const_cast<BakeConfig&>(c))); };
+  p.set = [field](const json& v, BakeConfig& c) -> std::string {
+    if (!v.is_string()) return "must be a string";
+    field(c) = v.get<std::string>();
+    return "";
+  };
+  return p;
+}
+
+template <class Enum>
+Parameter MakeEnum(std::string section, std::string key,
+                   std::vector<std::pair<std::string, Enum>> names, std::string description,
+                   std::function<Enum&(BakeConfig&)> field) {
+  std::string range;
+  for (const auto& [name, value] : names) range += (range.empty() ? "" : " | ") + name;
+  Parameter p{std::move(section),     std::move(key), "",     range,
+              std::move(description), nullptr,        nullptr};
+  p.get = [field, names](const BakeConfig& c) {
+    const Enum value = field(const_cast<BakeConfig&>(c));
+    for (const auto& [name, v] : names)
+      if (v == value) return json(name);
+    return json(nullptr);
+  };
+  p.set = [field, names, range](const json& v, BakeConfig& c) -> std::string {
+    if (!v.is_string()) return "must be a string: " + range;
+    for (const auto& [name, value] : names) {
+      if (name == v.get<std::string>()) {
+        field(c) = value;
+        return "";
+      }
+    }
+    return "'" + v.get<std::string>() + "' is not one of " + range;
+  };
+  return p;
+}
+
+Parameter MakeUint(std::string section, std::string key, std::string unit, uint32_t lo, uint32_t hi,
+                   std::string description, std::function<uint32_t&(BakeConfig&)> field) {
+  Parameter p{std::move(section),
+              std::move(key),
+              std::move(unit),
+              "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]",
+              std::move(description),
+              nullptr,
+              nullptr};
+  p.get = [field](const BakeConfig& c) { return json(field(const_cast<BakeConfig&>(c))); };
+  p.set = [field, lo, hi, range = p.range](const json& v, BakeConfig& c) -> std::string {
+    if (!v.is_number_integer() && !v.is_number_unsigned()) return "must be an integer in " + range;
+    const int64_t x = v.get<int64_t>();
+    if (x < lo || x > hi) return "must be in " + range;
+    field(c) = static_cast<uint32_t>(x);
+    return "";
+  };
+  return p;
+}
+
 const std::vector<Parameter>& Parameters() {
   static const std::vector<Parameter> table = {
       MakeNumber("import", "unit_scale", "m per source unit", 0, 1e6, false,
@@ -100,6 +160,107 @@ const std::vector<Parameter>& Parameters() {
       MakeBool("import", "rename_duplicate_joints",
                "repair duplicate or empty joint names with suffixes instead of failing",
                [](BakeConfig& c) -> bool& { return c.import.rename_duplicate_joints; }),
+
+      MakeBool("maps", "enabled",
+               "bake paper A's front/back depth and normal maps of the rest pose",
+               [](BakeConfig& c) -> bool& { return c.maps_enabled; }),
+      MakeString("maps", "clip", "empty: the rest pose; a clip name: its poses at maps.clip_rate",
+                 [](BakeConfig& c) -> std::string& { return c.maps_clip; }),
+      MakeFloat("maps", "clip_rate", "Hz", 0, 1000, false,
+                "poses per second of maps.clip; 0 = every resampled frame",
+                [](BakeConfig& c) -> float& { return c.maps_clip_rate; }),
+      MakeUint(
+          "maps", "resolution", "texels", 16, 8192,
+          "N: texels along the square window's side (the texel budget N*N for a fitted window)",
+          [](BakeConfig& c) -> uint32_t& { return c.maps.resolution; }),
+      MakeBool("maps", "fitted_window",
+               "fit the window to the body's L x H instead of the paper's square",
+               [](BakeConfig& c) -> bool& { return c.maps.fitted_window; }),
+      MakeFloat("maps", "epsilon", "m", 0, 0.1, false,
+                "offset of the surface along its normals before rendering",
+                [](BakeConfig& c) -> float& { return c.maps.epsilon; }),
+      MakeFloat("maps", "margin", "m", 0, 1, false,
+                "camera box enlargement beyond the offset surface",
+                [](BakeConfig& c) -> float& { return c.maps.margin; }),
+      MakeEnum<DepthEncoding>(
+          "maps", "depth_encoding",
+          {{"float32", DepthEncoding::kFloat32}, {"unorm16", DepthEncoding::kUnorm16}},
+          "how depth is stored",
+          [](BakeConfig& c) -> DepthEncoding& { return c.maps.depth_encoding; }),
+      MakeEnum<NormalEncoding>(
+          "maps", "normal_encoding",
+          {{"float32", NormalEncoding::kFloat32},
+           {"oct16", NormalEncoding::kOct16},
+           {"rgb8", NormalEncoding::kRgb8}},
+          "how normals are stored (rgb8 is the paper's colour encoding)",
+          [](BakeConfig& c) -> NormalEncoding& { return c.maps.normal_encoding; }),
+      MakeEnum<MapRenderer>(
+          "maps", "renderer", {{"cpu", MapRenderer::kCpu}, {"osmesa", MapRenderer::kOsMesa}},
+          "cpu: in-house deterministic rasterizer; osmesa: the paper's GL path (llvmpipe)",
+          [](BakeConfig& c) -> MapRenderer& { return c.maps.renderer; }),
+
+      MakeBool("hulls", "enabled", "bake paper B's per-bone convex colliders",
+               [](BakeConfig& c) -> bool& { return c.hulls_enabled; }),
+      MakeFloat("hulls", "rigid_threshold", "weight", 0.5, 1, true,
+                "a vertex is rigid to its heaviest bone when that weight reaches this",
+                [](BakeConfig& c) -> float& { return c.rigid_threshold; }),
+      MakeFloat("hulls", "delta", "m", 0, 0.1, false,
+                "inflation: the delta-ball of every rigid vertex is inside",
+                [](BakeConfig& c) -> float& { return c.hull.delta; }),
+      MakeEnum<InflationMode>(
+          "hulls", "inflation",
+          {{"minkowski", InflationMode::kMinkowskiIcosahedron},
+           {"vertex_normal", InflationMode::kVertexNormalOffset}},
+          "minkowski: guaranteed containment; vertex_normal: the paper's offset",
+          [](BakeConfig& c) -> InflationMode& { return c.hull.inflation; }),
+      MakeEnum<SimplifyMode>("hulls", "simplify",
+                             {{"edge_collapse", SimplifyMode::kEdgeCollapse},
+                              {"plane_removal", SimplifyMode::kPlaneRemoval},
+                              {"none", SimplifyMode::kNone}},
+                             "how the inflated hull is simplified, always convex and containing",
+                             [](BakeConfig& c) -> SimplifyMode& { return c.hull.simplify; }),
+      MakeUint("hulls", "max_triangles", "triangles", 4, 100000,
+               "simplification stops at or below this",
+               [](BakeConfig& c) -> uint32_t& { return c.hull.max_triangles; }),
+      MakeFloat("hulls", "max_growth", "m", 0, 1, false,
+                "no collider vertex ends farther than this beyond the inflated hull",
+                [](BakeConfig& c) -> float& { return c.hull.max_growth; }),
+      MakeEnum<ObbMode>(
+          "hulls", "obb",
+          {{"covariance", ObbMode::kCovariance}, {"cgal_optimal", ObbMode::kCgalOptimal}},
+          "covariance: the paper's statistical box; cgal_optimal: CGAL's optimiser (seeded)",
+          [](BakeConfig& c) -> ObbMode& { return c.hull.obb; }),
+      MakeUint("hulls", "min_points", "vertices", 1, 1000000,
+               "bones with fewer distinct rigid vertices are left to the joint spheres",
+               [](BakeConfig& c) -> uint32_t& { return c.hull.min_points; }),
+
+      MakeEnum<ProjectionAxis>(
+          "hulls", "projection_axis",
+          {{"auto", ProjectionAxis::kAuto},
+           {"longest", ProjectionAxis::kLongest},
+           {"shortest", ProjectionAxis::kShortest}},
+          "OBB axis the Kirkpatrick hierarchies project along (paper: longest)",
+          [](BakeConfig& c) -> ProjectionAxis& { return c.kirkpatrick.axis; }),
+      MakeEnum<MapTableChoice>(
+          "hulls", "map_table",
+          {{"auto", MapTableChoice::kAuto},
+           {"sphere", MapTableChoice::kSphere},
+           {"cylinder", MapTableChoice::kCylinder}},
+          "response table shape; auto picks a cylinder for elongated colliders",
+          [](BakeConfig& c) -> MapTableChoice& { return c.map_table.kind; }),
+      MakeFloat("hulls", "cylinder_elongation", "ratio", 1, 1000, false,
+                "auto: a cylinder when the longest / middle OBB half extent reaches this",
+                [](BakeConfig& c) -> float& { return c.map_table.cylinder_elongation; }),
+      MakeUint("hulls", "map_rows", "cells", 1, 1024,
+               "theta (sphere) or z (cylinder) cells of the map table",
+               [](BakeConfig& c) -> uint32_t& { return c.map_table.sphere_rows; }),
+      MakeUint("hulls", "map_cols", "cells", 1, 1024, "phi cells of the map table",
+               [](BakeConfig& c) -> uint32_t& { return c.map_table.sphere_cols; }),
+
+      MakeBool("spheres", "enabled", "bake paper B's joint spheres over the flexible vertices",
+               [](BakeConfig& c) -> bool& { return c.spheres_enabled; }),
+      MakeFloat("spheres", "delta", "m", 0, 0.1, false, "added to each joint sphere's radius",
+                [](BakeConfig& c) -> float& { return c.sphere_delta; }),
   };
   return table;
 }

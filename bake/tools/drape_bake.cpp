@@ -74,15 +74,16 @@ int main(int argc, char** argv) {
     if (drape::Status s = drape::bake::LoadBakeConfig(config_path, &config); !s.ok())
       return Fail(s.message());
   }
-  const auto start = std::chrono::steady_clock::now();
-  drape::bake::BakeResult result;
-  if (drape::Status s = drape::bake::BakeCharacter(input, config, &result); !s.ok())
-    return Fail(s.message());
   if (!preview_dir.empty()) {
     std::error_code error;
     std::filesystem::create_directories(preview_dir, error);
     if (error)
       return Fail(preview_dir + ": cannot create the preview directory: " + error.message());
+  }
+  const auto start = std::chrono::steady_clock::now();
+  drape::bake::BakeResult result;
+  if (drape::Status s = drape::bake::BakeCharacter(input, config, &result, preview_dir); !s.ok()) {
+    return Fail(s.message());
   }
 
   std::vector<uint8_t> bytes;

@@ -2,7 +2,7 @@
 # drape-bake / drape-inspect contract: every bad input -> exit != 0, one stderr line that names
 # the input and the reason, no output file. Good input -> a file drape-inspect loads.
 set -u
-BAKE=$1 INSPECT=$2 SOURCE=$3 SHARED=$4
+BAKE=$1 INSPECT=$2 SOURCE=$3 SHARED=$4 QUERY=$5
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 failures=0 passed=0
@@ -96,6 +96,38 @@ if "$BAKE" "$MANNEQUIN" -o "$WORK/mannequin.drape" --report "$WORK/mannequin.jso
   else fail "inspect message for a truncated file: $(cat "$WORK/cut.stderr")"; fi
 else
   fail "baking the mannequin: $(cat "$WORK/good.stderr")"
+fi
+# --- drape-query: the runtime's answers from the command line.
+if [ -e "$WORK/mannequin.drape" ]; then
+  # Inside the chest, far in front of the body, inside the left thigh; one segment through the
+  # left shin from front to back (thinner than the step: must be caught by maps and hulls).
+  printf '0 1.32 0.02\n0 1.0 0.8\n0.095 0.7 0.0\n' >"$WORK/points.txt"
+  printf '0.095 0.3 0.3 0.095 0.3 -0.3\n' >"$WORK/segments.txt"
+  "$QUERY" "$WORK/mannequin.drape" --points "$WORK/points.txt" >"$WORK/points.csv" 2>"$WORK/query.stderr"
+  rows=$(grep -c '^[0-9]' "$WORK/points.csv")
+  if [ "$rows" -eq 9 ]; then passed=$((passed + 1)); else fail "query: expected 9 rows (3 points x 3 methods), got $rows: $(cat "$WORK/query.stderr")"; fi
+  # inside flags: column 3. Chest: maps and hulls say inside; the far point: nobody.
+  check_flag() {  # row method expected
+    local got
+    got=$(awk -F, -v r="$1" -v m="$2" '$1 == r && $2 == m {print $3}' "$3")
+    if [ "$got" = "$4" ]; then passed=$((passed + 1)); else fail "query row $1 $2: inside=$got, expected $4"; fi
+  }
+  check_flag 0 maps "$WORK/points.csv" 1
+  check_flag 0 hulls "$WORK/points.csv" 1
+  check_flag 1 maps "$WORK/points.csv" 0
+  check_flag 1 hulls "$WORK/points.csv" 0
+  check_flag 1 spheres "$WORK/points.csv" 0
+  check_flag 2 maps "$WORK/points.csv" 1
+  "$QUERY" "$WORK/mannequin.drape" --segments "$WORK/segments.txt" --method all >"$WORK/segments.csv"
+  for method in maps hulls; do
+    contact=$(awk -F, -v m=$method '$1 == 0 && $2 == m {print $4}' "$WORK/segments.csv")
+    if [ "$contact" = 1 ]; then passed=$((passed + 1)); else fail "query: $method missed a segment through the shin"; fi
+  done
+  "$QUERY" "$WORK/mannequin.drape" --clip walk --time 0.5 --mesh "$WORK/posed.obj"
+  if [ "$(grep -c '^f ' "$WORK/posed.obj")" -eq 7584 ]; then passed=$((passed + 1)); else fail "query --mesh: wrong face count"; fi
+  if "$QUERY" "$WORK/mannequin.drape" --clip nope --points "$WORK/points.txt" 2>"$WORK/q.err" >/dev/null; then
+    fail "query accepted a missing clip"
+  elif grep -q "no clip named 'nope'" "$WORK/q.err"; then passed=$((passed + 1)); else fail "query message: $(cat "$WORK/q.err")"; fi
 fi
 if "$BAKE" --dump-config | grep -q '"unit_scale"'; then passed=$((passed + 1)); else fail "--dump-config"; fi
 

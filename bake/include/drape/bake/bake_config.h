@@ -6,13 +6,37 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "drape/bake/body_map_baker.h"
+#include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
+#include "drape/bake/kirkpatrick_builder.h"
+#include "drape/bake/map_table_builder.h"
 #include "drape/formats/status.h"
 
 namespace drape::bake {
 
 struct BakeConfig {
   ImportOptions import;
+
+  bool maps_enabled = true;  // paper A: front/back depth and normal maps of the rest pose
+  // Depth as unorm16 by default: its error (depth range / 65535, about 5 um on a person) is far
+  // below a texel, at half the bytes of float32.
+  BodyMapOptions maps = [] {
+    BodyMapOptions o;
+    o.depth_encoding = DepthEncoding::kUnorm16;
+    return o;
+  }();
+  std::string maps_clip;  // empty: the rest pose; else every time of this clip at maps_clip_rate
+  float maps_clip_rate = 0.f;  // Hz, >= 0; 0 = each of the clip's resampled frames
+
+  bool hulls_enabled = true;      // paper B: a convex collider per bone
+  float rigid_threshold = 0.99f;  // a vertex is rigid to its heaviest bone at this weight, (0.5, 1]
+  HullOptions hull;
+  KirkpatrickOptions kirkpatrick;
+  MapTableOptions map_table;
+
+  bool spheres_enabled = true;  // paper B: a sphere per joint over its flexible vertices
+  float sphere_delta = 0.005f;  // metres added to each joint sphere's radius, >= 0
 };
 
 // Reads a JSON config file over the defaults in `config`. `path` names the file in messages.

@@ -16,6 +16,8 @@ struct BakeResult {
   nlohmann::json report;
 };
 
-Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result);
+// preview_dir: where preview pictures go (must exist), or empty for none.
+Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result,
+                     const std::string& preview_dir = "");
 
 }  // namespace drape::bake

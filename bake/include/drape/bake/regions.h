@@ -1,0 +1,37 @@
+#pragma once
+// Paper B §2.1: the body split by skin weight into rigid regions (one bone) and flexible regions
+// (blended, near joints). Positions are taken in the rest pose, whose scale is the animation's.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drape/bake/character.h"
+#include "drape/formats/status.h"
+
+namespace drape::bake {
+
+struct JointRegion {
+  int32_t child = -1;   // the joint sphere moves with this bone
+  int32_t parent = -1;  // the other bone of the pair (-1 if none)
+  Float3 center;        // rest-pose asset frame, metres
+  std::vector<uint32_t> flexible_vertices;
+};
+
+struct Regions {
+  float rigid_threshold = 0.99f;
+  std::vector<Float3> rest_positions;  // the rest-pose skinned mesh
+  std::vector<Mat34> rest_skinning;    // per joint: bind -> rest
+  std::vector<Mat34> collider_frames;  // per joint: rigid rest-pose joint frame -> asset
+  std::vector<std::vector<uint32_t>> rigid_vertices;  // per joint
+  std::vector<JointRegion> joints;                    // one per bone pair with flexible vertices
+};
+
+// rigid_threshold in (0.5, 1]: a vertex is rigid to its heaviest bone when that weight reaches it.
+Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions);
+
+// Joint spheres (paper B §2.3): centred on the joint, radius covering its flexible vertices plus
+// delta (metres). Written into the bind-pose frame the runtime expects.
+std::vector<JointSphereData> BuildJointSpheres(const Regions& regions, float delta);
+
+}  // namespace drape::bake

@@ -1,0 +1,141 @@
+#include "drape/bake/regions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "drape/runtime/math.h"
+#include "drape/runtime/skeleton_pose.h"
+#include "drape/runtime/skinning.h"
+
+namespace drape::bake {
+namespace {
+
+// The rigid part of an affine joint matrix: columns orthonormalised (Gram-Schmidt in double),
+// translation kept. Joint matrices carry the unit scale and sometimes authored scale.
+Mat34 RigidPart(const Mat34& m) {
+  double c[3][3];
+  for (int col = 0; col < 3; ++col)
+    for (int row = 0; row < 3; ++row) c[col][row] = m.m[4 * row + col];
+  auto normalize = [](double* v) {
+    const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; ++k) v[k] = n > 0 ? v[k] / n : (k == 0 ? 1.0 : 0.0);
+  };
+  normalize(c[0]);
+  const double d01 = c[0][0] * c[1][0] + c[0][1] * c[1][1] + c[0][2] * c[1][2];
+  for (int k = 0; k < 3; ++k) c[1][k] -= d01 * c[0][k];
+  normalize(c[1]);
+  c[2][0] = c[0][1] * c[1][2] - c[0][2] * c[1][1];
+  c[2][1] = c[0][2] * c[1][0] - c[0][0] * c[1][2];
+  c[2][2] = c[0][0] * c[1][1] - c[0][1] * c[1][0];
+  Mat34 r;
+  for (int col = 0; col < 3; ++col)
+    for (int row = 0; row < 3; ++row) r.m[4 * row + col] = static_cast<float>(c[col][row]);
+  r.m[3] = m.m[3];
+  r.m[7] = m.m[7];
+  r.m[11] = m.m[11];
+  return r;
+}
+
+bool IsAncestor(const SkeletonData& s, int32_t ancestor, int32_t joint) {
+  for (int32_t j = s.parents[joint]; j >= 0; j = s.parents[j])
+    if (j == ancestor) return true;
+  return false;
+}
+
+}  // namespace
+
+Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions) {
+  if (!(rigid_threshold > 0.5f && rigid_threshold <= 1.f)) {
+    return Status(StatusCode::kInvalidArgument, "hulls.rigid_threshold must be in (0.5, 1]");
+  }
+  *regions = Regions{};
+  regions->rigid_threshold = rigid_threshold;
+  const SkeletonData& skeleton = character.skeleton;
+  const MeshData& mesh = character.mesh;
+  const uint32_t joints = skeleton.joint_count();
+
+  SkeletonPose pose;
+  if (Status s = pose.Init(skeleton); !s.ok()) return s;
+  pose.SetRest();
+  regions->rest_positions.resize(mesh.vertex_count());
+  if (Status s = SkinMesh(mesh, pose.skinning(), regions->rest_positions); !s.ok()) return s;
+  regions->rest_skinning.assign(pose.skinning().begin(), pose.skinning().end());
+  regions->collider_frames.resize(joints);
+  for (uint32_t j = 0; j < joints; ++j) regions->collider_frames[j] = RigidPart(pose.world()[j]);
+
+  regions->rigid_vertices.assign(joints, {});
+  std::map<std::pair<int32_t, int32_t>, size_t> joint_index;  // (child, parent) -> regions->joints
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    // The two heaviest influences, ties broken by the lower joint index (deterministic).
+    int32_t first = -1, second = -1;
+    float w_first = 0.f, w_second = 0.f;
+    for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k) {
+      const int32_t j = mesh.influence_joints[k];
+      const float w = mesh.influence_weights[k];
+      if (w > w_first || (w == w_first && j < first)) {
+        second = first, w_second = w_first;
+        first = j, w_first = w;
+      } else if (w > w_second || (w == w_second && j < second)) {
+        second = j, w_second = w;
+      }
+    }
+    if (first < 0) continue;
+    if (w_first >= rigid_threshold || second < 0) {
+      regions->rigid_vertices[first].push_back(v);
+      continue;
+    }
+    // The joint between the two bones: the descendant carries it.
+    int32_t child = first, parent = second;
+    if (IsAncestor(skeleton, first, second)) child = second, parent = first;
+    auto [it, inserted] =
+        joint_index.emplace(std::make_pair(child, parent), regions->joints.size());
+    if (inserted) {
+      JointRegion region;
+      region.child = child;
+      region.parent = parent;
+      if (IsAncestor(skeleton, parent, child)) {
+        const Mat34& world = pose.world()[child];
+        region.center = {world.m[3], world.m[7], world.m[11]};
+      }
+      regions->joints.push_back(region);
+    }
+    regions->joints[it->second].flexible_vertices.push_back(v);
+  }
+  // Bones that are not ancestor and descendant have no joint origin: centre on the vertices.
+  for (JointRegion& region : regions->joints) {
+    if (IsAncestor(skeleton, region.parent, region.child)) continue;
+    double sum[3] = {0, 0, 0};
+    for (uint32_t v : region.flexible_vertices) {
+      sum[0] += regions->rest_positions[v].x;
+      sum[1] += regions->rest_positions[v].y;
+      sum[2] += regions->rest_positions[v].z;
+    }
+    const double n = static_cast<double>(region.flexible_vertices.size());
+    region.center = {static_cast<float>(sum[0] / n), static_cast<float>(sum[1] / n),
+                     static_cast<float>(sum[2] / n)};
+  }
+  return Status::Ok();
+}
+
+std::vector<JointSphereData> BuildJointSpheres(const Regions& regions, float delta) {
+  std::vector<JointSphereData> spheres;
+  for (const JointRegion& region : regions.joints) {
+    float radius = 0.f;
+    for (uint32_t v : region.flexible_vertices) {
+      radius = std::max(radius, Length(regions.rest_positions[v] - region.center));
+    }
+    Mat34 rest_to_bind;
+    if (!InverseAffine(regions.rest_skinning[region.child], &rest_to_bind)) continue;
+    JointSphereData sphere;
+    sphere.joint = region.child;
+    sphere.parent_joint = region.parent;
+    sphere.center = TransformPoint(rest_to_bind, region.center);
+    // Round outward so every flexible vertex stays inside in float.
+    sphere.radius = std::nextafter(radius + delta, INFINITY);
+    spheres.push_back(sphere);
+  }
+  return spheres;
+}
+
+}  // namespace drape::bake
