@@ -273,7 +273,8 @@ size_t OrientComponentsOutward(MeshData* mesh) {
   size_t flipped = 0;
   for (const auto& [component, v] : volume) flipped += v < 0.0;
   for (size_t t = 0; t < triangles; ++t) {
-    if (volume[find(mesh->triangles[3 * t])] < 0.0) std::swap(mesh->triangles[3 * t + 1], mesh->triangles[3 * t + 2]);
+    if (volume[find(mesh->triangles[3 * t])] < 0.0)
+      std::swap(mesh->triangles[3 * t + 1], mesh->triangles[3 * t + 2]);
   }
   return flipped;
 }

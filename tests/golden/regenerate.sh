@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Rewrites the golden files from the current build. Only for a deliberate change of the bake's
+# output: say why in the commit, and keep the old files while the loader still reads them.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+build/bin/drape-bake samples/mannequin/mannequin.gltf -o tests/golden/mannequin_colliders_v1.drape \
+  --config tests/golden/mannequin_colliders.json
