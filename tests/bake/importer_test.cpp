@@ -9,6 +9,7 @@
 
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -264,6 +265,48 @@ TEST(Importer, WeightsAreRenormalisedAndRigidPartsKept) {
   for (const std::string& w : character.warnings)
     warned |= w.find("weight sums outside") != std::string::npos;
   EXPECT_TRUE(warned) << "RobotExpressive's skinned hands have raw weight sums up to 1.755";
+}
+
+TEST(Importer, CharacterWithoutSkeletonIsOneRigidRoot) {
+  const std::string path = ::testing::TempDir() + "/tetrahedron.obj";
+  {
+    std::ofstream obj(path);
+    obj << "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  }
+  Character character;
+  const Status s = ImportCharacter(path, ImportOptions{}, &character);
+  ASSERT_TRUE(s.ok()) << s.message();
+  ASSERT_EQ(character.skeleton.joint_count(), 1u);
+  EXPECT_EQ(character.skeleton.joint_names[0], "root");
+  EXPECT_TRUE(character.clips.empty());
+  EXPECT_EQ(character.mesh.triangle_count(), 4u);
+  for (uint32_t v = 0; v < character.mesh.vertex_count(); ++v) {
+    ASSERT_EQ(character.mesh.influence_offsets[v + 1] - character.mesh.influence_offsets[v], 1u);
+    EXPECT_EQ(character.mesh.influence_weights[character.mesh.influence_offsets[v]], 1.f);
+  }
+}
+
+TEST(Importer, InwardWoundComponentsAreFlipped) {
+  // The same tetrahedron wound inward: the importer must orient it outward and say so.
+  const std::string path = ::testing::TempDir() + "/inward.obj";
+  {
+    std::ofstream obj(path);
+    obj << "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n";
+  }
+  Character character;
+  ASSERT_TRUE(ImportCharacter(path, ImportOptions{}, &character).ok());
+  double volume = 0;
+  const MeshData& m = character.mesh;
+  for (uint32_t t = 0; t < m.triangle_count(); ++t) {
+    const Float3 a = m.positions[m.triangles[3 * t]], b = m.positions[m.triangles[3 * t + 1]],
+                 c = m.positions[m.triangles[3 * t + 2]];
+    volume += Dot(a, Cross(b, c)) / 6.0;
+  }
+  EXPECT_GT(volume, 0.0);
+  bool reported = false;
+  for (const std::string& w : character.warnings)
+    reported |= w.find("wound inward") != std::string::npos;
+  EXPECT_TRUE(reported);
 }
 
 TEST(Importer, BadInputsFailWithTheFileNamed) {
