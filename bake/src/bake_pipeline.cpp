@@ -1,5 +1,7 @@
 #include "drape/bake/bake_pipeline.h"
 
+#include "collider_preview.h"
+
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -311,6 +313,13 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     }
     report["joint_spheres"] = spheres;
     timings["spheres_ms"] = MillisecondsSince(start);
+  }
+  if (!preview_dir.empty() && (config.hulls_enabled || config.spheres_enabled)) {
+    if (Status s =
+            WriteColliderPreview(asset, regions.rest_positions, regions.rest_skinning, preview_dir);
+        !s.ok()) {
+      return Status(s.code(), input + ": " + s.message());
+    }
   }
   report["warnings"] = character.warnings;
 
