@@ -1,0 +1,182 @@
+#pragma once
+// A mass-spring cloth built from any triangle mesh (paper A §1, paper B §1.1): the editable
+// ClothDescription, the validating BuildCloth, the immutable Cloth topology it fills, and the
+// ClothState (positions, previous positions, velocities) the caller owns and the solver advances.
+//
+// Springs. Every distinct triangle edge is a stretch spring. Every edge shared by exactly two
+// triangles also gives a bend spring between the two vertices opposite it (paper A fig. 1, paper
+// B fig. 1), unless those two vertices are already joined by a stretch spring or another bend
+// spring. Rest lengths are the distances in ClothDescription::positions.
+//
+// Masses. Either explicit per particle, or from area: each triangle gives a third of its area to
+// each of its vertices, times `density` (kg/m^2); a positive `total_mass` then rescales all
+// masses to that sum. Pinned and attached particles have inverse mass 0: springs and forces do
+// not move them (paper B §1.1: "setting one end's inverse mass to 0 constrains it").
+//
+// Attachments (paper B §3.2 geometric constraints): a particle moves rigidly with a joint. It is
+// stored with its position in the bind-pose asset frame; at a pose with skinning matrix S of that
+// joint its target is S * bind_position (see ClothSolver for the interpolation inside a frame).
+//
+// Solver layout. Springs are stored in flat arrays ordered by colour: within one colour no two
+// springs share a particle, so a colour is solved in parallel with per-particle writes only and
+// the result does not depend on the thread count. Each colour holds springs of one kind. The
+// colouring is deterministic (a function of the description only).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "drape/formats/status.h"
+#include "drape/formats/types.h"
+
+namespace drape {
+
+enum class SpringKind : uint8_t {
+  kStretch = 0,  // a triangle edge (paper B: tension-shear spring)
+  kBend = 1,     // across a shared edge, between the two opposite vertices
+};
+
+// How one kind of spring responds. The explicit Euler integrator uses stiffness and damping
+// (forces); the Verlet integrator uses correction (paper B's iterative length correction).
+struct SpringMaterial {
+  float stiffness = 200.f;  // N/m per spring, finite, >= 0: force per metre of length error
+  float damping = 0.05f;    // N*s/m per spring, finite, >= 0: force per m/s of length change
+  float correction = 1.f;   // in [0, 1]: fraction of the length error one iteration removes
+                            // (1 = paper B's full correction)
+};
+
+// A particle that moves rigidly with a joint (paper B §3.2).
+struct ClothAttachment {
+  uint32_t particle = 0;
+  int32_t joint = -1;    // index into the skinning matrices, >= 0
+  Float3 bind_position;  // metres, bind-pose asset frame; target = skinning(joint) * this
+};
+
+// Editable input of BuildCloth.
+struct ClothDescription {
+  std::vector<Float3> positions;    // metres, finite: the rest shape (rest lengths come from it)
+  std::vector<uint32_t> triangles;  // 3 vertex indices per triangle (winding is not used)
+  // kg per particle, each finite and > 0; empty: masses from area (density, total_mass).
+  std::vector<float> masses;
+  float density = 0.15f;         // kg/m^2 areal density, finite, >= 0 (used when masses is empty)
+  float total_mass = 0.f;        // kg, finite, >= 0; > 0 rescales area masses to this total
+  std::vector<uint32_t> pinned;  // particles that only the caller moves (inverse mass 0)
+  std::vector<ClothAttachment> attachments;  // at most one per particle (inverse mass 0)
+  SpringMaterial stretch;
+  SpringMaterial bend{20.f, 0.01f, 0.2f};
+  bool bend_springs = true;  // false: stretch springs only
+};
+
+// What BuildCloth did with input it tolerates.
+struct ClothBuildReport {
+  uint32_t dropped_triangles = 0;    // a repeated vertex index: no springs, no mass
+  uint32_t zero_area_triangles = 0;  // area < 1e-12 m^2: springs kept, no mass
+  uint32_t dropped_springs = 0;      // rest length < 1e-7 m, or both ends have inverse mass 0
+  uint32_t non_manifold_edges = 0;   // edges of more than two triangles: no bend spring
+  uint32_t stretch_colours = 0;
+  uint32_t bend_colours = 0;
+};
+
+// One spring in solver form. weight_a + weight_b = 1 (or both 0): the share of a length
+// correction each end takes, inverse_mass / (inverse_mass_a + inverse_mass_b) (paper B eq. 3).
+struct ClothSpring {
+  uint32_t a = 0, b = 0;
+  float rest_length = 0.f;  // metres, > 0
+  float weight_a = 0.f, weight_b = 0.f;
+};  // 20 bytes
+
+// A range of springs of one kind in which no two springs share a particle.
+struct SpringColour {
+  uint32_t begin = 0, end = 0;  // into Cloth::springs()
+  SpringKind kind = SpringKind::kStretch;
+};
+
+class Cloth;
+
+// Validates `description` and fills `cloth` (allocates). Rejected with kInvalidArgument and a
+// message naming the field and index: no particles or more than 2^30, a non-finite position, a
+// triangle count not a multiple of 3, a vertex index out of range, masses of the wrong count or
+// not finite and > 0, density or total_mass not finite and >= 0, a pinned index or attachment
+// particle out of range, two attachments of one particle, a negative joint, a non-finite
+// attachment position, a material value out of range, or a particle that gets no mass (in no
+// triangle with area, masses empty) and is neither pinned nor attached. Tolerated and counted in
+// the report: see ClothBuildReport. On error `cloth` is left empty.
+Status BuildCloth(const ClothDescription& description, Cloth* cloth);
+
+// The immutable topology of one cloth. Only BuildCloth fills it.
+class Cloth {
+ public:
+  uint32_t particle_count() const { return static_cast<uint32_t>(rest_positions_.size()); }
+  bool empty() const { return rest_positions_.empty(); }
+
+  std::span<const Float3> rest_positions() const { return rest_positions_; }
+  // kg as described (explicit, or from area; pinned and attached particles keep theirs).
+  std::span<const float> masses() const { return masses_; }
+  // 1/kg; 0 for pinned and attached particles.
+  std::span<const float> inverse_masses() const { return inverse_masses_; }
+  std::span<const float> areas() const {
+    return areas_;
+  }  // m^2 per particle (a third of each
+     // adjacent triangle): fluid drag
+  std::span<const uint32_t> triangles() const { return triangles_; }  // kept triangles
+  std::span<const ClothSpring> springs() const { return springs_; }
+  std::span<const SpringColour> colours() const { return colours_; }
+  // Particles with inverse mass 0 (pinned or attached), ascending.
+  std::span<const uint32_t> kinematic_particles() const { return kinematic_; }
+  std::span<const ClothAttachment> attachments() const { return attachments_; }  // by particle
+  const SpringMaterial& material(SpringKind kind) const {
+    return kind == SpringKind::kStretch ? stretch_ : bend_;
+  }
+  uint32_t spring_count(SpringKind kind) const {
+    return kind == SpringKind::kStretch ? stretch_count_ : bend_count_;
+  }
+  // Skinning matrices Step needs for the attachments: max joint + 1 (0 without attachments).
+  uint32_t required_joint_count() const { return required_joints_; }
+  float total_mass() const { return total_mass_; }  // kg over the dynamic particles
+  const ClothBuildReport& build_report() const { return report_; }
+
+  // The largest explicit Euler step (seconds) for which the undamped-plus-damped spring system is
+  // stable, from a Gershgorin bound on the eigenvalues of M^-1 K and M^-1 C: with
+  // w2 = max_i 2 sum_j k_ij / m_i and g = max_i 2 sum_j c_ij / m_i + extra_damping,
+  // h = (sqrt(g^2 + 4 w2) - g) / w2 (semi-implicit Euler is stable for h^2 w2 + 2 h g < 4).
+  // Conservative: the bound is attained only by the worst mode. +inf without springs.
+  // extra_damping: 1/s, the solver's global velocity damping.
+  float MaxStableEulerStep(float extra_damping = 0.f) const;
+
+  size_t memory_bytes() const;
+
+ private:
+  friend Status BuildCloth(const ClothDescription& description, Cloth* cloth);
+  void Clear();
+
+  float euler_stiffness_rate_ = 0.f;  // 1/s^2: max_i 2 sum_j k_ij / m_i over dynamic particles
+  float euler_damping_rate_ = 0.f;    // 1/s: max_i 2 sum_j c_ij / m_i
+  std::vector<Float3> rest_positions_;
+  std::vector<float> masses_, inverse_masses_, areas_;
+  std::vector<uint32_t> triangles_;
+  std::vector<ClothSpring> springs_;
+  std::vector<SpringColour> colours_;
+  std::vector<uint32_t> kinematic_;
+  std::vector<ClothAttachment> attachments_;
+  SpringMaterial stretch_, bend_;
+  uint32_t stretch_count_ = 0, bend_count_ = 0;
+  uint32_t required_joints_ = 0;
+  float total_mass_ = 0.f;
+  ClothBuildReport report_;
+};
+
+// The per-particle state of one cloth, owned by the caller (read it, or move particles between
+// steps: pinned particles stay wherever the caller puts them). All three arrays have the
+// cloth's particle count.
+struct ClothState {
+  std::vector<Float3> positions;           // metres, world (asset) frame
+  std::vector<Float3> previous_positions;  // positions at the start of the last substep
+  std::vector<Float3> velocities;          // m/s
+
+  // Rest positions, zero velocities (allocates).
+  void Reset(const Cloth& cloth);
+  // Sizes match the cloth.
+  bool Matches(const Cloth& cloth) const;
+};
+
+}  // namespace drape

@@ -1,0 +1,975 @@
+// Cloth, ClothSolver and the garment generators: resting contact with both integrators,
+// attachments, relative simulation, long runs against a moving collider, NaN handling,
+// determinism across thread counts, and the builder's validation.
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "drape/formats/body_map_data.h"
+#include "drape/formats/hull_collider_data.h"
+#include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/cloth.h"
+#include "drape/runtime/cloth_solver.h"
+#include "drape/runtime/garments.h"
+#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/math.h"
+
+namespace drape {
+namespace {
+
+// Seconds at the start of frame `step`.
+float Time(int step, float dt) { return static_cast<float>(step) * dt; }
+
+Mat34 Translation(Float3 t) {
+  Mat34 m;
+  m.m[3] = t.x;
+  m.m[7] = t.y;
+  m.m[11] = t.z;
+  return m;
+}
+
+// Rotation about +y by `angle` radians, then translation t.
+Mat34 RotationY(float angle, Float3 t) {
+  Mat34 m = Translation(t);
+  const float c = std::cos(angle), s = std::sin(angle);
+  m.m[0] = c;
+  m.m[2] = s;
+  m.m[8] = -s;
+  m.m[10] = c;
+  return m;
+}
+
+// One joint sphere on joint 0: with skinning = Translation(t) its centre is center + t.
+void BuildSphere(Float3 center, float radius, HullColliderSet* set) {
+  JointSphereData sphere;
+  sphere.joint = 0;
+  sphere.center = center;
+  sphere.radius = radius;
+  ASSERT_TRUE(set->Build({}, std::span<const JointSphereData>(&sphere, 1), 1).ok());
+}
+
+double KineticEnergy(const Cloth& cloth, const ClothState& state) {
+  double energy = 0.0;
+  for (uint32_t i = 0; i < cloth.particle_count(); ++i) {
+    if (cloth.inverse_masses()[i] == 0.f) continue;
+    const Float3 v = state.velocities[i];
+    energy += 0.5 * cloth.masses()[i] * (double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+  }
+  return energy;
+}
+
+// Deepest penetration (metres, <= 0 when every particle is outside) of the dynamic particles.
+float MaxPenetration(const Cloth& cloth, const ClothState& state, Float3 center, float radius) {
+  float deepest = -std::numeric_limits<float>::infinity();
+  for (uint32_t i = 0; i < cloth.particle_count(); ++i) {
+    if (cloth.inverse_masses()[i] == 0.f) continue;
+    deepest = std::max(deepest, radius - Length(state.positions[i] - center));
+  }
+  return deepest;
+}
+
+bool AllFinite(const ClothState& state) {
+  for (size_t i = 0; i < state.positions.size(); ++i)
+    if (!IsFinite(state.positions[i]) || !IsFinite(state.velocities[i])) return false;
+  return true;
+}
+
+// max over stretch springs of L / R - 1, every spring evaluated.
+float MaxStretch(const Cloth& cloth, const ClothState& state) {
+  float worst = -1.f;
+  for (const SpringColour& colour : cloth.colours()) {
+    if (colour.kind != SpringKind::kStretch) continue;
+    for (uint32_t k = colour.begin; k < colour.end; ++k) {
+      const ClothSpring& s = cloth.springs()[k];
+      const Float3 d = state.positions[s.b] - state.positions[s.a];
+      worst = std::max(worst, std::sqrt(Dot(d, d)) / s.rest_length - 1.f);
+    }
+  }
+  return worst;
+}
+
+ClothDescription SheetDescription(uint32_t cells, float size, Float3 center) {
+  SheetShape shape;
+  shape.center = center;
+  shape.width = shape.height = size;
+  shape.columns = shape.rows = cells;
+  GarmentMesh mesh;
+  EXPECT_TRUE(MakeSheet(shape, &mesh).ok());
+  ClothDescription d;
+  d.positions = mesh.positions;
+  d.triangles = mesh.triangles;
+  return d;
+}
+
+// The physics tests run on one OpenMP thread: the small cloths here gain nothing from a second
+// one, and on a loaded 2-core CI machine spinning OpenMP barriers would dominate the run time.
+// ThreadCountDoesNotChangeResults sets the thread count itself.
+class SingleThreadEnvironment : public ::testing::Environment {
+ public:
+  void SetUp() override { omp_set_num_threads(1); }
+};
+[[maybe_unused]] const ::testing::Environment* const kSingleThread =
+    ::testing::AddGlobalTestEnvironment(new SingleThreadEnvironment);
+
+// Skinning matrices of a one-joint skeleton for one frame.
+struct OneJointFrame {
+  Mat34 start, end;
+  ClothFrame Frame(float dt) const {
+    ClothFrame f;
+    f.dt = dt;
+    f.skinning_start = std::span<const Mat34>(&start, 1);
+    f.skinning_end = std::span<const Mat34>(&end, 1);
+    return f;
+  }
+};
+
+// ---- Resting contact -------------------------------------------------------------------------
+
+struct IntegratorCase {
+  const char* name;
+  ClothIntegrator integrator;
+};
+
+class SheetOnSphere : public ::testing::TestWithParam<IntegratorCase> {};
+
+// A 30x30 sheet (1 m, 0.15 kg) dropped from 0.15 m above a 0.3 m sphere drapes over it and comes
+// to rest: after 5 s its kinetic energy is below 1e-4 of the potential energy of the drop
+// (m g 0.15 m = 0.22 J; measured: about 1e-5 of it for Euler, 1e-6 for Verlet), and no particle
+// is inside the sphere by more than 1 mm after any step.
+// Separation is 0 here: with a separation s > 0 every contact lifts a particle by s against the
+// cloth's tension, which then pulls it back: a chatter of amplitude s (0.1 mm by default) whose
+// kinetic energy (about 5e-5 J here) would hide whether the cloth itself has come to rest.
+// Friction is 1 and damping 2/s: paper A's friction only scales the tangential velocity at a
+// contact, it has no static part, so with less the cloth keeps creeping on the slope and the
+// buckling model's wrinkles keep snapping through (kinetic energy spikes near 1e-4 J). Even with
+// friction 1 Verlet creeps: each substep's spring correction moves contact particles
+// tangentially and nothing undoes the displacement (about 2 mm/s here, hence the 3 cm bound on
+// the middle particle's horizontal position).
+TEST_P(SheetOnSphere, ComesToRest) {
+  const Float3 center{0.f, 0.f, 0.f};
+  const float radius = 0.3f;
+  HullColliderSet hulls;
+  BuildSphere(center, radius, &hulls);
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(SheetDescription(30, 1.f, {0.f, 0.45f, 0.f}), &cloth).ok());
+  const float dt = 1.f / 60.f;
+  ClothSolverSettings settings = ClothSolverSettings::PaperB();
+  settings.substeps = 4;
+  if (GetParam().integrator == ClothIntegrator::kExplicitEuler) {
+    settings = ClothSolverSettings::PaperA(RecommendedEulerSubsteps(cloth, dt, 2.f));
+    EXPECT_GT(settings.substeps, 10u);  // 200 N/m springs on 0.16 g particles
+  }
+  settings.damping = 2.f;
+  ClothSolver solver;
+  ASSERT_TRUE(solver.Init(cloth, settings).ok());
+  ClothState state;
+  state.Reset(cloth);
+  ClothColliders colliders;
+  colliders.hulls = &hulls;
+  colliders.response.friction = 1.f;
+  colliders.response.separation = 0.f;
+  const OneJointFrame joint;
+  float deepest = -1.f;
+  ClothStepStats stats;
+  for (int step = 0; step < 300; ++step) {
+    ASSERT_TRUE(solver.Step(&state, colliders, joint.Frame(dt), &stats).ok()) << "step " << step;
+    deepest = std::max(deepest, MaxPenetration(cloth, state, center, radius));
+  }
+  const double drop_energy = cloth.total_mass() * 9.81 * 0.15;
+  EXPECT_LT(KineticEnergy(cloth, state), 1e-4 * drop_energy);
+  EXPECT_LE(deepest, 1e-3f);
+  EXPECT_GT(stats.contacts, 100u);  // the cap over the sphere's top
+  EXPECT_EQ(stats.substeps, settings.substeps);
+  EXPECT_GT(stats.hull_contacts, 100u * settings.substeps);
+  EXPECT_LT(stats.max_stretch, 0.15f);
+  EXPECT_EQ(stats.max_stretch, MaxStretch(cloth, state));  // the same formula, all springs
+  // The middle particle sits on the top of the sphere; the corners hang below its centre.
+  const Float3 middle = state.positions[15 * 31 + 15];
+  EXPECT_NEAR(middle.y, radius, 1e-3f);
+  EXPECT_NEAR(middle.x, 0.f, 3e-2f);
+  EXPECT_NEAR(middle.z, 0.f, 3e-2f);
+  EXPECT_LT(state.positions[0].y, 0.f);
+  EXPECT_LT(state.positions[30 * 31 + 30].y, 0.f);
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, SheetOnSphere,
+                         ::testing::Values(IntegratorCase{"verlet", ClothIntegrator::kVerlet},
+                                           IntegratorCase{"euler",
+                                                          ClothIntegrator::kExplicitEuler}),
+                         [](const auto& param_info) { return std::string(param_info.param.name); });
+
+// ---- Attachments -----------------------------------------------------------------------------
+
+// A cape whose top row is attached to joint 0 while the joint swings about y and travels.
+// Attached particles are exactly at skinning_end * bind_position after every step, even the ones
+// inside a collider (a neck sphere on the same joint encloses the middle of the top row). The
+// rest of the cape trails: no particle is farther from its column's attached particle than its
+// rest distance plus the measured stretch bound, and after the joint stops the cape hangs under
+// its attachment.
+TEST(ClothSolver, CapeFollowsMovingJoint) {
+  CapeShape shape;
+  shape.top_center = {0.f, 1.5f, -0.15f};
+  shape.top_width = 0.4f;
+  shape.bottom_width = 0.6f;
+  shape.length = 0.8f;
+  shape.columns = 16;
+  shape.rows = 24;
+  GarmentMesh mesh;
+  ASSERT_TRUE(MakeCape(shape, &mesh).ok());
+  ClothDescription d;
+  d.positions = mesh.positions;
+  d.triangles = mesh.triangles;
+  for (const uint32_t p : mesh.held) d.attachments.push_back({p, 0, mesh.positions[p]});
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  EXPECT_EQ(cloth.kinematic_particles().size(), 17u);
+  EXPECT_EQ(cloth.required_joint_count(), 1u);
+
+  HullColliderSet hulls;
+  const Float3 neck{0.f, 1.5f, -0.15f};
+  const float neck_radius = 0.06f;
+  BuildSphere(neck, neck_radius, &hulls);
+  uint32_t attached_inside = 0;
+  for (const uint32_t p : mesh.held)
+    attached_inside += Length(mesh.positions[p] - neck) < neck_radius;
+  ASSERT_GE(attached_inside, 3u);
+
+  ClothSolverSettings settings = ClothSolverSettings::PaperB();
+  settings.substeps = 4;
+  settings.damping = 0.5f;
+  ClothSolver solver;
+  ASSERT_TRUE(solver.Init(cloth, settings).ok());
+  ClothState state;
+  state.Reset(cloth);
+  ClothColliders colliders;
+  colliders.hulls = &hulls;
+
+  const float dt = 1.f / 60.f;
+  const auto pose = [](float t) {
+    const float moving = std::min(t, 2.f);  // the joint stops at t = 2 s
+    const float angle = 0.6f * std::sin(2.f * std::numbers::pi_v<float> * 0.5f * moving);
+    return RotationY(angle,
+                     {0.3f * std::sin(2.f * std::numbers::pi_v<float> * 0.7f * moving),
+                      0.1f * std::sin(2.f * std::numbers::pi_v<float> * moving), 0.5f * moving});
+  };
+  const uint32_t stride = shape.columns + 1;
+  // Distance to the column's attached particle / rest distance, after allowing for the neck
+  // sphere, which can push a particle up to its radius off the straight line.
+  float worst_ratio = 0.f;
+  for (int step = 0; step < 300; ++step) {
+    OneJointFrame joint{pose(Time(step, dt)), pose(Time(step + 1, dt))};
+    ASSERT_TRUE(solver.Step(&state, colliders, joint.Frame(dt)).ok()) << "step " << step;
+    for (const ClothAttachment& a : cloth.attachments()) {
+      const Float3 target = TransformPoint(joint.end, a.bind_position);
+      ASSERT_EQ(std::memcmp(&state.positions[a.particle], &target, sizeof(Float3)), 0)
+          << "attached particle " << a.particle << " step " << step;
+    }
+    for (uint32_t j = 1; j <= shape.rows; ++j) {
+      for (uint32_t i = 0; i < stride; ++i) {
+        const uint32_t p = j * stride + i;
+        const float rest = Length(mesh.positions[p] - mesh.positions[i]);
+        const float distance = Length(state.positions[p] - state.positions[i]);
+        worst_ratio = std::max(worst_ratio, (distance - neck_radius) / rest);
+      }
+    }
+  }
+  // Verlet with 3 iterations and 4 substeps stretches the 24-spring columns under the joint's
+  // accelerations (up to about 5 m/s^2 here) by about 3 %; 10 % is the bound.
+  EXPECT_LT(worst_ratio, 1.1f);
+  // Three seconds after the joint stopped, the bottom-middle particle hangs below the top-middle
+  // one (the frame is rotated by the final angle; the cape hangs along -y).
+  const Float3 top = state.positions[shape.columns / 2];
+  const Float3 bottom = state.positions[shape.rows * stride + shape.columns / 2];
+  EXPECT_NEAR(bottom.x, top.x, 0.03f);
+  EXPECT_NEAR(bottom.z, top.z, 0.03f);
+  EXPECT_LT(bottom.y, top.y - 0.75f);
+}
+
+// Relative simulation: a cape attached to the root joint, which runs at 3 m/s along +z against
+// still air (drag 1 kg/(m^2 s)). Without relative simulation the air blows the cape back (the
+// drag force 3 N/m^2 is twice its weight 1.5 N/m^2: a trailing angle near 60 degrees); with it
+// the root's translation is invisible to the cloth, which hangs straight down.
+TEST(ClothSolver, RelativeSimulationRemovesRootTranslation) {
+  CapeShape shape;
+  shape.top_center = {0.f, 1.5f, -0.15f};
+  shape.columns = 8;
+  shape.rows = 12;
+  shape.length = 0.6f;
+  GarmentMesh mesh;
+  ASSERT_TRUE(MakeCape(shape, &mesh).ok());
+  ClothDescription d;
+  d.positions = mesh.positions;
+  d.triangles = mesh.triangles;
+  for (const uint32_t p : mesh.held) d.attachments.push_back({p, 0, mesh.positions[p]});
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  const float dt = 1.f / 60.f;
+  float offsets[2] = {0.f, 0.f};
+  for (int relative = 0; relative < 2; ++relative) {
+    ClothSolverSettings settings = ClothSolverSettings::PaperB();
+    settings.substeps = 2;
+    settings.drag = 1.f;
+    settings.root_joint = relative ? 0 : -1;
+    settings.root_bind_position = {0.f, 1.f, 0.f};
+    ClothSolver solver;
+    ASSERT_TRUE(solver.Init(cloth, settings).ok());
+    ClothState state;
+    state.Reset(cloth);
+    for (int step = 0; step < 120; ++step) {
+      OneJointFrame joint{Translation({0.f, 0.f, 3.f * Time(step, dt)}),
+                          Translation({0.f, 0.f, 3.f * Time(step + 1, dt)})};
+      ASSERT_TRUE(solver.Step(&state, ClothColliders{}, joint.Frame(dt)).ok());
+    }
+    const Float3 top = state.positions[shape.columns / 2];
+    const Float3 bottom = state.positions[shape.rows * (shape.columns + 1) + shape.columns / 2];
+    offsets[relative] = bottom.z - top.z;
+    EXPECT_NEAR(top.z, 6.f - 0.15f, 1e-4f);
+  }
+  EXPECT_LT(offsets[0], -0.3f) << "the cape should trail without relative simulation";
+  EXPECT_NEAR(offsets[1], 0.f, 0.005f) << "the cape should hang straight with it";
+}
+
+// ---- Long runs -------------------------------------------------------------------------------
+
+class MovingSphereLongRun : public ::testing::TestWithParam<float> {};
+
+// A hanging sheet pinned along its top edge and a 0.2 m sphere sweeping back and forth through
+// its plane (peak speed 1.13 m/s) for 10 s at the given frame length, paper B's settings (one
+// substep, three iterations): every step succeeds, stays finite, leaves no particle more than
+// 1 mm inside the sphere at the end of the step, keeps every particle within 2 m, and keeps the
+// kinetic energy below that of the whole cloth moving at twice the sphere's peak speed (the
+// measured peak is about half that bound at 1/30 s, a quarter at 1/60 s).
+TEST_P(MovingSphereLongRun, StaysBounded) {
+  const float dt = GetParam();
+  SheetShape shape;
+  shape.center = {0.f, 1.f, 0.f};
+  shape.axis_v = {0.f, 1.f, 0.f};
+  shape.columns = shape.rows = 24;
+  GarmentMesh mesh;
+  ASSERT_TRUE(MakeSheet(shape, &mesh).ok());
+  ClothDescription d;
+  d.positions = mesh.positions;
+  d.triangles = mesh.triangles;
+  d.pinned = mesh.held;
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  const Float3 center{0.f, 0.9f, 0.f};
+  const float radius = 0.2f;
+  HullColliderSet hulls;
+  BuildSphere(center, radius, &hulls);
+  ClothSolver solver;
+  ASSERT_TRUE(solver.Init(cloth, ClothSolverSettings::PaperB()).ok());
+  ClothState state;
+  state.Reset(cloth);
+  ClothColliders colliders;
+  colliders.hulls = &hulls;
+  const float omega = 2.f * std::numbers::pi_v<float> * 0.4f;
+  const float amplitude = 0.45f;
+  const auto offset = [&](float t) { return Float3{0.f, 0.f, amplitude * std::sin(omega * t)}; };
+  const double energy_bound = 0.5 * cloth.total_mass() * std::pow(2.0 * amplitude * omega, 2.0);
+  double max_energy = 0.0;
+  float deepest = -1.f;
+  uint32_t contact_steps = 0;
+  const int steps = static_cast<int>(std::lround(10.f / dt));
+  for (int step = 0; step < steps; ++step) {
+    OneJointFrame joint{Translation(offset(Time(step, dt))),
+                        Translation(offset(Time(step + 1, dt)))};
+    ClothStepStats stats;
+    ASSERT_TRUE(solver.Step(&state, colliders, joint.Frame(dt), &stats).ok()) << "step " << step;
+    ASSERT_TRUE(AllFinite(state)) << "step " << step;
+    const Float3 c = center + offset(Time(step + 1, dt));
+    deepest = std::max(deepest, MaxPenetration(cloth, state, c, radius));
+    max_energy = std::max(max_energy, KineticEnergy(cloth, state));
+    contact_steps += stats.contacts > 0;
+    for (const Float3& p : state.positions) ASSERT_LT(Length(p - shape.center), 2.f);
+  }
+  EXPECT_LE(deepest, 1e-3f);
+  EXPECT_LT(max_energy, energy_bound);
+  EXPECT_GT(contact_steps, static_cast<uint32_t>(steps / 4));  // the sphere does push the sheet
+}
+
+INSTANTIATE_TEST_SUITE_P(FrameLengths, MovingSphereLongRun,
+                         ::testing::Values(1.f / 60.f, 1.f / 30.f), [](const auto& param_info) {
+                           return param_info.param < 0.02f ? std::string("dt_1_60")
+                                                           : std::string("dt_1_30");
+                         });
+
+// ---- Body maps -------------------------------------------------------------------------------
+
+// A 0.6 x 0.6 x 0.1 m slab as paper A's front and back maps (64 x 64 texels over [-0.5, 0.5]^2),
+// with a joint sphere beside it: a sheet falling along -z (the maps' view axis) lands on the slab
+// and on the sphere. Both colliders report contacts and no particle ends a step more than 1 mm
+// inside either. (The depth is measured in the box of the covered texels: a particle that slid
+// off the slab's edge can be left on a texel side wall, which IsInside counts as inside.)
+TEST(ClothSolver, BodyMapAndHullsTogether) {
+  BodyMapPose pose;
+  pose.width = pose.height = 64;
+  pose.origin_x = pose.origin_y = -0.5f;
+  pose.texel_size = 1.f / 64.f;
+  pose.front_z = 0.5f;
+  pose.depth_range = 1.f;
+  const size_t texels = 64 * 64;
+  for (int view = 0; view < 2; ++view) {
+    pose.depth_f32[view].assign(texels, 2.f);  // background
+    pose.normal_f32[view].assign(texels * 3, 0.f);
+  }
+  for (uint32_t j = 0; j < 64; ++j) {
+    for (uint32_t i = 0; i < 64; ++i) {
+      const float x = pose.origin_x + (static_cast<float>(i) + 0.5f) * pose.texel_size;
+      const float y = pose.origin_y + (static_cast<float>(j) + 0.5f) * pose.texel_size;
+      if (std::fabs(x) > 0.3f || std::fabs(y) > 0.3f) continue;
+      const size_t t = j * 64 + i;
+      pose.depth_f32[0][t] = pose.front_z - 0.05f;                        // top at z = 0.05
+      pose.depth_f32[1][t] = -0.05f - (pose.front_z - pose.depth_range);  // bottom at z = -0.05
+      pose.normal_f32[0][3 * t + 2] = 1.f;
+      pose.normal_f32[1][3 * t + 2] = -1.f;
+    }
+  }
+  BodyMapCollider body_map;
+  ASSERT_TRUE(body_map.Build(pose).ok());
+  const float kSlabHalf = 0.5f - 13.f / 64.f;  // texel edges of the covered texels
+  HullColliderSet hulls;
+  const Float3 sphere_center{0.45f, 0.45f, -0.05f};
+  BuildSphere(sphere_center, 0.1f, &hulls);
+
+  SheetShape shape;
+  shape.center = {0.f, 0.f, 0.2f};
+  shape.axis_v = {0.f, 1.f, 0.f};
+  shape.width = shape.height = 1.2f;
+  shape.columns = shape.rows = 24;
+  GarmentMesh mesh;
+  ASSERT_TRUE(MakeSheet(shape, &mesh).ok());
+  ClothDescription d;
+  d.positions = mesh.positions;
+  d.triangles = mesh.triangles;
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  ClothSolverSettings settings = ClothSolverSettings::PaperB();
+  settings.substeps = 2;
+  settings.gravity = {0.f, 0.f, -9.81f};
+  ClothSolver solver;
+  ASSERT_TRUE(solver.Init(cloth, settings).ok());
+  ClothState state;
+  state.Reset(cloth);
+  ClothColliders colliders;
+  colliders.hulls = &hulls;
+  colliders.body_map = &body_map;
+  const OneJointFrame joint;
+  uint32_t hull_contacts = 0, map_contacts = 0;
+  for (int step = 0; step < 90; ++step) {
+    ClothStepStats stats;
+    ASSERT_TRUE(solver.Step(&state, colliders, joint.Frame(1.f / 60.f), &stats).ok());
+    hull_contacts += stats.hull_contacts;
+    map_contacts += stats.body_map_contacts;
+    for (uint32_t i = 0; i < cloth.particle_count(); ++i) {
+      // Depth inside the box the maps hold: texels 13..50 in x and y, z in [-0.05, 0.05].
+      const Float3 p = state.positions[i];
+      const float depth = std::min({p.x + kSlabHalf, kSlabHalf - p.x, p.y + kSlabHalf,
+                                    kSlabHalf - p.y, p.z + 0.05f, 0.05f - p.z});
+      ASSERT_LE(depth, 1e-3f) << "particle " << i << " step " << step;
+      ASSERT_GE(Length(state.positions[i] - sphere_center), 0.1f - 1e-3f);
+    }
+  }
+  EXPECT_GT(hull_contacts, 0u);
+  EXPECT_GT(map_contacts, 0u);
+  // The merged flags of the last substep mark particles on the slab.
+  const uint32_t middle = 12 * 25 + 12;
+  EXPECT_NE(solver.contact_flags()[middle] & kCollisionContact, 0);
+  EXPECT_NEAR(state.positions[middle].z, 0.05f, 2e-3f);
+}
+
+// ---- Invalid states --------------------------------------------------------------------------
+
+// A NaN in the input state is reported (kInvalidState, naming the particle) and nothing moves.
+TEST(ClothSolver, NanInputIsReportedAndNotPropagated) {
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(SheetDescription(20, 1.f, {0.f, 0.f, 0.f}), &cloth).ok());
+  ClothSolver solver;
+  ASSERT_TRUE(solver.Init(cloth, ClothSolverSettings::PaperB()).ok());
+  ClothState state;
+  state.Reset(cloth);
+  const OneJointFrame joint;
+  for (int step = 0; step < 5; ++step)
+    ASSERT_TRUE(solver.Step(&state, ClothColliders{}, joint.Frame(1.f / 60.f)).ok());
+
+  for (int which = 0; which < 2; ++which) {
+    ClothState bad = state;
+    const uint32_t particle = which == 0 ? 123 : 45;
+    if (which == 0) {
+      bad.positions[particle].y = std::numeric_limits<float>::quiet_NaN();
+    } else {
+      bad.velocities[particle].z = std::numeric_limits<float>::infinity();
+    }
+    const ClothState before = bad;
+    const Status status = solver.Step(&bad, ClothColliders{}, joint.Frame(1.f / 60.f));
+    EXPECT_EQ(status.code(), StatusCode::kInvalidState);
+    EXPECT_NE(status.message().find("particle " + std::to_string(particle)), std::string::npos)
+        << status.message();
+    const size_t bytes = before.positions.size() * sizeof(Float3);
+    EXPECT_EQ(std::memcmp(bad.positions.data(), before.positions.data(), bytes), 0);
+    EXPECT_EQ(std::memcmp(bad.velocities.data(), before.velocities.data(), bytes), 0);
+    EXPECT_EQ(std::memcmp(bad.previous_positions.data(), before.previous_positions.data(), bytes),
+              0);
+  }
+}
+
+// Explicit Euler far beyond its stability bound (1e4 N/m springs, one substep at 60 Hz against
+// a bound near 0.1 ms) blows up. The blow-up is reported as kInvalidState naming a particle, and
+// the state is the one before the failing step (the last valid substep), finite.
+TEST(ClothSolver, BlowUpIsReportedAndStateKept) {
+  ClothDescription d = SheetDescription(10, 1.f, {0.f, 0.f, 0.f});
+  d.stretch.stiffness = 1e4f;
+  d.pinned = {0};
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  EXPECT_LT(cloth.MaxStableEulerStep(), 1e-3f);
+  ClothSolver solver;
+  ASSERT_TRUE(solver.Init(cloth, ClothSolverSettings::PaperA(1)).ok());
+  ClothState state;
+  state.Reset(cloth);
+  state.velocities[60] = {0.f, 1.f, 0.f};  // a kick to start the unstable modes
+  const OneJointFrame joint;
+  Status status;
+  int step = 0;
+  ClothState before;
+  for (; step < 200; ++step) {
+    before = state;
+    status = solver.Step(&state, ClothColliders{}, joint.Frame(1.f / 60.f));
+    if (!status.ok()) break;
+  }
+  ASSERT_LT(step, 200) << "explicit Euler was expected to blow up";
+  EXPECT_EQ(status.code(), StatusCode::kInvalidState);
+  EXPECT_NE(status.message().find("particle "), std::string::npos) << status.message();
+  EXPECT_TRUE(AllFinite(state));
+  const size_t bytes = state.positions.size() * sizeof(Float3);
+  EXPECT_EQ(std::memcmp(state.positions.data(), before.positions.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(state.velocities.data(), before.velocities.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(state.previous_positions.data(), state.positions.data(), bytes), 0);
+}
+
+TEST(ClothSolver, RejectsBadFramesAndSettings) {
+  ClothDescription d = SheetDescription(4, 1.f, {0.f, 0.f, 0.f});
+  d.attachments.push_back({0, 2, d.positions[0]});  // joint 2: needs three matrices
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  EXPECT_EQ(cloth.required_joint_count(), 3u);
+  ClothSolver solver;
+  ClothState state;
+  state.Reset(cloth);
+  const OneJointFrame joint;
+  EXPECT_EQ(solver.Step(&state, ClothColliders{}, joint.Frame(0.01f)).code(),
+            StatusCode::kInvalidArgument);  // not initialised
+  ClothSolverSettings bad = ClothSolverSettings::PaperB();
+  bad.substeps = 0;
+  EXPECT_EQ(solver.Init(cloth, bad).code(), StatusCode::kInvalidArgument);
+  bad = ClothSolverSettings::PaperB();
+  bad.damping = -1.f;
+  EXPECT_EQ(solver.Init(cloth, bad).code(), StatusCode::kInvalidArgument);
+  ASSERT_TRUE(solver.Init(cloth, ClothSolverSettings::PaperB()).ok());
+  EXPECT_EQ(solver.Step(&state, ClothColliders{}, joint.Frame(0.01f)).code(),
+            StatusCode::kInvalidArgument);  // one matrix for joint 2
+  const Mat34 three[3];
+  ClothFrame frame;
+  frame.skinning_start = three;
+  frame.skinning_end = three;
+  frame.dt = 0.f;
+  EXPECT_EQ(solver.Step(&state, ClothColliders{}, frame).code(), StatusCode::kInvalidArgument);
+  frame.dt = 0.01f;
+  ClothColliders colliders;
+  colliders.response.friction = 2.f;
+  EXPECT_EQ(solver.Step(&state, colliders, frame).code(), StatusCode::kInvalidArgument);
+  ClothState wrong_size = state;
+  wrong_size.velocities.pop_back();
+  EXPECT_EQ(solver.Step(&wrong_size, ClothColliders{}, frame).code(), StatusCode::kInvalidArgument);
+  EXPECT_TRUE(solver.Step(&state, ClothColliders{}, frame).ok());
+}
+
+// ---- Determinism -----------------------------------------------------------------------------
+
+// Runs `frames` frames of a 72 x 72 sheet (5184 particles, above every parallel threshold of the
+// solver) falling onto a sphere that rises, with wind and drag, on `threads` OpenMP threads.
+ClothState RunSheetScene(const Cloth& cloth, const ClothSolverSettings& settings, int threads,
+                         int frames, uint32_t* contacts = nullptr) {
+  omp_set_num_threads(threads);
+  HullColliderSet hulls;
+  BuildSphere({0.f, 0.f, 0.f}, 0.3f, &hulls);
+  ClothSolver solver;
+  EXPECT_TRUE(solver.Init(cloth, settings).ok());
+  ClothState state;
+  state.Reset(cloth);
+  ClothColliders colliders;
+  colliders.hulls = &hulls;
+  for (int step = 0; step < frames; ++step) {
+    OneJointFrame joint{Translation({0.f, Time(step, 0.002f), 0.f}),
+                        Translation({0.f, Time(step + 1, 0.002f), 0.f})};
+    ClothStepStats stats;
+    const Status s = solver.Step(&state, colliders, joint.Frame(1.f / 60.f), &stats);
+    EXPECT_TRUE(s.ok()) << s.message();
+    if (contacts != nullptr) *contacts += stats.hull_contacts;
+  }
+  omp_set_num_threads(1);
+  return state;
+}
+
+void ExpectBitwiseEqual(const ClothState& a, const ClothState& b) {
+  ASSERT_EQ(a.positions.size(), b.positions.size());
+  const size_t bytes = a.positions.size() * sizeof(Float3);
+  EXPECT_EQ(std::memcmp(a.positions.data(), b.positions.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(a.velocities.data(), b.velocities.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(a.previous_positions.data(), b.previous_positions.data(), bytes), 0);
+}
+
+// The same scene on one and on two OpenMP threads gives bitwise identical states, for both
+// integrators (explicit Euler on a heavier sheet so that few substeps are stable).
+TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
+  ClothDescription d = SheetDescription(71, 1.2f, {0.f, 0.33f, 0.f});
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  ASSERT_GT(cloth.particle_count(), 4096u);
+  ClothSolverSettings verlet = ClothSolverSettings::PaperB();
+  verlet.substeps = 2;
+  verlet.drag = 0.5f;
+  verlet.wind = {1.f, 0.f, 0.f};
+  uint32_t contacts = 0;
+  const ClothState one = RunSheetScene(cloth, verlet, 1, 8, &contacts);
+  EXPECT_GT(contacts, 100u);  // the sheet reached the sphere
+  ExpectBitwiseEqual(one, RunSheetScene(cloth, verlet, 2, 8));
+
+  // The same sheet with its particles numbered in a shuffled order (a fixed permutation): most
+  // springs are then "far" (between distant index chunks) and take the coloured path.
+  ClothDescription shuffled = d;
+  std::vector<uint32_t> order(d.positions.size());
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  uint64_t random = 12345;
+  for (size_t i = order.size() - 1; i > 0; --i) {
+    random = random * 6364136223846793005ull + 1442695040888963407ull;
+    std::swap(order[i], order[(random >> 33) % (i + 1)]);
+  }
+  for (uint32_t i = 0; i < order.size(); ++i) shuffled.positions[order[i]] = d.positions[i];
+  for (uint32_t& t : shuffled.triangles) t = order[t];
+  Cloth shuffled_cloth;
+  ASSERT_TRUE(BuildCloth(shuffled, &shuffled_cloth).ok());
+  contacts = 0;
+  const ClothState shuffled_one = RunSheetScene(shuffled_cloth, verlet, 1, 8, &contacts);
+  EXPECT_GT(contacts, 100u);
+  ExpectBitwiseEqual(shuffled_one, RunSheetScene(shuffled_cloth, verlet, 2, 8));
+
+  d = SheetDescription(71, 1.2f, {0.f, 0.305f, 0.f});
+  d.density = 3.f;
+  d.stretch.stiffness = 50.f;
+  Cloth heavy;
+  ASSERT_TRUE(BuildCloth(d, &heavy).ok());
+  ClothSolverSettings euler =
+      ClothSolverSettings::PaperA(RecommendedEulerSubsteps(heavy, 1.f / 60.f, 0.1f));
+  EXPECT_LE(euler.substeps, 32u);
+  euler.drag = 0.5f;
+  euler.wind = {1.f, 0.f, 0.f};
+  contacts = 0;
+  const ClothState euler_one = RunSheetScene(heavy, euler, 1, 3, &contacts);
+  EXPECT_GT(contacts, 100u);
+  ExpectBitwiseEqual(euler_one, RunSheetScene(heavy, euler, 2, 3));
+}
+
+// The SSE spring kernel and the scalar reference kernel give the same bits (same operations in
+// the same order), with and without the buckling model (maxps / minps against the branches).
+TEST(ClothSolver, SimdAndScalarKernelsAgree) {
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(SheetDescription(71, 1.2f, {0.f, 0.45f, 0.f}), &cloth).ok());
+  for (const bool buckling : {false, true}) {
+    ClothSolverSettings settings = ClothSolverSettings::PaperB();
+    settings.buckling = buckling;
+    settings.simd = true;
+    const ClothState simd = RunSheetScene(cloth, settings, 1, 20);
+    settings.simd = false;
+    ExpectBitwiseEqual(simd, RunSheetScene(cloth, settings, 1, 20));
+  }
+}
+
+// ---- Builder ---------------------------------------------------------------------------------
+
+// Two triangles sharing an edge: 5 stretch springs, 1 bend spring between the opposite corners,
+// masses a third of each triangle's area times density.
+TEST(BuildCloth, QuadTopologyAndMasses) {
+  ClothDescription d;
+  d.positions = {{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {1.f, 1.f, 0.f}, {0.f, 1.f, 0.f}};
+  d.triangles = {0, 1, 2, 0, 2, 3};
+  d.density = 0.3f;
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  EXPECT_EQ(cloth.spring_count(SpringKind::kStretch), 5u);
+  EXPECT_EQ(cloth.spring_count(SpringKind::kBend), 1u);
+  EXPECT_NEAR(cloth.masses()[0], 0.3f * (0.5f / 3.f + 0.5f / 3.f), 1e-7f);
+  EXPECT_NEAR(cloth.masses()[1], 0.3f * 0.5f / 3.f, 1e-7f);
+  EXPECT_NEAR(cloth.total_mass(), 0.3f, 1e-6f);
+  for (const ClothSpring& s : cloth.springs()) {
+    if (s.a == 1 && s.b == 3) {
+      EXPECT_NEAR(s.rest_length, std::sqrt(2.f), 1e-6f);
+    }
+    EXPECT_NEAR(s.weight_a + s.weight_b, 1.f, 1e-6f);
+  }
+  // total_mass rescales; pinning zeroes the inverse mass and the weights follow.
+  d.total_mass = 2.f;
+  d.pinned = {1};
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  EXPECT_NEAR(cloth.masses()[0] + cloth.masses()[1] + cloth.masses()[2] + cloth.masses()[3], 2.f,
+              1e-5f);
+  EXPECT_EQ(cloth.inverse_masses()[1], 0.f);
+  for (const ClothSpring& s : cloth.springs()) {
+    if (s.a == 1) {
+      EXPECT_EQ(s.weight_a, 0.f);
+    }
+    if (s.b == 1) {
+      EXPECT_EQ(s.weight_b, 0.f);
+    }
+  }
+  ASSERT_EQ(cloth.kinematic_particles().size(), 1u);
+  EXPECT_EQ(cloth.kinematic_particles()[0], 1u);
+}
+
+TEST(BuildCloth, RejectsBadInput) {
+  const ClothDescription good = SheetDescription(3, 1.f, {0.f, 0.f, 0.f});
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(good, &cloth).ok());
+  const auto expect_rejected = [&](const ClothDescription& d, const char* needle) {
+    Cloth c;
+    const Status s = BuildCloth(d, &c);
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument) << needle;
+    EXPECT_NE(s.message().find(needle), std::string::npos) << s.message();
+    EXPECT_TRUE(c.empty());
+  };
+  ClothDescription d = good;
+  d.triangles[7] = 16;  // 16 particles: index out of range
+  expect_rejected(d, "triangles[2] corner 1 = 16");
+  d = good;
+  d.triangles.pop_back();
+  expect_rejected(d, "not a multiple of 3");
+  d = good;
+  d.positions[5].x = std::numeric_limits<float>::quiet_NaN();
+  expect_rejected(d, "positions[5]");
+  d = good;
+  d.masses.assign(d.positions.size(), 0.01f);
+  d.masses[3] = -1.f;
+  expect_rejected(d, "masses[3]");
+  d = good;
+  d.masses.assign(3, 0.01f);
+  expect_rejected(d, "masses has 3 entries");
+  d = good;
+  d.density = -1.f;
+  expect_rejected(d, "density");
+  d = good;
+  d.pinned = {99};
+  expect_rejected(d, "pinned[0] = 99");
+  d = good;
+  d.attachments = {{2, 0, {}}, {2, 1, {}}};
+  expect_rejected(d, "more than one attachment");
+  d = good;
+  d.attachments = {{2, -1, {}}};
+  expect_rejected(d, "joint = -1");
+  d = good;
+  d.stretch.correction = 1.5f;
+  expect_rejected(d, "correction");
+  d = good;
+  d.positions.push_back({5.f, 5.f, 5.f});  // in no triangle: no mass
+  expect_rejected(d, "particle 16 gets no mass");
+  d.pinned = {16};  // pinned, it needs none
+  EXPECT_TRUE(BuildCloth(d, &cloth).ok());
+  d = ClothDescription{};
+  expect_rejected(d, "no particles");
+}
+
+// Degenerate triangles do not stop the build: repeated indices are dropped, zero-area ones keep
+// their (non-zero) edges but carry no mass, zero-length edges give no spring.
+TEST(BuildCloth, DegenerateTrianglesAreHandled) {
+  ClothDescription d;
+  d.positions = {{0.f, 0.f, 0.f},
+                 {1.f, 0.f, 0.f},
+                 {0.f, 1.f, 0.f},
+                 {2.f, 0.f, 0.f},   // collinear with 0 and 1
+                 {0.f, 0.f, 0.f}};  // coincides with 0
+  d.triangles = {0, 1, 2,           // good
+                 1, 1, 2,           // repeated index: dropped
+                 0, 1, 3,           // zero area (collinear)
+                 0, 4, 1,           // zero area, zero-length edge 0-4
+                 4, 1, 2};          // 4 gets its mass here
+  d.pinned = {3};                   // 3 has no area: it must be pinned to be accepted
+  Cloth cloth;
+  const Status s = BuildCloth(d, &cloth);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const ClothBuildReport& r = cloth.build_report();
+  EXPECT_EQ(r.dropped_triangles, 1u);
+  EXPECT_EQ(r.zero_area_triangles, 2u);
+  EXPECT_GE(r.dropped_springs, 1u);  // 0-4
+  EXPECT_EQ(cloth.triangles().size(), 12u);
+  for (const ClothSpring& spring : cloth.springs()) {
+    EXPECT_GE(spring.rest_length, 1e-7f);
+    EXPECT_FALSE(spring.a == 0 && spring.b == 4);
+  }
+  EXPECT_EQ(cloth.masses()[3], 0.f);
+  EXPECT_NEAR(cloth.masses()[4], 0.15f * 0.5f / 3.f, 1e-7f);  // from 4-1-2 only
+}
+
+// Every colour is a set of springs with pairwise distinct particles, one kind each, and together
+// the colours cover every spring once: on a skirt (valence 6) and on a fan of 300 triangles
+// around one centre (valence 300: at least 300 stretch colours).
+void ExpectIndependentColours(const Cloth& cloth) {
+  std::vector<int> seen(cloth.particle_count(), -1);
+  uint32_t covered = 0;
+  for (size_t c = 0; c < cloth.colours().size(); ++c) {
+    const SpringColour& colour = cloth.colours()[c];
+    EXPECT_EQ(colour.begin, covered);
+    covered = colour.end;
+    for (uint32_t k = colour.begin; k < colour.end; ++k) {
+      const ClothSpring& s = cloth.springs()[k];
+      ASSERT_NE(seen[s.a], static_cast<int>(c));
+      ASSERT_NE(seen[s.b], static_cast<int>(c));
+      seen[s.a] = seen[s.b] = static_cast<int>(c);
+    }
+  }
+  EXPECT_EQ(covered, cloth.springs().size());
+  EXPECT_EQ(cloth.colours().size(),
+            cloth.build_report().stretch_colours + cloth.build_report().bend_colours);
+}
+
+TEST(BuildCloth, ColoursAreIndependentSets) {
+  SkirtShape shape;
+  GarmentMesh mesh;
+  ASSERT_TRUE(MakeSkirt(shape, &mesh).ok());
+  ClothDescription d;
+  d.positions = mesh.positions;
+  d.triangles = mesh.triangles;
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  ExpectIndependentColours(cloth);
+  EXPECT_LE(cloth.build_report().stretch_colours, 11u);  // first fit: <= 2 * valence - 1
+
+  ClothDescription fan;
+  const uint32_t rim = 300;
+  fan.positions.push_back({0.f, 0.f, 0.f});
+  for (uint32_t i = 0; i < rim; ++i) {
+    const float angle = 2.f * std::numbers::pi_v<float> * static_cast<float>(i) / rim;
+    fan.positions.push_back({std::cos(angle), 0.f, std::sin(angle)});
+    fan.triangles.insert(fan.triangles.end(), {0, 1 + i, 1 + (i + 1) % rim});
+  }
+  ASSERT_TRUE(BuildCloth(fan, &cloth).ok());
+  ExpectIndependentColours(cloth);
+  EXPECT_GE(cloth.build_report().stretch_colours, rim);
+  EXPECT_EQ(cloth.spring_count(SpringKind::kStretch), 2 * rim);
+  EXPECT_EQ(cloth.spring_count(SpringKind::kBend), rim);
+}
+
+// ---- Garments --------------------------------------------------------------------------------
+
+// Each generator gives a mesh that builds into a cloth with the expected counts: a grid of
+// C x R cells has C(R+1) + R(C+1) edges plus C R diagonals; a closed ring of S segments and R
+// cells has S(R+1) + 2 S R; every interior edge gives at most one bend spring.
+TEST(Garments, GeneratorsBuildValidCloths) {
+  struct Expect {
+    const char* name;
+    GarmentMesh mesh;
+    uint32_t particles, stretch, held, boundary_edges;
+  };
+  std::vector<Expect> cases;
+  {
+    SheetShape s;
+    s.columns = 7;
+    s.rows = 5;
+    Expect e{"sheet", {}, 8 * 6, 7 * 6 + 5 * 8 + 7 * 5, 8, 2 * 7 + 2 * 5};
+    ASSERT_TRUE(MakeSheet(s, &e.mesh).ok());
+    cases.push_back(e);
+  }
+  {
+    SkirtShape s;
+    s.segments = 12;
+    s.rings = 4;
+    Expect e{"skirt", {}, 12 * 5, 12 * 5 + 2 * 12 * 4, 12, 2 * 12};
+    ASSERT_TRUE(MakeSkirt(s, &e.mesh).ok());
+    cases.push_back(e);
+  }
+  {
+    CapeShape s;
+    s.columns = 6;
+    s.rows = 9;
+    Expect e{"cape", {}, 7 * 10, 6 * 10 + 9 * 7 + 6 * 9, 7, 2 * 6 + 2 * 9};
+    ASSERT_TRUE(MakeCape(s, &e.mesh).ok());
+    cases.push_back(e);
+  }
+  {
+    SleeveShape s;
+    s.segments = 10;
+    s.rings = 6;
+    Expect e{"sleeve", {}, 10 * 7, 10 * 7 + 2 * 10 * 6, 10, 2 * 10};
+    ASSERT_TRUE(MakeSleeve(s, &e.mesh).ok());
+    cases.push_back(e);
+  }
+  for (const Expect& e : cases) {
+    SCOPED_TRACE(e.name);
+    EXPECT_EQ(e.mesh.positions.size(), e.particles);
+    EXPECT_EQ(e.mesh.held.size(), e.held);
+    ClothDescription d;
+    d.positions = e.mesh.positions;
+    d.triangles = e.mesh.triangles;
+    d.pinned = e.mesh.held;
+    Cloth cloth;
+    const Status s = BuildCloth(d, &cloth);
+    ASSERT_TRUE(s.ok()) << s.message();
+    const ClothBuildReport& r = cloth.build_report();
+    EXPECT_EQ(r.dropped_triangles + r.zero_area_triangles + r.non_manifold_edges, 0u);
+    // Springs between two held particles are dropped (both inverse masses are 0).
+    uint32_t held_edges = 0;
+    {
+      ClothDescription free = d;
+      free.pinned.clear();
+      Cloth all;
+      ASSERT_TRUE(BuildCloth(free, &all).ok());
+      EXPECT_EQ(all.spring_count(SpringKind::kStretch), e.stretch);
+      const uint32_t interior = e.stretch - e.boundary_edges;
+      EXPECT_GT(all.spring_count(SpringKind::kBend), interior / 2);
+      EXPECT_LE(all.spring_count(SpringKind::kBend), interior);
+      held_edges =
+          all.spring_count(SpringKind::kStretch) - cloth.spring_count(SpringKind::kStretch);
+    }
+    EXPECT_GE(held_edges, e.held - 1);
+    EXPECT_NEAR(cloth.total_mass() + 0.f, cloth.total_mass(), 0.f);
+    EXPECT_GT(cloth.total_mass(), 0.f);
+    for (const uint32_t t : cloth.triangles()) EXPECT_LT(t, e.particles);
+  }
+  GarmentMesh mesh;
+  SkirtShape bad_skirt;
+  bad_skirt.segments = 2;
+  EXPECT_EQ(MakeSkirt(bad_skirt, &mesh).code(), StatusCode::kInvalidArgument);
+  SheetShape bad_sheet;
+  bad_sheet.axis_v = bad_sheet.axis_u;
+  EXPECT_EQ(MakeSheet(bad_sheet, &mesh).code(), StatusCode::kInvalidArgument);
+  SleeveShape bad_sleeve;
+  bad_sleeve.radius = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(MakeSleeve(bad_sleeve, &mesh).code(), StatusCode::kInvalidArgument);
+  EXPECT_TRUE(mesh.positions.empty());
+}
+
+// Sleeve geometry: every particle is at `radius` from the axis and the held ring at the start.
+TEST(Garments, SleeveIsATube) {
+  SleeveShape s;
+  s.start = {0.2f, 1.4f, 0.f};
+  s.axis = {0.f, -0.6f, 0.8f};
+  GarmentMesh mesh;
+  ASSERT_TRUE(MakeSleeve(s, &mesh).ok());
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const Float3 r = mesh.positions[i] - s.start;
+    const float along = Dot(r, s.axis);
+    EXPECT_NEAR(Length(r - s.axis * along), s.radius, 1e-5f);
+    EXPECT_GE(along, -1e-5f);
+    EXPECT_LE(along, s.length + 1e-5f);
+  }
+  for (const uint32_t p : mesh.held)
+    EXPECT_NEAR(Dot(mesh.positions[p] - s.start, s.axis), 0.f, 1e-6f);
+}
+}  // namespace
+}  // namespace drape
