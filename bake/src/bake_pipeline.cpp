@@ -237,7 +237,7 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
 }  // namespace
 
 Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result,
-                     const std::string& preview_dir) {
+                     const std::string& preview_dir, const Scene* scene) {
   json& report = result->report;
   report = json::object();
   report["input"] = input;
@@ -320,6 +320,17 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
         !s.ok()) {
       return Status(s.code(), input + ": " + s.message());
     }
+  }
+  if (scene != nullptr) {
+    start = Clock::now();
+    SceneReach reach;
+    if (Status s = AnalyzeSceneReach(*scene, asset, &reach); !s.ok()) return s;
+    json left_out = json::array();
+    PruneUnreachable(reach, &asset, &left_out);
+    report["scene"] = SceneReachToJson(reach);
+    report["scene"]["source"] = scene->source;
+    report["scene"]["left_out"] = left_out;
+    timings["reach_ms"] = MillisecondsSince(start);
   }
   report["warnings"] = character.warnings;
 

@@ -67,12 +67,19 @@ int main(int argc, char** argv) {
   }
   if (input.empty()) return Fail("no INPUT given (usage: drape-bake INPUT -o OUT.drape)");
   if (output.empty()) return Fail(input + ": no output given (-o OUT.drape)");
-  if (!scene_path.empty()) return Fail(scene_path + ": --scene is not supported by this build yet");
-
   drape::bake::BakeConfig config;
   if (!config_path.empty()) {
     if (drape::Status s = drape::bake::LoadBakeConfig(config_path, &config); !s.ok())
       return Fail(s.message());
+  }
+  // The scene decides the collider kinds and the clip; its own bake overrides come last.
+  drape::bake::Scene scene;
+  if (!scene_path.empty()) {
+    if (drape::Status s = drape::bake::LoadScene(scene_path, &scene); !s.ok())
+      return Fail(s.message());
+    if (drape::Status s = drape::bake::ApplySceneToBakeConfig(scene, &config); !s.ok()) {
+      return Fail(s.message());
+    }
   }
   if (!preview_dir.empty()) {
     std::error_code error;
@@ -82,7 +89,9 @@ int main(int argc, char** argv) {
   }
   const auto start = std::chrono::steady_clock::now();
   drape::bake::BakeResult result;
-  if (drape::Status s = drape::bake::BakeCharacter(input, config, &result, preview_dir); !s.ok()) {
+  if (drape::Status s = drape::bake::BakeCharacter(input, config, &result, preview_dir,
+                                                   scene_path.empty() ? nullptr : &scene);
+      !s.ok()) {
     return Fail(s.message());
   }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "drape/bake/bake_config.h"
+#include "drape/bake/scene.h"
 #include "drape/formats/character_asset.h"
 #include "drape/formats/status.h"
 
@@ -16,8 +17,10 @@ struct BakeResult {
   nlohmann::json report;
 };
 
-// preview_dir: where preview pictures go (must exist), or empty for none.
+// preview_dir: where preview pictures go (must exist), or empty for none. scene: when given, the
+// colliders and map poses the scene's garments cannot reach over what it plays are left out, and
+// the report says which and why ("model only what a scene needs").
 Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result,
-                     const std::string& preview_dir = "");
+                     const std::string& preview_dir = "", const Scene* scene = nullptr);
 
 }  // namespace drape::bake

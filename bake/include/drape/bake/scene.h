@@ -1,0 +1,252 @@
+#pragma once
+// A scene: one character, the pose or clip it plays, the garments it wears and how they are
+// held, which collision methods run, the solver's parameters and what to output. The editable
+// description (Scene), its JSON parser (every refusal names the file and the JSON path of the bad
+// field, e.g. "scene.json: /garments/0/attach/joint: no joint named 'hipz'"), its resolution
+// against a skeleton (garment meshes, joint indices, the clip), and "model only what a scene
+// needs": the region the garments can reach over every frame the scene plays, the colliders that
+// region touches and the poses it plays (AnalyzeSceneReach). The format is documented field by
+// field in samples/scenes/README.md.
+//
+// Frames of a scene. The simulation advances in frames of solver.dt seconds. Frame k (k >= 0)
+// covers scene time [start + k dt, start + (k + 1) dt]; clip time is scene time wrapped by the
+// clip's duration when `loop`, else clamped to it. Before frame 0 the garments settle for
+// animation.settle seconds with the body held still at the start pose (these frames are not
+// output). A static scene (no clip) holds the rest or bind pose throughout.
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drape/bake/bake_config.h"
+#include "drape/formats/character_asset.h"
+#include "drape/formats/status.h"
+#include "drape/formats/types.h"
+#include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/cloth.h"
+#include "drape/runtime/cloth_solver.h"
+#include "drape/runtime/garments.h"
+#include "drape/runtime/hull_collider.h"
+
+namespace drape::bake {
+
+enum class GarmentType : uint8_t { kSheet, kSkirt, kCape, kSleeve, kObj };
+const char* ToString(GarmentType type);
+
+// The frame a garment's positions are written in. kBind: the bind-pose asset frame (attachments
+// are stored in it). kRest: the rest pose as authored (what a viewer shows); an attached particle
+// is mapped to the bind frame through the inverse of its joint's rest skinning matrix.
+enum class GarmentFrame : uint8_t { kBind, kRest };
+
+// Which particles of a garment: exactly one of a generator ring (by name, see GarmentRingNames),
+// explicit vertex indices, or the particles inside an axis-aligned box.
+struct SceneSelection {
+  std::string ring;
+  std::vector<uint32_t> vertices;
+  bool has_box = false;
+  Float3 box_min, box_max;  // metres, in the garment's frame after anchoring
+  std::string path;         // JSON path of the selection object, for messages
+};
+
+struct SceneAttachment {
+  std::string joint;  // joint name in the character's skeleton
+  SceneSelection particles;
+};
+
+struct SceneGarment {
+  std::string name;
+  GarmentType type = GarmentType::kSkirt;
+  GarmentFrame frame = GarmentFrame::kBind;
+  // Empty, or a joint whose position (in `frame`) is added to every position of the shape
+  // (centres, starts, OBJ offset, box corners): garments can be written relative to the body.
+  std::string anchor;
+  SheetShape sheet;
+  SkirtShape skirt;
+  CapeShape cape;
+  SleeveShape sleeve;
+  std::string obj_file;   // kObj: resolved against the scene's directory
+  float obj_scale = 1.f;  // kObj: metres per OBJ unit, > 0
+  Float3 obj_offset;      // kObj: metres, added after scaling
+  // Cloth material (drape/runtime/cloth.h). Masses come from area and density, rescaled to
+  // total_mass when it is > 0.
+  float density = 0.15f;   // kg/m^2
+  float total_mass = 0.f;  // kg, 0 = from density
+  SpringMaterial stretch;
+  SpringMaterial bend{20.f, 0.01f, 0.2f};
+  bool bend_springs = true;
+  std::vector<SceneAttachment> attachments;       // particles moving rigidly with a joint
+  std::vector<SceneSelection> pins;               // particles fixed in the world
+  std::array<float, 3> color{0.8f, 0.25f, 0.3f};  // linear RGB in [0, 1], for pictures
+  std::string path;                               // "/garments/<index>"
+};
+
+enum class ScenePose : uint8_t { kRest, kBind };
+
+struct SceneAnimation {
+  std::string clip;                   // empty: a static pose
+  ScenePose pose = ScenePose::kRest;  // the static pose (without a clip)
+  float start = 0.f;                  // seconds into the clip, >= 0
+  float duration = -1.f;  // seconds of scene time, > 0; -1: the clip's duration (1 s static)
+  bool loop = true;
+  float settle = 0.5f;  // seconds simulated at the start pose before frame 0, >= 0
+};
+
+enum class SceneAnimationOutput : uint8_t { kAuto, kMp4, kGif, kContactSheet, kNone };
+
+struct SceneOutput {
+  uint32_t every = 1;                  // write every k-th frame, >= 1
+  uint32_t width = 640, height = 640;  // pixels, [16, 4096]
+  bool overlay_colliders = false;      // hull edges and sphere outlines over the picture
+  bool obj = false;                    // the cloth mesh per written frame as OBJ
+  SceneAnimationOutput animation = SceneAnimationOutput::kAuto;
+  float camera_yaw_deg = 35.f;    // about +Y, from the character's front (+Z) towards +X
+  float camera_pitch_deg = 12.f;  // above the horizon, (-89, 89)
+  float camera_zoom = 1.f;        // > 0; 1 fits the body's bounds over the clip
+};
+
+struct Scene {
+  std::string source;     // the scene file as named by the caller: prefix of every message
+  std::string directory;  // relative paths resolve against it
+  std::string character;  // model file (anything drape-bake reads) or a .drape, resolved
+  nlohmann::json bake = nlohmann::json::object();  // overrides, as a drape-bake --config file
+
+  SceneAnimation animation;
+  std::vector<SceneGarment> garments;
+
+  // Collision: any combination of the three methods.
+  bool use_maps = false, use_hulls = true, use_spheres = true;
+  DepthSampling maps_sampling = DepthSampling::kNearest;
+  PoseBlend maps_blend = PoseBlend::kBracket;
+  HullColliderOptions hull_options;
+  float reach_margin = 0.05f;   // metres added to each garment's reach radius, >= 0
+  float reach_stretch = 0.15f;  // fraction the cloth may stretch beyond its rest lengths, >= 0
+  bool prune = true;            // drape-sim drops colliders the garments cannot reach
+
+  // Solver. settings.root_joint/root_bind_position are filled at resolution (relative).
+  ClothSolverSettings solver = [] {
+    ClothSolverSettings s = ClothSolverSettings::PaperB();
+    s.substeps = 4;
+    s.iterations = 5;
+    s.damping = 0.2f;
+    return s;
+  }();
+  bool auto_substeps = false;  // explicit Euler: RecommendedEulerSubsteps per garment
+  bool relative = false;       // relative simulation against the skeleton's root joint
+  float dt = 1.f / 60.f;       // seconds per frame, (0, 1]
+  ResponseParams response{0.3f, 0.f, 1e-3f};
+
+  SceneOutput output;
+
+  // Frames simulated after the settle (a caller may override it, e.g. drape-sim --frames);
+  // computed by the parser as ceil(duration / dt) once the duration is known (ResolveSceneClip
+  // fills it for a clip's default duration). 0 until then.
+  uint32_t frame_count = 0;
+};
+
+// Reads and parses a scene file. Relative paths in it resolve against its directory.
+Status LoadScene(const std::string& path, Scene* scene);
+// Parses a scene already read; `source` names it in messages, `directory` resolves paths.
+Status ParseScene(const nlohmann::json& json, const std::string& source,
+                  const std::string& directory, Scene* scene);
+
+// The bake configuration a scene needs: the scene's /bake overrides, then the collider kinds from
+// its collision methods (maps, hulls, spheres each on or off) and, when maps are used with a
+// clip, maps.clip = that clip. Fails with the JSON path of a bad override.
+Status ApplySceneToBakeConfig(const Scene& scene, BakeConfig* config);
+
+// Finds the scene's clip in the asset (-1 for a static pose) and fills scene->frame_count when the
+// duration defaults to the clip's. Error: "<scene>: /animation/clip: no clip named 'x' (clips:
+// ..)".
+Status ResolveSceneClip(const CharacterAsset& asset, Scene* scene, int32_t* clip);
+
+// Ring names a garment type offers for attach/pin selections ("held" is every generator's
+// suggested set). Sheet: top (the +axis_v edge, held), bottom, left (-axis_u), right. Skirt:
+// waist (held), hem. Cape: top (held), bottom, left (-x), right. Sleeve: start (held), end. OBJ:
+// none.
+std::vector<std::string> GarmentRingNames(GarmentType type);
+
+// A garment resolved against a skeleton: the cloth description (rest shape in the garment's
+// frame, attachments with joint indices and bind-frame positions, pins, material) and, per
+// particle, the joint whose pose carries it initially (the joint of its nearest held particle
+// along the mesh; -1 for none, e.g. pinned-only or free garments).
+struct ResolvedGarment {
+  ClothDescription description;
+  std::vector<int32_t> carrier_joint;
+  // Per joint of the skeleton: garment frame -> bind-pose asset frame (identity for kBind; the
+  // inverse rest skinning matrix for kRest). A particle p carried by joint j sits at
+  // S[j] * frame_to_bind[j] * p at a pose with skinning matrices S.
+  std::vector<Mat34> frame_to_bind;
+};
+
+// Builds garment `index` of the scene against the skeleton: generator or OBJ mesh, anchoring,
+// selections (errors name the JSON path: unknown ring, vertex index out of range, empty box,
+// unknown joint, a particle both attached and pinned ...). Allocates.
+Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skeleton,
+                      ResolvedGarment* out);
+
+// Positions of the garment at a pose: every particle moved rigidly by its carrier joint's
+// skinning matrix from the garment frame (S[j] * frame_to_bind[j] * p); particles without one
+// keep their rest positions. `positions` gets the particle count.
+void PlaceGarment(const ResolvedGarment& garment, std::span<const Mat34> skinning,
+                  std::vector<Float3>* positions);
+
+// Per particle: the length (metres) of the shortest path along the rest shape's edges to the
+// nearest held (attached or pinned) particle, and that particle's index; +inf and UINT32_MAX
+// when no held particle is connected to it. An upper bound of the geodesic distance, so a
+// particle of a cloth stretched by at most s lies within (1 + s) * distance of that particle.
+void NearestHeldParticles(const ClothDescription& cloth, std::vector<float>* distance,
+                          std::vector<uint32_t>* nearest);
+
+// What one collider is to the scene's garments.
+struct ColliderReach {
+  int32_t joint = -1;
+  std::string joint_name;
+  bool reachable = true;
+  // Metres: min over the sampled poses of (distance from the collider's bound to the nearest
+  // held particle) - that garment's reach radius. <= 0: reachable.
+  float clearance = -std::numeric_limits<float>::infinity();
+};
+
+struct GarmentReach {
+  std::string name;
+  uint32_t held_particles = 0;
+  bool bounded = true;   // false: a part of the garment is held by nothing (it can go anywhere)
+  float max_path = 0.f;  // metres, longest shortest path from a particle to a held particle
+  float radius = 0.f;    // metres, (1 + reach_stretch) * max_path + reach_margin
+};
+
+struct SceneReach {
+  int32_t clip = -1;           // -1: a static pose
+  uint32_t sampled_poses = 0;  // poses tested (substep boundaries of every frame + settle)
+  float clip_time_min = 0.f, clip_time_max = 0.f;  // range of clip times played
+  bool whole_clip = true;                          // every part of the clip is played
+  std::vector<GarmentReach> garments;
+  std::vector<ColliderReach> hulls;    // one per asset.hulls, same order
+  std::vector<ColliderReach> spheres;  // one per asset.joint_spheres, same order
+  // Indices into asset.body_maps.poses the scene reads (nearest and bracketing poses of every
+  // frame end time; the poses of the scene's clip, or the static poses), ascending.
+  std::vector<uint32_t> played_map_poses;
+};
+
+// Over every pose the scene plays (settle, then each frame at its substep boundaries): the
+// region the garments can reach is the union of spheres of radius GarmentReach::radius around
+// their posed held particles; a hull is reachable when its posed OBB meets that region in some
+// pose, a joint sphere when its posed sphere does. A garment with an unheld part reaches
+// everything. Needs scene.frame_count (ResolveSceneClip). Allocates.
+Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneReach* out);
+
+// The analysis as JSON (for reports): garments, per collider {bone, kind, reachable, clearance_m},
+// played clip range, played map poses.
+nlohmann::json SceneReachToJson(const SceneReach& reach);
+
+// Drops the hulls, joint spheres and body-map poses the scene cannot reach or does not play from
+// `asset`, appending one {"bone"/"pose", "kind", "reason"} entry per dropped item to *left_out (a
+// JSON array). `reach` must come from AnalyzeSceneReach on this asset. Keeps every map pose when
+// none of them is played (and says so).
+void PruneUnreachable(const SceneReach& reach, CharacterAsset* asset, nlohmann::json* left_out);
+
+}  // namespace drape::bake

@@ -1,0 +1,212 @@
+#include "simulation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "drape/runtime/math.h"
+#include "drape/runtime/skinning.h"
+
+namespace drape::sim {
+namespace {
+
+bool Finite(Float3 p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+
+}  // namespace
+
+float ClipTimeOf(const ClipData& clip, float time, bool loop) {
+  if (loop && clip.duration > 0.f) {
+    time = std::fmod(time, clip.duration);
+    if (time < 0.f) time += clip.duration;
+  }
+  return std::fmin(std::fmax(time, 0.f), clip.duration);
+}
+
+Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& asset, int32_t clip) {
+  scene_ = &scene;
+  asset_ = &asset;
+  clip_ = clip;
+  settle_frames_ = static_cast<int64_t>(std::lround(scene.animation.settle / scene.dt));
+  const std::string where = scene.source + ": ";
+  if (Status s = pose_.Init(asset.skeleton); !s.ok()) return Status(s.code(), where + s.message());
+
+  // Hulls and joint spheres: one set holding the kinds the scene uses.
+  std::vector<HullColliderData> hulls;
+  std::vector<JointSphereData> spheres;
+  if (scene.use_hulls) {
+    hulls = asset.hulls;
+    for (uint32_t h = 0; h < asset.hulls.size(); ++h) hull_indices_.push_back(h);
+  }
+  if (scene.use_spheres) {
+    spheres = asset.joint_spheres;
+    for (uint32_t s = 0; s < asset.joint_spheres.size(); ++s) sphere_indices_.push_back(s);
+  }
+  if (!hulls.empty() || !spheres.empty()) {
+    if (Status s = hulls_.Build(hulls, spheres, asset.skeleton.joint_count(), scene.hull_options);
+        !s.ok()) {
+      return Status(s.code(), where + "the asset's hulls and spheres: " + s.message());
+    }
+    has_hull_set_ = true;
+  }
+  if (scene.use_maps) {
+    std::vector<BodyMapPose> poses;
+    for (const BodyMapPose& p : asset.body_maps.poses)
+      if (p.clip == clip) poses.push_back(p);
+    if (poses.empty()) {
+      return Status(
+          StatusCode::kInvalidArgument,
+          where + "/collision/methods: uses maps, but the asset holds no body-map pose " +
+              (clip < 0 ? std::string("of the static pose")
+                        : "of clip '" + asset.clips[static_cast<size_t>(clip)].name + "'"));
+    }
+    std::stable_sort(poses.begin(), poses.end(),
+                     [](const BodyMapPose& a, const BodyMapPose& b) { return a.time < b.time; });
+    if (Status s = maps_.Build(poses, scene.maps_sampling, scene.maps_blend); !s.ok())
+      return Status(s.code(), where + "the asset's body maps: " + s.message());
+    has_maps_ = true;
+  }
+
+  // Garments, placed at the start pose.
+  if (Status s = Pose(scene.animation.start, &skin_start_); !s.ok()) return s;
+  skin_end_ = skin_start_;
+  ClothSolverSettings settings = scene.solver;
+  if (scene.relative) {
+    settings.root_joint = 0;
+    Mat34 root;
+    if (!asset.skeleton.inverse_bind.empty() &&
+        InverseAffine(asset.skeleton.inverse_bind[0], &root))
+      settings.root_bind_position = {root.m[3], root.m[7], root.m[11]};
+  }
+  for (size_t g = 0; g < scene.garments.size(); ++g) {
+    auto garment = std::make_unique<Garment>();
+    if (Status s = bake::ResolveGarment(scene, g, asset.skeleton, &garment->resolved); !s.ok())
+      return s;
+    const std::string at = where + scene.garments[g].path + ": ";
+    if (Status s = BuildCloth(garment->resolved.description, &garment->cloth); !s.ok())
+      return Status(s.code(), at + s.message());
+    ClothSolverSettings garment_settings = settings;
+    if (scene.auto_substeps) {
+      garment_settings.substeps = std::clamp(
+          RecommendedEulerSubsteps(garment->cloth, scene.dt, settings.damping), 1u, 256u);
+    }
+    if (Status s = garment->solver.Init(garment->cloth, garment_settings); !s.ok())
+      return Status(s.code(), at + s.message());
+    garment->state.Reset(garment->cloth);
+    bake::PlaceGarment(garment->resolved, skin_start_, &garment->start_positions);
+    garment->state.positions = garment->start_positions;
+    garment->state.previous_positions = garment->start_positions;
+    garments_.push_back(std::move(garment));
+  }
+  return Status::Ok();
+}
+
+uint32_t SceneSimulation::particle_count() const {
+  uint32_t n = 0;
+  for (const auto& g : garments_) n += g->cloth.particle_count();
+  return n;
+}
+
+float SceneSimulation::FrameStartTime(int64_t frame) const {
+  return scene_->animation.start + (frame < 0 ? 0.f : static_cast<float>(frame) * scene_->dt);
+}
+
+Status SceneSimulation::Pose(float time, std::vector<Mat34>* skinning) {
+  if (clip_ >= 0) {
+    if (Status s = pose_.SampleClip(asset_->clips[static_cast<size_t>(clip_)], time,
+                                    scene_->animation.loop);
+        !s.ok())
+      return Status(s.code(), scene_->source + ": " + s.message());
+  } else if (scene_->animation.pose == bake::ScenePose::kRest) {
+    pose_.SetRest();
+  } else {
+    pose_.SetBind();
+  }
+  skinning->assign(pose_.skinning().begin(), pose_.skinning().end());
+  return Status::Ok();
+}
+
+Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
+  *stats = FrameStats{};
+  stats->frame = frame;
+  const float t0 = FrameStartTime(frame);
+  const float t1 = frame < 0 ? t0 : t0 + scene_->dt;
+  stats->time = t1;
+  if (Status s = Pose(t0, &skin_start_); !s.ok()) return s;
+  if (Status s = Pose(t1, &skin_end_); !s.ok()) return s;
+
+  ClothColliders colliders;
+  colliders.response = scene_->response;
+  colliders.hulls = has_hull_set_ ? &hulls_ : nullptr;
+  if (has_maps_) {
+    const float map_time = clip_ >= 0 ? ClipTimeOf(asset_->clips[static_cast<size_t>(clip_)], t1,
+                                                   scene_->animation.loop)
+                                      : 0.f;
+    colliders.body_map = &maps_.At(map_time, &map_scratch_);
+  }
+  ClothFrame cloth_frame;
+  cloth_frame.dt = scene_->dt;
+  cloth_frame.skinning_start = skin_start_;
+  cloth_frame.skinning_end = skin_end_;
+
+  Status result = Status::Ok();
+  for (size_t g = 0; g < garments_.size() && result.ok(); ++g) {
+    Garment& garment = *garments_[g];
+    ClothStepStats step;
+    const auto start = std::chrono::steady_clock::now();
+    result = garment.solver.Step(&garment.state, colliders, cloth_frame, &step);
+    stats->step_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats->contacts += step.contacts;
+    stats->hull_contacts += step.hull_contacts;
+    stats->body_map_contacts += step.body_map_contacts;
+    stats->max_stretch = std::max(stats->max_stretch, step.max_stretch);
+    if (!result.ok()) {
+      result = Status(result.code(), scene_->source + ": frame " + std::to_string(frame) + ", " +
+                                         scene_->garments[g].path + ": " + result.message());
+    }
+  }
+  Measure(colliders.body_map, stats);
+  return result;
+}
+
+void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats) {
+  // Point queries at the end pose: the hull set at exactly s = 1 (Step leaves its last substep
+  // selected; the next Step poses it afresh).
+  if (has_hull_set_) (void)hulls_.SelectSubstep(1.f, 1.f);
+  for (const auto& g : garments_) {
+    const ClothState& state = g->state;
+    for (size_t i = 0; i < state.positions.size(); ++i) {
+      const Float3 p = state.positions[i];
+      if (!Finite(p) || !Finite(state.velocities[i])) {
+        stats->finite = false;
+        continue;
+      }
+      bool inside = false;
+      float depth = 0.f;
+      if (has_hull_set_) {
+        const ContactQuery q = hulls_.Query(p, p);
+        if (q.inside_end) {
+          inside = true;
+          depth = std::max(depth, q.depth);
+        }
+      }
+      if (body_map != nullptr) {
+        const ContactQuery q = body_map->Query(p, p);
+        if (q.inside_end) {
+          inside = true;
+          depth = std::max(depth, q.depth);
+        }
+      }
+      if (inside) ++stats->inside_particles;
+      stats->max_penetration = std::max(stats->max_penetration, depth);
+    }
+  }
+}
+
+void SceneSimulation::SkinBody(std::vector<Float3>* positions) const {
+  positions->resize(asset_->mesh.vertex_count());
+  (void)SkinMesh(asset_->mesh, skin_end_, *positions);
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,435 @@
+// Scenes: the JSON format (every refusal names the JSON path of the bad field), garment
+// resolution against a skeleton, the bake configuration a scene implies, and the reach analysis
+// ("model only what a scene needs") on the baked mannequin.
+
+#include "drape/bake/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <string>
+
+#include "drape/bake/bake_pipeline.h"
+#include "drape/runtime/math.h"
+#include "drape/runtime/skeleton_pose.h"
+#include "test_support.h"
+
+namespace drape::bake {
+namespace {
+
+using nlohmann::json;
+
+std::string DemoPath() { return test::SourceDir() + "/samples/scenes/demo.json"; }
+std::string ScenesDir() { return test::SourceDir() + "/samples/scenes"; }
+
+json DemoJson() {
+  std::ifstream in(DemoPath());
+  return json::parse(in);
+}
+
+// Parses `j` as if it were samples/scenes/scene.json.
+Status Parse(const json& j, Scene* scene) {
+  return ParseScene(j, "scene.json", ScenesDir(), scene);
+}
+
+// The mannequin baked once for the whole suite: hulls, spheres, and coarse maps of the walk at
+// 10 Hz (11 poses), enough for the pose bookkeeping.
+class SceneTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    BakeConfig config;
+    config.maps.resolution = 64;
+    config.maps_clip = "walk";
+    config.maps_clip_rate = 10.f;
+    BakeResult result;
+    const Status s = BakeCharacter(test::MannequinPath(), config, &result);
+    ASSERT_TRUE(s.ok()) << s.message();
+    asset_ = new CharacterAsset(std::move(result.asset));
+  }
+  static void TearDownTestSuite() {
+    delete asset_;
+    asset_ = nullptr;
+  }
+  static const CharacterAsset& asset() { return *asset_; }
+
+  // A mini skirt (25 cm) held at the hips, walking the whole clip.
+  static json MiniSkirt() {
+    json j = DemoJson();
+    j["animation"] = {{"clip", "walk"}, {"start", 0.0}, {"duration", 1.0}, {"loop", true}};
+    j["garments"][0]["shape"]["length"] = 0.25;
+    j["garments"][0]["shape"]["bottom_radius"] = 0.3;
+    j["collision"]["reach_margin"] = 0.02;
+    j["collision"]["reach_stretch"] = 0.1;
+    return j;
+  }
+
+ private:
+  static CharacterAsset* asset_;
+};
+CharacterAsset* SceneTest::asset_ = nullptr;
+
+TEST(SceneParse, DemoScene) {
+  Scene scene;
+  const Status s = LoadScene(DemoPath(), &scene);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(scene.source, DemoPath());
+  EXPECT_TRUE(std::filesystem::equivalent(scene.character, test::MannequinPath()));
+  EXPECT_EQ(scene.animation.clip, "walk");
+  EXPECT_FLOAT_EQ(scene.animation.duration, 3.f);
+  EXPECT_TRUE(scene.animation.loop);
+  // 3 s at 1/60 s per frame (dt is written as 0.0166667: the count rounds to 180, not 181).
+  EXPECT_EQ(scene.frame_count, 180u);
+  ASSERT_EQ(scene.garments.size(), 1u);
+  const SceneGarment& skirt = scene.garments[0];
+  EXPECT_EQ(skirt.type, GarmentType::kSkirt);
+  EXPECT_EQ(skirt.name, "skirt");
+  EXPECT_EQ(skirt.anchor, "hips");
+  EXPECT_EQ(skirt.skirt.segments, 64u);
+  ASSERT_EQ(skirt.attachments.size(), 1u);
+  EXPECT_EQ(skirt.attachments[0].joint, "hips");
+  EXPECT_EQ(skirt.attachments[0].particles.ring, "waist");
+  EXPECT_EQ(skirt.attachments[0].particles.path, "/garments/0/attach");
+  EXPECT_TRUE(scene.use_hulls);
+  EXPECT_TRUE(scene.use_spheres);
+  EXPECT_FALSE(scene.use_maps);
+  EXPECT_EQ(scene.solver.integrator, ClothIntegrator::kVerlet);
+  EXPECT_EQ(scene.solver.substeps, 4u);
+  EXPECT_EQ(scene.output.every, 2u);
+}
+
+// Every bad field is refused with "scene.json: <JSON path>: <reason>".
+TEST(SceneParse, BadFieldsNameTheirPath) {
+  struct Case {
+    const char* name;
+    std::function<void(json&)> mutate;
+    const char* prefix;  // "scene.json: " + this
+    const char* reason;  // must appear after the prefix
+  };
+  const std::vector<Case> cases = {
+      {"missing character", [](json& j) { j.erase("character"); }, "/character: ", "missing"},
+      {"character not found", [](json& j) { j["character"] = "nobody.glb"; },
+       "/character: ", "not found"},
+      {"unknown garment type", [](json& j) { j["garments"][0]["type"] = "dress"; },
+       "/garments/0/type: ", "'dress' is not one of sheet | skirt | cape | sleeve | obj"},
+      {"missing garment type", [](json& j) { j["garments"][0].erase("type"); },
+       "/garments/0/type: ", "missing"},
+      {"negative dt", [](json& j) { j["solver"]["dt"] = -0.01; }, "/solver/dt: ", "out of range"},
+      {"zero dt", [](json& j) { j["solver"]["dt"] = 0; }, "/solver/dt: ", "out of range"},
+      {"unknown collision method",
+       [](json& j) {
+         j["collision"]["methods"] = {"hulls", "lasers"};
+       },
+       "/collision/methods/1: ", "'lasers' is not a collision method"},
+      {"methods not an array", [](json& j) { j["collision"]["methods"] = "hulls"; },
+       "/collision/methods: ", "must be an array"},
+      {"substeps as text", [](json& j) { j["solver"]["substeps"] = "four"; },
+       "/solver/substeps: ", "integer"},
+      {"width as fraction", [](json& j) { j["output"]["width"] = 12.5; },
+       "/output/width: ", "must be an integer"},
+      {"joint as number", [](json& j) { j["garments"][0]["attach"]["joint"] = 3; },
+       "/garments/0/attach/joint: ", "must be a string"},
+      {"attach without joint", [](json& j) { j["garments"][0]["attach"].erase("joint"); },
+       "/garments/0/attach/joint: ", "missing"},
+      {"gravity with text",
+       [](json& j) {
+         j["solver"]["gravity"] = {0, "down", 0};
+       },
+       "/solver/gravity/1: ", "must be a number"},
+      {"garments as object", [](json& j) { j["garments"] = json::object(); },
+       "/garments: ", "non-empty array"},
+      {"unknown key", [](json& j) { j["solver"]["substepz"] = 2; },
+       "/solver/substepz: ", "unknown key"},
+      {"negative radius", [](json& j) { j["garments"][0]["shape"]["top_radius"] = -0.1; },
+       "/garments/0/shape/top_radius: ", "out of range"},
+      {"selection with two kinds",
+       [](json& j) {
+         j["garments"][0]["attach"]["vertices"] = {0, 1};
+       },
+       "/garments/0/attach: ", "only one of"},
+      {"bad bake override", [](json& j) { j["bake"]["maps"]["resolution"] = 3; },
+       "/bake/maps/resolution: ", "must be in"},
+      {"bake override of a kind",
+       [](json& j) {
+         j["bake"]["hulls"] = {{"enabled", false}};
+       },
+       "/bake/hulls/enabled: ", "/collision/methods"},
+      {"clip and pose", [](json& j) { j["animation"]["pose"] = "rest"; },
+       "/animation/pose: ", "not both"},
+      {"friction above 1", [](json& j) { j["solver"]["friction"] = 1.5; },
+       "/solver/friction: ", "out of range"},
+      {"colour out of range",
+       [](json& j) {
+         j["garments"][0]["color"] = {1, 2, 0};
+       },
+       "/garments/0/color/1: ", "out of range"},
+      {"maps of the bind pose",
+       [](json& j) {
+         j["animation"] = {{"pose", "bind"}};
+         j["collision"]["methods"] = {"maps"};
+       },
+       "/animation/pose: ", "rest pose"},
+      {"not an object", [](json& j) { j = json::array(); }, "", "must be a JSON object"},
+  };
+  for (const Case& c : cases) {
+    json j = DemoJson();
+    c.mutate(j);
+    Scene scene;
+    const Status s = Parse(j, &scene);
+    ASSERT_FALSE(s.ok()) << c.name;
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument) << c.name;
+    const std::string expected_prefix = std::string("scene.json: ") + c.prefix;
+    EXPECT_EQ(s.message().rfind(expected_prefix, 0), 0u)
+        << c.name << ": " << s.message() << " should start with " << expected_prefix;
+    EXPECT_NE(s.message().find(c.reason), std::string::npos)
+        << c.name << ": " << s.message() << " should say " << c.reason;
+    EXPECT_EQ(s.message().find('\n'), std::string::npos) << c.name << ": one line";
+  }
+}
+
+TEST(SceneParse, LoadNamesTheFile) {
+  Scene scene;
+  Status s = LoadScene("/nonexistent/scene.json", &scene);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().rfind("/nonexistent/scene.json: ", 0), 0u) << s.message();
+  const std::string path = ::testing::TempDir() + "/broken_scene.json";
+  std::ofstream(path) << "{\"character\": ";
+  s = LoadScene(path, &scene);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().rfind(path + ": not valid JSON", 0), 0u) << s.message();
+}
+
+TEST(SceneParse, BakeConfigFollowsTheScene) {
+  Scene scene;
+  ASSERT_TRUE(LoadScene(DemoPath(), &scene).ok());
+  BakeConfig config;
+  ASSERT_TRUE(ApplySceneToBakeConfig(scene, &config).ok());
+  EXPECT_FALSE(config.maps_enabled);  // the demo uses hulls and spheres only
+  EXPECT_TRUE(config.hulls_enabled);
+  EXPECT_TRUE(config.spheres_enabled);
+  EXPECT_EQ(config.maps.resolution, 512u);  // its /bake override
+  EXPECT_EQ(config.maps_clip, "");
+
+  json j = DemoJson();
+  j["collision"]["methods"] = {"maps"};
+  j["bake"]["maps"]["clip_rate"] = 15;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  config = BakeConfig{};
+  ASSERT_TRUE(ApplySceneToBakeConfig(scene, &config).ok());
+  EXPECT_TRUE(config.maps_enabled);
+  EXPECT_FALSE(config.hulls_enabled);
+  EXPECT_FALSE(config.spheres_enabled);
+  EXPECT_EQ(config.maps_clip, "walk");
+  EXPECT_FLOAT_EQ(config.maps_clip_rate, 15.f);
+}
+
+TEST_F(SceneTest, ResolutionErrorsNameTheirPath) {
+  struct Case {
+    const char* name;
+    std::function<void(json&)> mutate;
+    const char* expected;  // the message starts with "scene.json: " + this
+  };
+  const std::vector<Case> cases = {
+      {"unknown joint", [](json& j) { j["garments"][0]["attach"]["joint"] = "hipz"; },
+       "/garments/0/attach/joint: no joint named 'hipz'"},
+      {"unknown anchor", [](json& j) { j["garments"][0]["anchor"] = "pelvis"; },
+       "/garments/0/anchor: no joint named 'pelvis'"},
+      {"unknown ring", [](json& j) { j["garments"][0]["attach"]["ring"] = "belt"; },
+       "/garments/0/attach/ring: no ring named 'belt' on a skirt (rings: held | waist | hem)"},
+      {"vertex out of range",
+       [](json& j) {
+         j["garments"][0]["attach"] = json::array({{{"joint", "hips"}, {"ring", "waist"}},
+                                                   {{"joint", "hips"}, {"vertices", {5, 99999}}}});
+       },
+       "/garments/0/attach/1/vertices/1: particle 99999 is out of range"},
+      {"empty box",
+       [](json& j) {
+         j["garments"][0]["attach"] = {{"joint", "hips"},
+                                       {"box", {{"min", {5, 5, 5}}, {"max", {6, 6, 6}}}}};
+       },
+       "/garments/0/attach/box: selects no particle"},
+      {"held twice",
+       [](json& j) {
+         j["garments"][0]["attach"] = json::array(
+             {{{"joint", "hips"}, {"ring", "waist"}}, {{"joint", "spine"}, {"vertices", {3}}}});
+       },
+       "/garments/0/attach/1: particle 3 is already held by /garments/0/attach/0"},
+  };
+  for (const Case& c : cases) {
+    json j = DemoJson();
+    c.mutate(j);
+    Scene scene;
+    ASSERT_TRUE(Parse(j, &scene).ok()) << c.name;
+    ResolvedGarment garment;
+    const Status s = ResolveGarment(scene, 0, asset().skeleton, &garment);
+    ASSERT_FALSE(s.ok()) << c.name;
+    const std::string expected = std::string("scene.json: ") + c.expected;
+    EXPECT_EQ(s.message().rfind(expected, 0), 0u) << c.name << ": " << s.message();
+  }
+
+  json j = DemoJson();
+  j["animation"]["clip"] = "run";
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  int32_t clip = 0;
+  const Status s = ResolveSceneClip(asset(), &scene, &clip);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().rfind("scene.json: /animation/clip: no clip named 'run'", 0), 0u)
+      << s.message();
+  EXPECT_NE(s.message().find("(clips: walk)"), std::string::npos) << s.message();
+}
+
+TEST_F(SceneTest, GarmentIsHeldInTheBindFrame) {
+  Scene scene;
+  ASSERT_TRUE(LoadScene(DemoPath(), &scene).ok());
+  ResolvedGarment garment;
+  const Status s = ResolveGarment(scene, 0, asset().skeleton, &garment);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const ClothDescription& d = garment.description;
+  ASSERT_EQ(d.positions.size(), 64u * 25u);
+  ASSERT_EQ(d.attachments.size(), 64u);  // the waist ring
+  const int32_t hips = FindJoint(asset().skeleton, "hips");
+  // The skirt is anchored at the hips joint (bind position y = 0.95) + 0.03.
+  for (const ClothAttachment& a : d.attachments) {
+    EXPECT_EQ(a.joint, hips);
+    EXPECT_LT(a.particle, 64u);
+    EXPECT_NEAR(a.bind_position.y, 0.98f, 1e-5f);
+    EXPECT_NEAR(std::hypot(a.bind_position.x, a.bind_position.z), 0.185f, 1e-5f);
+  }
+  // Every particle is carried by the hips; at a walk pose the placed waist is exactly where the
+  // solver puts the attachments (S * bind position), and in the bind pose nothing moves.
+  for (int32_t j : garment.carrier_joint) EXPECT_EQ(j, hips);
+  SkeletonPose pose;
+  ASSERT_TRUE(pose.Init(asset().skeleton).ok());
+  pose.SetBind();
+  std::vector<Float3> placed;
+  PlaceGarment(garment, pose.skinning(), &placed);
+  for (size_t i = 0; i < placed.size(); ++i) {
+    EXPECT_NEAR(Length(placed[i] - d.positions[i]), 0.f, 1e-5f);
+  }
+  ASSERT_TRUE(pose.SampleClip(asset().clips[0], 0.3f, true).ok());
+  PlaceGarment(garment, pose.skinning(), &placed);
+  for (const ClothAttachment& a : d.attachments) {
+    const Float3 target =
+        TransformPoint(pose.skinning()[static_cast<size_t>(hips)], a.bind_position);
+    EXPECT_NEAR(Length(placed[a.particle] - target), 0.f, 1e-5f);
+  }
+}
+
+TEST_F(SceneTest, NearestHeldPathFollowsTheMesh) {
+  json j = MiniSkirt();
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  ResolvedGarment garment;
+  ASSERT_TRUE(ResolveGarment(scene, 0, asset().skeleton, &garment).ok());
+  std::vector<float> distance;
+  std::vector<uint32_t> nearest;
+  NearestHeldParticles(garment.description, &distance, &nearest);
+  // The skirt's vertical edges run along the cone's generators: the hem is one slant height
+  // from the waist particle straight above it, the shortest path there.
+  const float slant = std::hypot(0.25f, 0.3f - 0.185f);
+  const uint32_t segments = 64, rings = 24;
+  for (uint32_t i = 0; i < segments; ++i) {
+    const uint32_t hem = rings * segments + i;
+    EXPECT_NEAR(distance[hem], slant, 1e-5f);
+    EXPECT_EQ(nearest[hem], i);
+  }
+  for (uint32_t i = 0; i < segments; ++i) EXPECT_EQ(distance[i], 0.f);
+  // An unheld part has no path.
+  ClothDescription loose = garment.description;
+  loose.attachments.clear();
+  NearestHeldParticles(loose, &distance, &nearest);
+  for (float d : distance) EXPECT_TRUE(std::isinf(d));
+}
+
+TEST_F(SceneTest, SkirtReachKeepsHipsAndDropsHeadAndWrists) {
+  Scene scene;
+  ASSERT_TRUE(Parse(MiniSkirt(), &scene).ok());
+  SceneReach reach;
+  const Status s = AnalyzeSceneReach(scene, asset(), &reach);
+  ASSERT_TRUE(s.ok()) << s.message();
+  ASSERT_EQ(reach.garments.size(), 1u);
+  const float slant = std::hypot(0.25f, 0.3f - 0.185f);
+  EXPECT_NEAR(reach.garments[0].max_path, slant, 1e-5f);
+  EXPECT_NEAR(reach.garments[0].radius, 1.1f * slant + 0.02f, 1e-5f);
+  EXPECT_TRUE(reach.garments[0].bounded);
+  // 60 frames of 4 substeps, plus the start.
+  EXPECT_EQ(reach.sampled_poses, 241u);
+  EXPECT_TRUE(reach.whole_clip);
+  ASSERT_EQ(reach.hulls.size(), asset().hulls.size());
+  ASSERT_EQ(reach.spheres.size(), asset().joint_spheres.size());
+
+  std::set<std::string> reachable_hulls, dropped_hulls, dropped_spheres;
+  for (const ColliderReach& c : reach.hulls) {
+    (c.reachable ? reachable_hulls : dropped_hulls).insert(c.joint_name);
+    EXPECT_EQ(c.reachable, c.clearance <= 0.f);
+  }
+  for (const ColliderReach& c : reach.spheres)
+    if (!c.reachable) dropped_spheres.insert(c.joint_name);
+  for (const char* kept : {"hips", "hip_l", "hip_r", "spine"})
+    EXPECT_TRUE(reachable_hulls.count(kept)) << kept << " should be reachable";
+  for (const char* dropped : {"head", "wrist_l", "wrist_r", "ankle_l", "ankle_r"})
+    EXPECT_TRUE(dropped_hulls.count(dropped)) << dropped << " should be out of reach";
+  for (const char* dropped : {"head", "wrist_l", "wrist_r"})
+    EXPECT_TRUE(dropped_spheres.count(dropped)) << dropped << " sphere should be out of reach";
+
+  // Pruning leaves exactly the reachable colliders and says why for each of the others.
+  CharacterAsset pruned = asset();
+  json left_out = json::array();
+  PruneUnreachable(reach, &pruned, &left_out);
+  EXPECT_EQ(pruned.hulls.size(), reachable_hulls.size());
+  EXPECT_EQ(pruned.joint_spheres.size() + dropped_spheres.size(), asset().joint_spheres.size());
+  size_t dropped_entries = 0;
+  for (const json& entry : left_out) {
+    if (entry["kind"] == "hull" || entry["kind"] == "joint_sphere") {
+      ++dropped_entries;
+      EXPECT_NE(entry["reason"].get<std::string>().find("cannot reach"), std::string::npos);
+    }
+  }
+  EXPECT_EQ(dropped_entries, dropped_hulls.size() + dropped_spheres.size());
+  // The whole looping clip is played: every map pose stays.
+  EXPECT_EQ(pruned.body_maps.poses.size(), asset().body_maps.poses.size());
+}
+
+TEST_F(SceneTest, ReachOfALooseGarmentIsEverything) {
+  json j = MiniSkirt();
+  j["garments"][0].erase("attach");
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  SceneReach reach;
+  ASSERT_TRUE(AnalyzeSceneReach(scene, asset(), &reach).ok());
+  EXPECT_FALSE(reach.garments[0].bounded);
+  for (const ColliderReach& c : reach.hulls) EXPECT_TRUE(c.reachable) << c.joint_name;
+  for (const ColliderReach& c : reach.spheres) EXPECT_TRUE(c.reachable) << c.joint_name;
+}
+
+TEST_F(SceneTest, PlayedMapPosesAreThoseOfThePlayedTimes) {
+  json j = MiniSkirt();
+  // 8 frames of 1/32 s (exact in float, so no frame end lands a rounding away from a pose).
+  j["animation"] = {{"clip", "walk"}, {"start", 0.2}, {"duration", 0.25}, {"loop", false}};
+  j["solver"]["dt"] = 0.03125;
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  SceneReach reach;
+  ASSERT_TRUE(AnalyzeSceneReach(scene, asset(), &reach).ok());
+  EXPECT_FALSE(reach.whole_clip);
+  EXPECT_NEAR(reach.clip_time_min, 0.2f, 1e-6f);
+  EXPECT_NEAR(reach.clip_time_max, 0.45f, 1e-6f);
+  // Poses at 0, 0.1, ..., 1.0 s: the frames end in [0.2, 0.45], so 0.2 .. 0.5 are read (a frame
+  // end between two poses reads both with kBracket).
+  ASSERT_EQ(asset().body_maps.poses.size(), 11u);
+  std::vector<float> times;
+  for (uint32_t p : reach.played_map_poses) times.push_back(asset().body_maps.poses[p].time);
+  ASSERT_EQ(times.size(), 4u);
+  for (size_t k = 0; k < times.size(); ++k)
+    EXPECT_NEAR(times[k], 0.2f + 0.1f * static_cast<float>(k), 1e-5f);
+  CharacterAsset pruned = asset();
+  json left_out = json::array();
+  PruneUnreachable(reach, &pruned, &left_out);
+  EXPECT_EQ(pruned.body_maps.poses.size(), 4u);
+}
+
+}  // namespace
+}  // namespace drape::bake
