@@ -1,5 +1,7 @@
 #include "drape/bake/kirkpatrick_builder.h"
 
+#include "drape/runtime/exact_orientation.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -17,42 +19,12 @@ Status Fail(const std::string& what) {
   return Status(StatusCode::kInvalidArgument, "Kirkpatrick: " + what);
 }
 
-// ---- Exact orientation on float coordinates. Products of two floats are exact in double; the
-// six-term sum is evaluated exactly with Shewchuk's grow-expansion (round to nearest, no FMA
-// contraction: the project compiles with -ffp-contract=off).
-void TwoSum(double a, double b, double* s, double* e) {
-  *s = a + b;
-  const double bb = *s - a;
-  *e = (a - (*s - bb)) + (b - bb);
-}
-int SignOfExactSum(const double* terms, int count) {
-  double expansion[16];
-  int size = 0;
-  for (int t = 0; t < count; ++t) {
-    double q = terms[t];
-    int kept = 0;
-    for (int i = 0; i < size; ++i) {
-      double s, e;
-      TwoSum(q, expansion[i], &s, &e);
-      if (e != 0.0) expansion[kept++] = e;
-      q = s;
-    }
-    expansion[kept++] = q;
-    size = kept;
-  }
-  for (int i = size - 1; i >= 0; --i)
-    if (expansion[i] != 0.0) return expansion[i] > 0.0 ? 1 : -1;
-  return 0;
-}
-
 struct Point {
   float u = 0.f, v = 0.f;
 };
 // Sign of the signed area of (a, b, c): > 0 counter-clockwise.
 int Orient(const Point& a, const Point& b, const Point& c) {
-  const double terms[6] = {double(b.u) * c.v,  -double(b.u) * a.v, -double(a.u) * c.v,
-                           -double(b.v) * c.u, double(b.v) * a.u,  double(a.v) * c.u};
-  return SignOfExactSum(terms, 6);
+  return Orient2dExact(a.u, a.v, b.u, b.v, c.u, c.v);
 }
 double Area2(const Point& a, const Point& b, const Point& c) {  // approximate, for ranking only
   return (double(b.u) - a.u) * (double(c.v) - a.v) - (double(b.v) - a.v) * (double(c.u) - a.u);
