@@ -16,6 +16,8 @@
 #include "drape/bake/mesh_queries.h"
 #include "drape/bake/regions.h"
 #include "drape/formats/asset_file.h"
+#include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/hull_collider.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
@@ -335,8 +337,24 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   report["warnings"] = character.warnings;
 
   start = Clock::now();
+  // The file validator, then the runtime's own builders: a bake the runtime would refuse fails
+  // here.
   if (Status s = ValidateAsset(asset); !s.ok()) {
     return Status(s.code(), input + ": the baked asset does not validate: " + s.message());
+  }
+  {
+    HullColliderSet hulls;
+    if (Status s = hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
+        !s.ok()) {
+      return Status(s.code(), input + ": the runtime refuses the baked colliders: " + s.message());
+    }
+    for (const BodyMapPose& pose : asset.body_maps.poses) {
+      BodyMapCollider maps;
+      if (Status s = maps.Build(pose); !s.ok()) {
+        return Status(s.code(),
+                      input + ": the runtime refuses the baked body maps: " + s.message());
+      }
+    }
   }
   timings["validate_ms"] = MillisecondsSince(start);
   report["timings"] = timings;

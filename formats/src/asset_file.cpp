@@ -42,16 +42,6 @@ uint64_t GetU64(const uint8_t* in) {
   return v;
 }
 
-// A read-only stream over caller-owned bytes (no copy of a possibly large payload).
-class SpanBuffer : public std::streambuf {
- public:
-  SpanBuffer(const uint8_t* data, size_t size) {
-    char* begin = const_cast<char*>(reinterpret_cast<const char*>(data));
-    setg(begin, begin, begin + size);
-  }
-  size_t consumed() const { return static_cast<size_t>(gptr() - eback()); }
-};
-
 Status Error(StatusCode code, const std::string& name, const std::string& reason) {
   return Status(code, name + ": " + reason);
 }
@@ -169,9 +159,9 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
   }
 
   CharacterAsset decoded;
-  SpanBuffer buffer(payload.data(), payload.size());
+  detail::SpanBuffer buffer(payload.data(), payload.size());
   std::istream stream(&buffer);
-  detail::g_max_elements = payload_size;
+  detail::g_decoding = &buffer;
   std::string failure;
   try {
     cereal::PortableBinaryInputArchive archive(
@@ -186,7 +176,7 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
   } catch (const std::length_error&) {
     failure = "payload does not decode: a count is too large";
   }
-  detail::g_max_elements = UINT64_MAX;
+  detail::g_decoding = nullptr;
   if (!failure.empty()) return Error(StatusCode::kCorrupt, name, failure);
   if (buffer.consumed() != payload.size()) {
     return Error(StatusCode::kCorrupt, name,

@@ -13,6 +13,22 @@ namespace {
 bool IsFinite(const Float3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
+// Rotations are applied without renormalising, so they must be unit length.
+bool IsUnit(const Quat& q) {
+  const double n = double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z + double(q.w) * q.w;
+  return std::isfinite(n) && std::fabs(n - 1.0) <= 2e-3;
+}
+bool IsUnit(const Float3& v) {
+  const double n = double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z;
+  return std::isfinite(n) && std::fabs(n - 1.0) <= 2e-3;
+}
+float Dot3(const Float3& a, const Float3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+// Beyond this magnitude products of two coordinates overflow float (1e19^2 > 3.4e38).
+constexpr float kMaxCoordinate = 1e18f;
+bool IsSane(const Float3& v) {
+  return IsFinite(v) && std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
+         std::fabs(v.z) <= kMaxCoordinate;
+}
 
 class Checker {
  public:
@@ -84,16 +100,17 @@ void CheckSkeleton(const SkeletonData& s, Checker& c) {
         !c.Finite(s.rest_local[j].scale, "skeleton.rest_local" + at + ".scale") ||
         !c.Finite(s.inverse_bind[j], "skeleton.inverse_bind" + at))
       return;
-    const Quat q = s.rest_local[j].rotation;
-    if (!c.Require(
-            std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w),
-            "skeleton.rest_local" + at + ".rotation", "is not finite"))
+    if (!c.Require(IsUnit(s.rest_local[j].rotation), "skeleton.rest_local" + at + ".rotation",
+                   "is not a finite unit quaternion") ||
+        !c.Require(IsSane(s.rest_local[j].translation) && IsSane(s.rest_local[j].scale),
+                   "skeleton.rest_local" + at, "has a translation or scale beyond 1e18"))
       return;
   }
 }
 
 void CheckClip(const ClipData& clip, size_t index, size_t joints, Checker& c) {
   const std::string at = "clips[" + std::to_string(index) + "]";
+  if (!c.Require(!clip.name.empty(), at + ".name", "is empty")) return;
   if (!c.Require(clip.duration >= 0.f && std::isfinite(clip.duration), at + ".duration",
                  "is negative or not finite") ||
       !c.Require(
@@ -113,14 +130,10 @@ void CheckClip(const ClipData& clip, size_t index, size_t joints, Checker& c) {
     return;
   for (size_t k = 0; k < clip.keys.size(); ++k) {
     const Transform& t = clip.keys[k];
-    if (IsFinite(t.translation) && IsFinite(t.scale) && std::isfinite(t.rotation.x) &&
-        std::isfinite(t.rotation.y) && std::isfinite(t.rotation.z) && std::isfinite(t.rotation.w))
-      continue;
+    if (IsSane(t.translation) && IsSane(t.scale) && IsUnit(t.rotation)) continue;
     const std::string key = at + ".keys[" + std::to_string(k) + "]";
-    if (!c.Finite(t.translation, key + ".translation") || !c.Finite(t.scale, key + ".scale") ||
-        !c.Finite(Float3{t.rotation.x, t.rotation.y, t.rotation.z}, key + ".rotation") ||
-        !c.Finite(t.rotation.w, key + ".rotation.w"))
-      return;
+    c.Require(false, key, "is not finite, beyond 1e18, or its rotation is not a unit quaternion");
+    return;
   }
 }
 
@@ -167,8 +180,9 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
         !c.Require(
             pose.width >= 1 && pose.height >= 1 && pose.width <= 16384 && pose.height <= 16384, at,
             "size is not in [1, 16384] texels") ||
-        !c.Require(std::isfinite(pose.texel_size) && pose.texel_size > 0.f, at + ".texel_size",
-                   "is not > 0") ||
+        !c.Require(
+            std::isfinite(pose.texel_size) && pose.texel_size >= 1e-6f && pose.texel_size <= 1e3f,
+            at + ".texel_size", "is not in [1e-6, 1e3] m") ||
         !c.Require(std::isfinite(pose.depth_range) && pose.depth_range > 0.f, at + ".depth_range",
                    "is not > 0") ||
         !c.Finite(pose.origin_x, at + ".origin_x") || !c.Finite(pose.origin_y, at + ".origin_y") ||
@@ -195,9 +209,9 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
                   at + ".normal_rgb8_" + v))
         return;
       for (size_t i = 0; i < pose.depth_f32[view].size(); ++i)
-        if (std::isnan(pose.depth_f32[view][i]) &&
-            !c.Require(!std::isnan(pose.depth_f32[view][i]),
-                       at + ".depth_f32_" + v + "[" + std::to_string(i) + "]", "is NaN"))
+        if (!(pose.depth_f32[view][i] >= 0.f) &&
+            !c.Require(false, at + ".depth_f32_" + v + "[" + std::to_string(i) + "]",
+                       "is NaN or negative"))
           return;
       for (size_t i = 0; i < pose.normal_f32[view].size(); ++i)
         if (!std::isfinite(pose.normal_f32[view][i]) &&
@@ -265,7 +279,7 @@ void CheckHull(const HullColliderData& h, size_t index, size_t joints, Checker& 
       return;
   for (size_t i = 0; i < h.planes.size(); ++i) {
     const std::string p = at + ".planes[" + std::to_string(i) + "]";
-    if (!c.Finite(h.planes[i].normal, p + ".normal") ||
+    if (!c.Require(IsUnit(h.planes[i].normal), p + ".normal", "is not a finite unit vector") ||
         !c.Finite(h.planes[i].offset, p + ".offset"))
       return;
   }
@@ -273,7 +287,15 @@ void CheckHull(const HullColliderData& h, size_t index, size_t joints, Checker& 
       !c.Finite(h.obb.half_extents, at + ".obb.half_extents") ||
       !c.Finite(h.obb.axes[0], at + ".obb.axes[0]") ||
       !c.Finite(h.obb.axes[1], at + ".obb.axes[1]") ||
-      !c.Finite(h.obb.axes[2], at + ".obb.axes[2]"))
+      !c.Finite(h.obb.axes[2], at + ".obb.axes[2]") ||
+      !c.Require(IsUnit(h.obb.axes[0]) && IsUnit(h.obb.axes[1]) && IsUnit(h.obb.axes[2]) &&
+                     std::fabs(Dot3(h.obb.axes[0], h.obb.axes[1])) <= 2e-3f &&
+                     std::fabs(Dot3(h.obb.axes[1], h.obb.axes[2])) <= 2e-3f &&
+                     std::fabs(Dot3(h.obb.axes[0], h.obb.axes[2])) <= 2e-3f,
+                 at + ".obb.axes", "are not orthonormal") ||
+      !c.Require(
+          h.obb.half_extents.x >= 0.f && h.obb.half_extents.y >= 0.f && h.obb.half_extents.z >= 0.f,
+          at + ".obb.half_extents", "are negative"))
     return;
   CheckHierarchy(h.upper, h.planes.size(), at + ".upper", c);
   CheckHierarchy(h.lower, h.planes.size(), at + ".lower", c);

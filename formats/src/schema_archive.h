@@ -10,6 +10,7 @@
 #include <cereal/types/string.hpp>
 #include <cstdint>
 #include <stdexcept>
+#include <streambuf>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -25,9 +26,54 @@ struct DecodeError : std::runtime_error {
 
 namespace detail {
 
-// Upper bound on any element count while decoding: the payload size in bytes (every element
-// takes at least one byte). Set by the decoder for the current thread.
-inline thread_local uint64_t g_max_elements = UINT64_MAX;
+// The payload stream being decoded on this thread, so array and string loads can bound their
+// counts by the bytes that are actually left before they allocate anything. Set by the decoder.
+class SpanBuffer : public std::streambuf {
+ public:
+  SpanBuffer(const uint8_t* data, size_t size) {
+    char* begin = const_cast<char*>(reinterpret_cast<const char*>(data));
+    setg(begin, begin, begin + size);
+  }
+  size_t consumed() const { return static_cast<size_t>(gptr() - eback()); }
+  size_t remaining() const { return static_cast<size_t>(egptr() - gptr()); }
+};
+inline thread_local const SpanBuffer* g_decoding = nullptr;
+
+// Fewest payload bytes one element of T can take when encoded: a count of n elements needs at
+// least n times this many bytes, which is checked before the vector is allocated.
+template <class T>
+constexpr size_t MinEncodedBytes() {
+  if constexpr (std::is_arithmetic_v<T> || std::is_same_v<T, Float3> || std::is_same_v<T, Quat> ||
+                std::is_same_v<T, Mat34> || std::is_same_v<T, Plane> ||
+                std::is_same_v<T, Transform>) {
+    return sizeof(T);
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return sizeof(cereal::size_type);  // the length
+  } else {
+    // A struct of this schema: at least its class version and one array length.
+    return sizeof(uint32_t) + sizeof(cereal::size_type);
+  }
+}
+
+inline void CheckCount(uint64_t count, size_t element_bytes) {
+  if (g_decoding == nullptr) return;  // not decoding a payload (e.g. JSON)
+  const uint64_t available = g_decoding->remaining();
+  if (count > available / element_bytes) {
+    throw DecodeError("an array of " + std::to_string(count) + " elements of at least " +
+                      std::to_string(element_bytes) + " bytes exceeds the " +
+                      std::to_string(available) + " payload bytes left");
+  }
+}
+
+// Strings through the same bound (cereal's own loader would resize to any length it reads).
+template <class Archive>
+void LoadString(Archive& ar, std::string& text) {
+  cereal::size_type length = 0;
+  ar(cereal::make_size_tag(length));
+  CheckCount(length, 1);
+  text.resize(static_cast<size_t>(length));
+  ar(cereal::binary_data(text.data(), text.size()));
+}
 
 inline void CheckVersion(uint32_t version, uint32_t known, const char* type) {
   if (version != known) {
@@ -59,11 +105,11 @@ template <class Archive, class T>
 void LoadArray(Archive& ar, std::vector<T>& values) {
   cereal::size_type count = 0;
   ar(cereal::make_size_tag(count));
-  if (count > g_max_elements) {
-    throw DecodeError("array of " + std::to_string(count) + " elements exceeds the payload size");
-  }
+  CheckCount(count, MinEncodedBytes<T>());
   values.resize(static_cast<size_t>(count));
-  if constexpr (std::is_arithmetic_v<T>) {
+  if constexpr (std::is_same_v<T, std::string>) {
+    for (T& v : values) LoadString(ar, v);
+  } else if constexpr (std::is_arithmetic_v<T>) {
     ar(cereal::binary_data(values.data(), values.size() * sizeof(T)));
   } else if constexpr (kIsFlatFloats<T>) {
     ar(cereal::binary_data(reinterpret_cast<float*>(values.data()), values.size() * sizeof(T)));
@@ -117,6 +163,15 @@ template <class Archive, class T>
 void load(Archive& ar, ArrayRef<T>& ref) {
   detail::LoadArray(ar, *ref.values);
 }
+template <class Archive>
+void Text(Archive& ar, const char* name, std::string& text) {
+  if constexpr (Archive::is_loading::value) {
+    detail::LoadString(ar, text);
+  } else {
+    ar(cereal::make_nvp(name, text));
+  }
+}
+
 template <class Archive, class T>
 void Array(Archive& ar, const char* name, std::vector<T>& values) {
   ArrayRef<T> ref{&values};
@@ -126,10 +181,11 @@ void Array(Archive& ar, const char* name, std::vector<T>& values) {
 template <class Archive>
 void serialize(Archive& ar, AssetInfo& info, const uint32_t version) {
   detail::CheckVersion(version, 1, "AssetInfo");
-  ar(cereal::make_nvp("source_name", info.source_name),
-     cereal::make_nvp("tool_version", info.tool_version),
-     cereal::make_nvp("unit_scale", info.unit_scale), cereal::make_nvp("up_axis", info.up_axis),
-     cereal::make_nvp("source_to_asset", info.source_to_asset));
+  Text(ar, "source_name", info.source_name);
+  Text(ar, "tool_version", info.tool_version);
+  ar(cereal::make_nvp("unit_scale", info.unit_scale));
+  Text(ar, "up_axis", info.up_axis);
+  ar(cereal::make_nvp("source_to_asset", info.source_to_asset));
 }
 
 template <class Archive>
@@ -144,8 +200,8 @@ void serialize(Archive& ar, SkeletonData& s, const uint32_t version) {
 template <class Archive>
 void serialize(Archive& ar, ClipData& c, const uint32_t version) {
   detail::CheckVersion(version, 1, "ClipData");
-  ar(cereal::make_nvp("name", c.name), cereal::make_nvp("duration", c.duration),
-     cereal::make_nvp("sample_rate", c.sample_rate),
+  Text(ar, "name", c.name);
+  ar(cereal::make_nvp("duration", c.duration), cereal::make_nvp("sample_rate", c.sample_rate),
      cereal::make_nvp("frame_count", c.frame_count));
   Array(ar, "keys", c.keys);
 }

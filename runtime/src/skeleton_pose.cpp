@@ -12,6 +12,14 @@ Status SkeletonPose::Init(const SkeletonData& skeleton) {
   if (skeleton.rest_local.size() != n || skeleton.inverse_bind.size() != n) {
     return Status(StatusCode::kInvalidArgument, "skeleton arrays have different lengths");
   }
+  // Hand-built skeletons skip the file validator: parents must precede their children.
+  for (size_t j = 0; j < n; ++j) {
+    if (skeleton.parents[j] < -1 || skeleton.parents[j] >= static_cast<int32_t>(j)) {
+      return Status(StatusCode::kInvalidArgument, "skeleton parent of joint " + std::to_string(j) +
+                                                      " is " + std::to_string(skeleton.parents[j]) +
+                                                      ", not -1 or an earlier joint");
+    }
+  }
   skeleton_ = &skeleton;
   local_.assign(n, Transform{});
   world_.assign(n, Mat34{});
@@ -39,6 +47,10 @@ Status SkeletonPose::SampleClip(const ClipData& clip, float time, bool loop) {
                   "clip '" + clip.name + "' does not match the skeleton");
   }
   if (!std::isfinite(time)) return Status(StatusCode::kInvalidArgument, "clip time is not finite");
+  if (!(clip.sample_rate > 0.f && std::isfinite(clip.sample_rate)) || !(clip.duration >= 0.f)) {
+    return Status(StatusCode::kInvalidArgument,
+                  "clip '" + clip.name + "' has a bad rate or duration");
+  }
   if (loop && clip.duration > 0.f) {
     time = std::fmod(time, clip.duration);
     if (time < 0.f) time += clip.duration;

@@ -7,6 +7,8 @@
 #include <string>
 
 #include "drape/formats/asset_file.h"
+#include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/hull_collider.h"
 #include "drape/runtime/skeleton_pose.h"
 
 namespace {
@@ -173,7 +175,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "drape-inspect: error: %s\n", status.message().c_str());
     return 1;
   }
-  // Prove the runtime can pose what it loaded: every clip's first frame.
+  // Prove the runtime can use what it loaded: pose every clip's first frame...
   drape::SkeletonPose pose;
   if (drape::Status status = pose.Init(asset.skeleton); !status.ok()) {
     std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
@@ -185,6 +187,22 @@ int main(int argc, char** argv) {
                    status.message().c_str());
       return 1;
     }
+  }
+  // And its colliders: a file that loads but that the runtime would refuse is reported here.
+  for (size_t p = 0; p < asset.body_maps.poses.size(); ++p) {
+    drape::BodyMapCollider maps;
+    if (drape::Status status = maps.Build(asset.body_maps.poses[p]); !status.ok()) {
+      std::fprintf(stderr, "drape-inspect: error: %s: body map pose %zu: %s\n", path.c_str(), p,
+                   status.message().c_str());
+      return 1;
+    }
+  }
+  drape::HullColliderSet hulls;
+  if (drape::Status status =
+          hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
+      !status.ok()) {
+    std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
+    return 1;
   }
   if (dump) {
     std::fputs(drape::AssetToJson(asset).c_str(), stdout);

@@ -80,9 +80,23 @@ Status LoadOrBakeAsset(const bake::Scene& scene, const std::string& directory, S
   if (Status s = bake::ApplySceneToBakeConfig(scene, &config); !s.ok()) return s;
   std::string hash;
   if (Status s = HashFile(scene.character, &hash); !s.ok()) return s;
+  // The bake code is linked into this program: a rebuilt drape-sim may bake differently (the
+  // format version does not change for that), so its own size and time are part of the key.
+  std::string tool_build = DRAPE_VERSION_STRING;
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const auto size = std::filesystem::file_size(self, error);
+    const auto time = std::filesystem::last_write_time(self, error);
+    if (!error) {
+      tool_build +=
+          " " + std::to_string(size) + " " + std::to_string(time.time_since_epoch().count());
+    }
+  }
   const json key = {{"character_fnv1a64", hash},
                     {"bake_config", bake::BakeConfigToJson(config)},
-                    {"format_version", kAssetFormatVersion}};
+                    {"format_version", kAssetFormatVersion},
+                    {"tool_build", tool_build}};
 
   const std::string drape_path = directory + "/character.drape";
   const std::string key_path = directory + "/character.bake.json";

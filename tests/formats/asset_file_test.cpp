@@ -60,6 +60,9 @@ CharacterAsset SmallAsset() {
   hull.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   hull.triangles = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
   hull.triangle_planes = {0, 1, 2, 3};
+  hull.obb.axes[0] = {1, 0, 0};
+  hull.obb.axes[1] = {0, 1, 0};
+  hull.obb.axes[2] = {0, 0, 1};
   hull.planes = {
       {{0, 0, -1}, 0}, {{0, -1, 0}, 0}, {{-1, 0, 0}, 0}, {{0.577f, 0.577f, 0.577f}, 0.578f}};
   hull.upper.vertices_uv = {0, 0, 1, 0, 0, 1};
@@ -201,6 +204,16 @@ TEST(AssetFile, OutOfRangeIndicesAreRefusedWithTheField) {
   CharacterAsset parents = SmallAsset();
   parents.skeleton.parents[1] = 2;
   EXPECT_NE(ValidateAsset(parents).message().find("skeleton.parents[1] = 2"), std::string::npos);
+  CharacterAsset skewed = SmallAsset();
+  skewed.skeleton.rest_local[1].rotation = {0.f, 0.f, 0.f, 2.f};
+  EXPECT_NE(ValidateAsset(skewed).message().find("not a finite unit quaternion"),
+            std::string::npos);
+  CharacterAsset tiny = SmallAsset();
+  tiny.body_maps.poses[0].texel_size = 1e-30f;  // 1 / texel_size would be infinite
+  EXPECT_NE(ValidateAsset(tiny).message().find("texel_size is not in"), std::string::npos);
+  CharacterAsset flat = SmallAsset();
+  flat.hulls[0].obb.axes[1] = {1, 0, 0};
+  EXPECT_NE(ValidateAsset(flat).message().find("obb.axes are not orthonormal"), std::string::npos);
   CharacterAsset dup = SmallAsset();
   dup.skeleton.joint_names[2] = "root";
   EXPECT_NE(ValidateAsset(dup).message().find("'root' is a duplicate"), std::string::npos);
@@ -212,12 +225,17 @@ TEST(AssetFile, HugeCountWithValidChecksumDoesNotAllocate) {
   // endianness byte and two uint32 class versions (CharacterAsset, AssetInfo).
   const size_t at = kAssetHeaderSize + 1 + 4 + 4;
   ASSERT_EQ(bytes[at], 10);  // strlen("small.gltf")
-  for (int i = 0; i < 8; ++i) bytes[at + i] = 0xFF;
-  FixChecksums(bytes);
-  CharacterAsset out;
-  const Status s = DecodeAsset(bytes, "huge.drape", &out);
-  EXPECT_FALSE(s.ok());
-  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  // Lengths a resize would accept (16 GiB, 1 GiB) and one it would refuse (2^64 - 1): each must
+  // be refused by the bound on the bytes left, before anything is allocated.
+  for (uint64_t length : {uint64_t{1} << 34, uint64_t{1} << 30, ~uint64_t{0}}) {
+    std::vector<uint8_t> bad = bytes;
+    for (int i = 0; i < 8; ++i) bad[at + i] = static_cast<uint8_t>(length >> (8 * i));
+    FixChecksums(bad);
+    CharacterAsset out;
+    const Status s = DecodeAsset(bad, "huge.drape", &out);
+    EXPECT_EQ(s.code(), StatusCode::kCorrupt) << length;
+    EXPECT_NE(s.message().find("payload bytes left"), std::string::npos) << s.message();
+  }
 }
 
 TEST(AssetFile, WriterLeavesNoPartialFile) {

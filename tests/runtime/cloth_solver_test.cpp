@@ -639,9 +639,9 @@ TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
   verlet.drag = 0.5f;
   verlet.wind = {1.f, 0.f, 0.f};
   uint32_t contacts = 0;
-  const ClothState one = RunSheetScene(cloth, verlet, 1, 8, &contacts);
+  const ClothState one = RunSheetScene(cloth, verlet, 1, 6, &contacts);
   EXPECT_GT(contacts, 100u);  // the sheet reached the sphere
-  ExpectBitwiseEqual(one, RunSheetScene(cloth, verlet, 2, 8));
+  ExpectBitwiseEqual(one, RunSheetScene(cloth, verlet, 2, 6));
 
   // The same sheet with its particles numbered in a shuffled order (a fixed permutation): most
   // springs are then "far" (between distant index chunks) and take the coloured path.
@@ -658,9 +658,9 @@ TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
   Cloth shuffled_cloth;
   ASSERT_TRUE(BuildCloth(shuffled, &shuffled_cloth).ok());
   contacts = 0;
-  const ClothState shuffled_one = RunSheetScene(shuffled_cloth, verlet, 1, 8, &contacts);
+  const ClothState shuffled_one = RunSheetScene(shuffled_cloth, verlet, 1, 6, &contacts);
   EXPECT_GT(contacts, 100u);
-  ExpectBitwiseEqual(shuffled_one, RunSheetScene(shuffled_cloth, verlet, 2, 8));
+  ExpectBitwiseEqual(shuffled_one, RunSheetScene(shuffled_cloth, verlet, 2, 6));
 
   d = SheetDescription(71, 1.2f, {0.f, 0.305f, 0.f});
   d.density = 3.f;
@@ -673,9 +673,9 @@ TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
   euler.drag = 0.5f;
   euler.wind = {1.f, 0.f, 0.f};
   contacts = 0;
-  const ClothState euler_one = RunSheetScene(heavy, euler, 1, 3, &contacts);
+  const ClothState euler_one = RunSheetScene(heavy, euler, 1, 2, &contacts);
   EXPECT_GT(contacts, 100u);
-  ExpectBitwiseEqual(euler_one, RunSheetScene(heavy, euler, 2, 3));
+  ExpectBitwiseEqual(euler_one, RunSheetScene(heavy, euler, 2, 2));
 }
 
 // The SSE spring kernel and the scalar reference kernel give the same bits (same operations in
