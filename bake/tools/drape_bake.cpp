@@ -21,27 +21,6 @@ int Fail(const std::string& message) {
   return 1;
 }
 
-// Writes next to `path` and renames, so a failure leaves nothing at `path`.
-drape::Status WriteTextAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      return drape::Status(drape::StatusCode::kIoError, path + ": cannot write");
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    return drape::Status(drape::StatusCode::kIoError, path + ": cannot rename: " + error.message());
-  }
-  return drape::Status::Ok();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -104,7 +83,8 @@ int main(int argc, char** argv) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   // Report first (atomically), then the asset: a failure at either step leaves no asset behind.
   if (!report_path.empty()) {
-    if (drape::Status s = WriteTextAtomically(report_path, result.report.dump(2) + "\n"); !s.ok()) {
+    if (drape::Status s = drape::WriteFileAtomically(report_path, result.report.dump(2) + "\n");
+        !s.ok()) {
       return Fail(s.message());
     }
   }

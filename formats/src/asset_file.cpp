@@ -190,17 +190,12 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
   return Status::Ok();
 }
 
-Status WriteAssetFile(const std::string& path, const CharacterAsset& asset) {
-  std::vector<uint8_t> bytes;
-  if (Status encoded = EncodeAsset(asset, &bytes); !encoded.ok()) {
-    return Error(encoded.code(), path, encoded.message());
-  }
+Status WriteFileAtomically(const std::string& path, std::string_view bytes) {
   const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     if (!out) return Error(StatusCode::kIoError, path, "cannot open for writing");
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     out.flush();
     if (!out) {
       out.close();
@@ -216,6 +211,14 @@ Status WriteAssetFile(const std::string& path, const CharacterAsset& asset) {
                  "cannot rename the temporary file: " + error.message());
   }
   return Status::Ok();
+}
+
+Status WriteAssetFile(const std::string& path, const CharacterAsset& asset) {
+  std::vector<uint8_t> bytes;
+  if (Status encoded = EncodeAsset(asset, &bytes); !encoded.ok()) {
+    return Error(encoded.code(), path, encoded.message());
+  }
+  return WriteFileAtomically(path, {reinterpret_cast<const char*>(bytes.data()), bytes.size()});
 }
 
 Status ReadAssetFile(const std::string& path, CharacterAsset* asset) {

@@ -37,7 +37,8 @@ struct Segment {
   drape::Float3 p0, p1;
 };
 
-bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows, std::string* error) {
+bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows,
+              std::string* error) {
   std::ifstream in(path);
   if (!in) {
     *error = path + ": cannot open";
@@ -56,8 +57,8 @@ bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows
     if (values.empty()) continue;
     const size_t expected = segments ? 6 : 3;
     if (values.size() != expected) {
-      *error = path + ":" + std::to_string(number) + ": expected " + std::to_string(expected) + " numbers, got " +
-               std::to_string(values.size());
+      *error = path + ":" + std::to_string(number) + ": expected " + std::to_string(expected) +
+               " numbers, got " + std::to_string(values.size());
       return false;
     }
     auto f = [&](size_t k) { return static_cast<float>(values[k]); };
@@ -73,9 +74,9 @@ void PrintRow(size_t row, const char* method, const drape::ContactQuery& q, cons
   drape::Float3 position = s.p1;
   drape::Float3 velocity = s.p1 - s.p0;
   if (q.contact) drape::ApplyResponse(q, drape::ResponseParams{}, &position, &velocity);
-  std::printf("%zu,%s,%d,%d,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g\n", row, method, q.inside_end ? 1 : 0,
-              q.contact ? 1 : 0, q.t, q.point.x, q.point.y, q.point.z, q.normal.x, q.normal.y, q.normal.z, q.depth,
-              position.x, position.y, position.z);
+  std::printf("%zu,%s,%d,%d,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g\n", row, method,
+              q.inside_end ? 1 : 0, q.contact ? 1 : 0, q.t, q.point.x, q.point.y, q.point.z,
+              q.normal.x, q.normal.y, q.normal.z, q.depth, position.x, position.y, position.z);
 }
 
 }  // namespace
@@ -117,7 +118,8 @@ int main(int argc, char** argv) {
       path = a;
     }
   }
-  if (path.empty() || (points_path.empty() == segments_path.empty() && mesh_path.empty())) return Usage();
+  if (path.empty() || (points_path.empty() == segments_path.empty() && mesh_path.empty()))
+    return Usage();
   if (method != "maps" && method != "hulls" && method != "spheres" && method != "all") {
     return Fail("--method '" + method + "' is not maps, hulls, spheres or all");
   }
@@ -139,21 +141,25 @@ int main(int argc, char** argv) {
 
   if (!mesh_path.empty()) {
     std::vector<drape::Float3> posed(asset.mesh.vertex_count());
-    if (drape::Status s = drape::SkinMesh(asset.mesh, pose.skinning(), posed); !s.ok()) return Fail(s.message());
-    std::ofstream obj(mesh_path);
-    obj << "# posed body mesh of " << path << (clip_name.empty() ? " (rest pose)" : " clip " + clip_name) << "\n";
+    if (drape::Status s = drape::SkinMesh(asset.mesh, pose.skinning(), posed); !s.ok())
+      return Fail(s.message());
+    std::ostringstream obj;
+    obj << "# posed body mesh of " << path
+        << (clip_name.empty() ? " (rest pose)" : " clip " + clip_name) << "\n";
     for (const drape::Float3& p : posed) obj << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
     for (size_t t = 0; t + 2 < asset.mesh.triangles.size(); t += 3) {
       obj << "f " << asset.mesh.triangles[t] + 1 << ' ' << asset.mesh.triangles[t + 1] + 1 << ' '
           << asset.mesh.triangles[t + 2] + 1 << '\n';
     }
-    if (!obj) return Fail(mesh_path + ": cannot write");
+    if (drape::Status s = drape::WriteFileAtomically(mesh_path, obj.str()); !s.ok())
+      return Fail(s.message());
   }
   if (points_path.empty() && segments_path.empty()) return 0;
 
   std::vector<Segment> rows;
   std::string error;
-  if (!ReadRows(points_path.empty() ? segments_path : points_path, !segments_path.empty(), &rows, &error)) {
+  if (!ReadRows(points_path.empty() ? segments_path : points_path, !segments_path.empty(), &rows,
+                &error)) {
     return Fail(error);
   }
 
@@ -170,7 +176,8 @@ int main(int argc, char** argv) {
     }
     if (best == nullptr) {
       if (method == "maps") {
-        return Fail(path + ": no body maps baked for " + (clip_name.empty() ? "the rest pose" : "clip '" + clip_name + "'"));
+        return Fail(path + ": no body maps baked for " +
+                    (clip_name.empty() ? "the rest pose" : "clip '" + clip_name + "'"));
       }
     } else if (drape::Status s = maps.Build(*best); !s.ok()) {
       return Fail(path + ": " + s.message());
@@ -178,10 +185,13 @@ int main(int argc, char** argv) {
   }
   drape::HullColliderSet hulls;
   if (want_hulls || want_spheres) {
-    if (drape::Status s = hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count()); !s.ok()) {
+    if (drape::Status s =
+            hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
+        !s.ok()) {
       return Fail(path + ": " + s.message());
     }
-    if (drape::Status s = hulls.SetPose(pose.skinning(), pose.skinning()); !s.ok()) return Fail(path + ": " + s.message());
+    if (drape::Status s = hulls.SetPose(pose.skinning(), pose.skinning()); !s.ok())
+      return Fail(path + ": " + s.message());
   }
 
   std::printf("row,method,inside,contact,t,px,py,pz,nx,ny,nz,depth,x_after,y_after,z_after\n");

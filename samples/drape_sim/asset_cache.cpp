@@ -27,26 +27,6 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
   return true;
 }
 
-Status WriteTextAtomically(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      return Status(StatusCode::kIoError, path + ": cannot write");
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    return Status(StatusCode::kIoError, path + ": cannot rename: " + error.message());
-  }
-  return Status::Ok();
-}
-
 }  // namespace
 
 Status HashFile(const std::string& path, std::string* hex) {
@@ -137,8 +117,8 @@ Status LoadOrBakeAsset(const bake::Scene& scene, const std::string& directory, S
   std::remove(key_path.c_str());
   if (Status s = WriteAssetFile(drape_path, out->asset); !s.ok()) return s;
   const json record = {{"character", scene.character}, {"key", key}};
-  if (Status s = WriteTextAtomically(key_path, record.dump(2) + "\n"); !s.ok()) return s;
-  if (Status s = WriteTextAtomically(directory + "/bake_report.json", out->report.dump(2) + "\n");
+  if (Status s = WriteFileAtomically(key_path, record.dump(2) + "\n"); !s.ok()) return s;
+  if (Status s = WriteFileAtomically(directory + "/bake_report.json", out->report.dump(2) + "\n");
       !s.ok())
     return s;
   return Status::Ok();

@@ -25,6 +25,7 @@
 
 #include "asset_cache.h"
 #include "drape/bake/scene.h"
+#include "drape/formats/asset_file.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skinning.h"
 #include "renderer.h"
@@ -194,7 +195,7 @@ struct FrameRenderer {
 
 Status WriteObj(const std::string& path, std::span<const Float3> positions,
                 std::span<const uint32_t> triangles) {
-  std::ofstream out(path, std::ios::trunc);
+  std::ostringstream out;
   out << "# drape-sim cloth, metres, asset frame (+Y up)\n";
   char line[96];
   for (const Float3& p : positions) {
@@ -205,17 +206,11 @@ Status WriteObj(const std::string& path, std::span<const Float3> positions,
   for (size_t t = 0; t + 2 < triangles.size(); t += 3)
     out << "f " << triangles[t] + 1 << ' ' << triangles[t + 1] + 1 << ' ' << triangles[t + 2] + 1
         << '\n';
-  out.flush();
-  if (!out) return Status(StatusCode::kIoError, path + ": cannot write");
-  return Status::Ok();
+  return WriteFileAtomically(path, out.str());
 }
 
 Status WriteText(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc);
-  out << text;
-  out.flush();
-  if (!out) return Status(StatusCode::kIoError, path + ": cannot write");
-  return Status::Ok();
+  return WriteFileAtomically(path, text);
 }
 
 // Removes the outputs of an earlier run that this run would not overwrite (a longer run's extra

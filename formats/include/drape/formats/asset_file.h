@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drape/formats/character_asset.h"
@@ -25,6 +26,8 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
 
 // Writes to "path.tmp-<pid>" and renames, so a failed write leaves no partial file at `path`.
 Status WriteAssetFile(const std::string& path, const CharacterAsset& asset);
+// The same for any bytes (reports, meshes, keys): all or nothing at `path`.
+Status WriteFileAtomically(const std::string& path, std::string_view bytes);
 Status ReadAssetFile(const std::string& path, CharacterAsset* asset);
 
 // Checks every count, index and value range the runtime relies on. Returns a message naming the
