@@ -911,6 +911,16 @@ ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
         SampleSlab(walk.hit_ci, walk.hit_cj, u, v, &top, &bottom);
       }
       back = walk.hit_z - bottom < top - walk.hit_z;
+      // The wall point belongs to the entered texel, whose slab contains it: a particle put there
+      // (plus separation along the mostly-z map normal) would still test inside. Step back across
+      // the wall by a thousandth of a texel, into the texel the segment came from.
+      const float dx = q1.x - q0.x, dy = q1.y - q0.y;
+      const float length = std::sqrt(dx * dx + dy * dy);
+      if (length > 0.f) {
+        const float back_off = 1e-3f * texel_size_ / length;
+        result.point.x -= dx * back_off;
+        result.point.y -= dy * back_off;
+      }
     }
     result.normal = normal_at(walk.hit_ci, walk.hit_cj, u, v, back);
     return result;
