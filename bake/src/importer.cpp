@@ -440,12 +440,15 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
       scale_source = "format default (metres)";
     }
     const double extent = rest_box.isEmpty() ? 0.0 : rest_box.sizes().maxCoeff() * scale;
-    if (extent > 20000.0) {
-      scale *= 0.001;
-      scale_source += ", then x0.001: the body would be " + Fmt(extent) + " m tall (taken as mm)";
-    } else if (extent > 20.0) {
-      scale *= 0.01;
-      scale_source += ", then x0.01: the body would be " + Fmt(extent) + " m tall (taken as cm)";
+    // A body beyond 20 m is taken to be in cm or mm: whichever brings it nearest (in ratio) to
+    // a person's 1.7 m. Characters between 5 cm and 20 m are left as they are.
+    if (extent > 20.0) {
+      const double cm = extent * 0.01, mm = extent * 0.001;
+      const bool millimetres = std::fabs(std::log(mm / 1.7)) < std::fabs(std::log(cm / 1.7));
+      scale *= millimetres ? 0.001 : 0.01;
+      scale_source += std::string(", then x") + (millimetres ? "0.001" : "0.01") +
+                      ": the body would be " + Fmt(extent) + " m tall (taken as " +
+                      (millimetres ? "mm" : "cm") + ")";
     }
   }
   const double extent_m = rest_box.isEmpty() ? 0.0 : rest_box.sizes().maxCoeff() * scale;
