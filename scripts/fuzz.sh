@@ -8,7 +8,7 @@ seconds=${1:-60}
 cmake -S tests/fuzz -B build-fuzz -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build-fuzz -j "${DRAPE_JOBS:-2}" >/dev/null
 status=0
-for pair in asset_decode:asset bake_config:config; do
+for pair in asset_decode:asset bake_config:config scene_parse:scene; do
   name=${pair%%:*} seeds=tests/fuzz/corpus/${pair##*:}
   corpus=$(mktemp -d)
   cp "$seeds"/* "$corpus"/
