@@ -1581,7 +1581,7 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
   uint32_t contacts = 0;
   // Small batches stay on the calling thread: waking a team costs more than it saves, and on a
   // loaded machine far more (measured: a 961-particle sheet 25x slower with 2 threads).
-#pragma omp parallel for schedule(static) reduction(+ : contacts) if (count > 4096)
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : contacts) if (count > 4096)
   for (int64_t i = 0; i < count; ++i) {
     const size_t k = static_cast<size_t>(i);
     if (!IsFinite(previous[k]) || !IsFinite(positions[k]) || !IsFinite(velocities[k])) {
