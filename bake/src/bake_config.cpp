@@ -38,19 +38,25 @@ Parameter MakeNumber(std::string section, std::string key, std::string unit, dou
   return p;
 }
 
+// A float parameter is range-checked in float: a value at a bound (0.1 m) is stored as the float
+// nearest to it (0.100000001), and that stored value must pass the check again when the config is
+// written back out and re-read (found by the config fuzzer).
 Parameter MakeFloat(std::string section, std::string key, std::string unit, double lo, double hi,
                     bool lo_open, std::string description,
                     std::function<float&(BakeConfig&)> field) {
-  auto holder = std::make_shared<double>();
-  Parameter p =
-      MakeNumber(std::move(section), std::move(key), std::move(unit), lo, hi, lo_open,
-                 std::move(description), [holder](BakeConfig&) -> double& { return *holder; });
+  Parameter p = MakeNumber(std::move(section), std::move(key), std::move(unit), lo, hi, lo_open,
+                           std::move(description), nullptr);
   p.get = [field](const BakeConfig& c) { return json(field(const_cast<BakeConfig&>(c))); };
-  auto check = p.set;
-  p.set = [check, holder, field](const json& v, BakeConfig& c) -> std::string {
-    std::string why = check(v, c);
-    if (why.empty()) field(c) = static_cast<float>(*holder);
-    return why;
+  p.set = [field, lo, hi, lo_open, range = p.range](const json& v, BakeConfig& c) -> std::string {
+    if (!v.is_number()) return "must be a number";
+    const double x = v.get<double>();
+    const float f = static_cast<float>(x);
+    const float flo = static_cast<float>(lo), fhi = static_cast<float>(hi);
+    if (!std::isfinite(x) || !std::isfinite(f) || f > fhi || f < flo || (lo_open && f == flo)) {
+      return "must be in " + range;
+    }
+    field(c) = f;
+    return "";
   };
   return p;
 }
