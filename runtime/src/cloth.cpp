@@ -1,5 +1,7 @@
 #include "drape/runtime/cloth.h"
 
+#include "spring_colouring.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -51,36 +53,15 @@ struct Pair {
   bool operator==(const Pair& o) const { return lo == o.lo && hi == o.hi; }
 };
 
-// First-fit greedy colouring in spring order: each spring takes the smallest colour neither of
-// its particles has yet (per-particle bitsets: O(springs * colours / 64)). Deterministic, and at
-// most 2 * max_valence - 1 colours. Appends the springs grouped by colour (spring order kept
-// within a colour, which keeps their particles close in memory) and the colour ranges; returns
-// the colour count.
+// Colours the springs (detail::FirstFitColours) and appends the springs grouped by colour (spring
+// order kept within a colour, which keeps their particles close in memory) and the colour ranges;
+// returns the colour count.
 uint32_t ColourSprings(const std::vector<ClothSpring>& springs, SpringKind kind,
                        uint32_t particle_count, std::vector<ClothSpring>* out,
                        std::vector<SpringColour>* colours) {
   std::vector<std::vector<uint64_t>> used(particle_count);
-  std::vector<uint32_t> colour_of(springs.size());
-  uint32_t colour_count = 0;
-  for (size_t k = 0; k < springs.size(); ++k) {
-    const std::vector<uint64_t>& ua = used[springs[k].a];
-    const std::vector<uint64_t>& ub = used[springs[k].b];
-    uint32_t colour = 0;
-    for (size_t w = 0;; ++w) {
-      const uint64_t taken = (w < ua.size() ? ua[w] : 0) | (w < ub.size() ? ub[w] : 0);
-      if (taken != ~uint64_t{0}) {
-        colour = static_cast<uint32_t>(64 * w + std::countr_one(taken));
-        break;
-      }
-    }
-    for (const uint32_t p : {springs[k].a, springs[k].b}) {
-      std::vector<uint64_t>& bits = used[p];
-      if (bits.size() <= colour / 64) bits.resize(colour / 64 + 1, 0);
-      bits[colour / 64] |= uint64_t{1} << (colour % 64);
-    }
-    colour_of[k] = colour;
-    colour_count = std::max(colour_count, colour + 1);
-  }
+  std::vector<uint32_t> colour_of;
+  const uint32_t colour_count = detail::FirstFitColours(springs, &used, &colour_of);
   std::vector<uint32_t> sizes(colour_count, 0);
   for (const uint32_t c : colour_of) ++sizes[c];
   const uint32_t base = static_cast<uint32_t>(out->size());
@@ -352,4 +333,38 @@ bool ClothState::Matches(const Cloth& cloth) const {
   return positions.size() == n && previous_positions.size() == n && velocities.size() == n;
 }
 
+namespace detail {
+
+uint32_t FirstFitColours(std::span<const ClothSpring> springs,
+                         std::vector<std::vector<uint64_t>>* used,
+                         std::vector<uint32_t>* colour_of) {
+  colour_of->assign(springs.size(), 0);
+  uint32_t count = 0;
+  for (size_t k = 0; k < springs.size(); ++k) {
+    const std::vector<uint64_t>& ua = (*used)[springs[k].a];
+    const std::vector<uint64_t>& ub = (*used)[springs[k].b];
+    uint32_t colour = 0;
+    for (size_t w = 0;; ++w) {
+      const uint64_t taken = (w < ua.size() ? ua[w] : 0) | (w < ub.size() ? ub[w] : 0);
+      if (taken != ~uint64_t{0}) {
+        colour = static_cast<uint32_t>(64 * w + std::countr_one(taken));
+        break;
+      }
+    }
+    for (const uint32_t p : {springs[k].a, springs[k].b}) {
+      std::vector<uint64_t>& bits = (*used)[p];
+      if (bits.size() <= colour / 64) bits.resize(colour / 64 + 1, 0);
+      bits[colour / 64] |= uint64_t{1} << (colour % 64);
+    }
+    (*colour_of)[k] = colour;
+    count = std::max(count, colour + 1);
+  }
+  for (const ClothSpring& spring : springs) {
+    std::fill((*used)[spring.a].begin(), (*used)[spring.a].end(), 0);
+    std::fill((*used)[spring.b].begin(), (*used)[spring.b].end(), 0);
+  }
+  return count;
+}
+
+}  // namespace detail
 }  // namespace drape

@@ -1,5 +1,7 @@
 #include "drape/runtime/cloth_solver.h"
 
+#include "spring_colouring.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -173,39 +175,6 @@ void PackBlocks(const std::vector<ClothSpring>& springs, uint32_t spare,
   }
 }
 
-// First-fit colouring of `springs` (in order): each takes the smallest colour neither of its
-// particles has yet. `used` holds one bitset per particle, all zero on entry and on return.
-uint32_t FirstFitColours(std::span<const ClothSpring> springs,
-                         std::vector<std::vector<uint64_t>>* used,
-                         std::vector<uint32_t>* colour_of) {
-  colour_of->assign(springs.size(), 0);
-  uint32_t count = 0;
-  for (size_t k = 0; k < springs.size(); ++k) {
-    const std::vector<uint64_t>& ua = (*used)[springs[k].a];
-    const std::vector<uint64_t>& ub = (*used)[springs[k].b];
-    uint32_t colour = 0;
-    for (size_t w = 0;; ++w) {
-      const uint64_t taken = (w < ua.size() ? ua[w] : 0) | (w < ub.size() ? ub[w] : 0);
-      if (taken != ~uint64_t{0}) {
-        colour = static_cast<uint32_t>(64 * w + std::countr_one(taken));
-        break;
-      }
-    }
-    for (const uint32_t p : {springs[k].a, springs[k].b}) {
-      std::vector<uint64_t>& bits = (*used)[p];
-      if (bits.size() <= colour / 64) bits.resize(colour / 64 + 1, 0);
-      bits[colour / 64] |= uint64_t{1} << (colour % 64);
-    }
-    (*colour_of)[k] = colour;
-    count = std::max(count, colour + 1);
-  }
-  for (const ClothSpring& spring : springs) {
-    std::fill((*used)[spring.a].begin(), (*used)[spring.a].end(), 0);
-    std::fill((*used)[spring.b].begin(), (*used)[spring.b].end(), 0);
-  }
-  return count;
-}
-
 // Paper A's spring force on lane k of a block: F_a = (k (L - R) + c (v_b - v_a).u) u, F_b = -F_a,
 // or nothing while the buckling model keeps the spring inactive.
 template <SpringSide side>
@@ -347,7 +316,7 @@ void ClothSolver::BuildSpringGroups(const Cloth& cloth) {
   // (they are solved one after the other, by one thread or with a barrier between them).
   const auto add_runs = [&](std::vector<ClothSpring>& springs, SpringKind kind, uint32_t group) {
     std::sort(springs.begin(), springs.end(), by_index);
-    by_colour.assign(FirstFitColours(springs, &used, &colour_of), {});
+    by_colour.assign(detail::FirstFitColours(springs, &used, &colour_of), {});
     for (size_t k = 0; k < springs.size(); ++k) by_colour[colour_of[k]].push_back(springs[k]);
     for (const std::vector<ClothSpring>& colour : by_colour) {
       SpringRun run;
