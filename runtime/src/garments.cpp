@@ -164,4 +164,13 @@ Status MakeSleeve(const SleeveShape& s, GarmentMesh* mesh) {
   return Status::Ok();
 }
 
+ClothDescription DescribeAttachedGarment(const GarmentMesh& mesh, int32_t joint) {
+  ClothDescription description;
+  description.positions = mesh.positions;
+  description.triangles = mesh.triangles;
+  for (const uint32_t p : mesh.held)
+    description.attachments.push_back({p, joint, mesh.positions[p]});
+  return description;
+}
+
 }  // namespace drape

@@ -32,11 +32,8 @@ int main(int argc, char** argv) {
   shape.top_center = {root.m[3], root.m[7] + 0.03f, root.m[11]};
   shape.top_radius = 0.19f;
   drape::GarmentMesh mesh;
-  drape::ClothDescription description;
   if (!Check(drape::MakeSkirt(shape, &mesh))) return 1;
-  description.positions = mesh.positions;
-  description.triangles = mesh.triangles;
-  for (uint32_t p : mesh.held) description.attachments.push_back({p, 0, mesh.positions[p]});
+  drape::ClothDescription description = drape::DescribeAttachedGarment(mesh, 0);
   drape::Cloth cloth;
   drape::ClothSolver solver;
   drape::ClothSolverSettings settings = drape::ClothSolverSettings::PaperB();

@@ -45,11 +45,8 @@ void WalkInSkirt(const CharacterAsset& asset, float dt, float seconds, RunResult
   shape.rings = 16;
   GarmentMesh skirt;
   ASSERT_TRUE(MakeSkirt(shape, &skirt).ok());
-  ClothDescription description;
-  description.positions = skirt.positions;
-  description.triangles = skirt.triangles;
+  ClothDescription description = DescribeAttachedGarment(skirt, hips);
   description.density = 0.15f;
-  for (uint32_t p : skirt.held) description.attachments.push_back({p, hips, skirt.positions[p]});
   Cloth cloth;
   ASSERT_TRUE(BuildCloth(description, &cloth).ok());
   ClothState state;

@@ -141,10 +141,7 @@ struct Scene {
     shape.rings = 100;
     GarmentMesh mesh;
     if (!MakeSkirt(shape, &mesh).ok()) std::abort();
-    ClothDescription d;
-    d.positions = mesh.positions;
-    d.triangles = mesh.triangles;
-    for (const uint32_t p : mesh.held) d.attachments.push_back({p, 0, mesh.positions[p]});
+    ClothDescription d = DescribeAttachedGarment(mesh, 0);
     s = BuildCloth(d, &cloth);
     if (!s.ok()) {
       std::fprintf(stderr, "cloth: %s\n", s.message().c_str());

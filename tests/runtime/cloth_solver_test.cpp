@@ -224,10 +224,7 @@ TEST(ClothSolver, CapeFollowsMovingJoint) {
   shape.rows = 24;
   GarmentMesh mesh;
   ASSERT_TRUE(MakeCape(shape, &mesh).ok());
-  ClothDescription d;
-  d.positions = mesh.positions;
-  d.triangles = mesh.triangles;
-  for (const uint32_t p : mesh.held) d.attachments.push_back({p, 0, mesh.positions[p]});
+  ClothDescription d = DescribeAttachedGarment(mesh, 0);
   Cloth cloth;
   ASSERT_TRUE(BuildCloth(d, &cloth).ok());
   EXPECT_EQ(cloth.kinematic_particles().size(), 17u);
@@ -305,10 +302,7 @@ TEST(ClothSolver, RelativeSimulationRemovesRootTranslation) {
   shape.length = 0.6f;
   GarmentMesh mesh;
   ASSERT_TRUE(MakeCape(shape, &mesh).ok());
-  ClothDescription d;
-  d.positions = mesh.positions;
-  d.triangles = mesh.triangles;
-  for (const uint32_t p : mesh.held) d.attachments.push_back({p, 0, mesh.positions[p]});
+  ClothDescription d = DescribeAttachedGarment(mesh, 0);
   Cloth cloth;
   ASSERT_TRUE(BuildCloth(d, &cloth).ok());
   const float dt = 1.f / 60.f;

@@ -10,6 +10,7 @@
 
 #include "drape/formats/status.h"
 #include "drape/formats/types.h"
+#include "drape/runtime/cloth.h"
 
 namespace drape {
 
@@ -72,5 +73,10 @@ Status MakeSheet(const SheetShape& shape, GarmentMesh* mesh);
 Status MakeSkirt(const SkirtShape& shape, GarmentMesh* mesh);
 Status MakeCape(const CapeShape& shape, GarmentMesh* mesh);
 Status MakeSleeve(const SleeveShape& shape, GarmentMesh* mesh);
+
+// The garment as a cloth: its positions and triangles, and its held particles attached to
+// `joint` at their current positions, read as the bind-pose asset frame (place the garment in
+// the bind pose first). Masses, materials and pins keep the description's defaults.
+ClothDescription DescribeAttachedGarment(const GarmentMesh& mesh, int32_t joint);
 
 }  // namespace drape
