@@ -1489,12 +1489,150 @@ uint32_t HullColliderSet::BroadPhase(Float3 p0, Float3 p1, float s0, float s1, b
   return kept;
 }
 
+namespace {
+
+// The contact planes one particle has been pushed out through in one ResolveParticle call, as
+// half-spaces n . x >= d (d = n . contact point + separation). Each is a supporting plane of its
+// collider (a hull face plane, or a sphere's tangent plane), so a point on the outer side of all
+// of them is outside every collider that produced one. Re-imposing them after each response is
+// what stops a particle pinched between overlapping colliders (armpit, crotch, a skirt between
+// the thighs at a large step) from being pushed out of one collider into the other and back.
+class ContactPlanes {
+ public:
+  void Add(Float3 normal, float offset) {
+    if (count_ == kMax) {  // keep the newest: shift the oldest out
+      for (uint32_t i = 1; i < kMax; ++i) planes_[i - 1] = planes_[i];
+      --count_;
+    }
+    planes_[count_++] = {normal, offset};
+  }
+  uint32_t count() const { return count_; }
+
+  // Moves *x to the nearest point on the outer side of every plane, by an active-set solve in
+  // double over at most three planes (the nearest point of a polyhedral region in 3D lies on at
+  // most three of its faces). Leaves *x unchanged and returns false when the violated planes have
+  // no common solution (they face each other: the particle is pinched with no room).
+  bool Enforce(Float3* x) const {
+    const double x0[3] = {x->x, x->y, x->z};
+    double p[3] = {x0[0], x0[1], x0[2]};
+    uint32_t active[3];
+    uint32_t active_count = 0;
+    for (uint32_t round = 0; round < kMax; ++round) {
+      // The most violated plane not yet active.
+      uint32_t worst = kMax;
+      double worst_violation = 1e-9;  // metres
+      for (uint32_t i = 0; i < count_; ++i) {
+        bool is_active = false;
+        for (uint32_t k = 0; k < active_count; ++k) is_active |= active[k] == i;
+        const double v = Offset(i) - Dot3(i, p);
+        if (!is_active && v > worst_violation) {
+          worst = i;
+          worst_violation = v;
+        }
+      }
+      if (worst == kMax) break;
+      if (active_count == 3) return false;
+      active[active_count++] = worst;
+      // p = x0 + sum_j lambda_j n_j with n_k . p = d_k for the active planes: G lambda = r.
+      double g[3][3], r[3], lambda[3] = {0.0, 0.0, 0.0};
+      for (uint32_t a = 0; a < active_count; ++a) {
+        for (uint32_t b = 0; b < active_count; ++b) g[a][b] = DotNormals(active[a], active[b]);
+        r[a] = Offset(active[a]) - Dot3(active[a], x0);
+      }
+      if (!Solve(g, r, active_count, lambda)) return false;
+      // A negative multiplier: that plane holds without being pushed on; drop it and re-solve.
+      for (uint32_t a = 0; a < active_count;) {
+        if (lambda[a] < 0.0 && active_count > 1) {
+          for (uint32_t b = a + 1; b < active_count; ++b) active[b - 1] = active[b];
+          --active_count;
+          for (uint32_t c = 0; c < active_count; ++c) {
+            for (uint32_t d = 0; d < active_count; ++d) g[c][d] = DotNormals(active[c], active[d]);
+            r[c] = Offset(active[c]) - Dot3(active[c], x0);
+          }
+          if (!Solve(g, r, active_count, lambda)) return false;
+          a = 0;
+          continue;
+        }
+        ++a;
+      }
+      for (int k = 0; k < 3; ++k) {
+        p[k] = x0[k];
+        for (uint32_t a = 0; a < active_count; ++a) p[k] += lambda[a] * Component(active[a], k);
+      }
+    }
+    for (uint32_t i = 0; i < count_; ++i) {
+      if (Offset(i) - Dot3(i, p) > 1e-7) return false;  // not reached: infeasible
+    }
+    *x = Float3{static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])};
+    // Rounding to float can leave a plane a few ulps short: nudge out along it.
+    for (uint32_t i = 0; i < count_; ++i) {
+      const Float3 n = planes_[i].normal;
+      for (int tries = 0; tries < 4 && Dot(n, *x) < planes_[i].offset; ++tries) {
+        const float push = std::max(planes_[i].offset - Dot(n, *x), 1e-7f);
+        *x = *x + n * push;
+      }
+    }
+    return true;
+  }
+
+ private:
+  static constexpr uint32_t kMax = 4;
+  struct HalfSpace {
+    Float3 normal;
+    float offset;
+  };
+  double Offset(uint32_t i) const { return planes_[i].offset; }
+  double Component(uint32_t i, int k) const {
+    const Float3 n = planes_[i].normal;
+    return k == 0 ? n.x : (k == 1 ? n.y : n.z);
+  }
+  double Dot3(uint32_t i, const double q[3]) const {
+    return Component(i, 0) * q[0] + Component(i, 1) * q[1] + Component(i, 2) * q[2];
+  }
+  double DotNormals(uint32_t i, uint32_t j) const {
+    return Component(i, 0) * Component(j, 0) + Component(i, 1) * Component(j, 1) +
+           Component(i, 2) * Component(j, 2);
+  }
+  // Gaussian elimination with partial pivoting on an n x n system, n <= 3. False when singular
+  // (parallel or dependent planes).
+  static bool Solve(double g[3][3], double r[3], uint32_t n, double out[3]) {
+    double a[3][4];
+    for (uint32_t i = 0; i < n; ++i) {
+      for (uint32_t j = 0; j < n; ++j) a[i][j] = g[i][j];
+      a[i][3] = r[i];
+    }
+    for (uint32_t col = 0; col < n; ++col) {
+      uint32_t pivot = col;
+      for (uint32_t row = col + 1; row < n; ++row) {
+        if (std::fabs(a[row][col]) > std::fabs(a[pivot][col])) pivot = row;
+      }
+      if (std::fabs(a[pivot][col]) < 1e-9) return false;
+      if (pivot != col) {
+        for (uint32_t j = 0; j < 4; ++j) std::swap(a[pivot][j], a[col][j]);
+      }
+      for (uint32_t row = 0; row < n; ++row) {
+        if (row == col) continue;
+        const double f = a[row][col] / a[col][col];
+        for (uint32_t j = col; j < 4; ++j) a[row][j] -= f * a[col][j];
+      }
+    }
+    for (uint32_t i = 0; i < n; ++i) out[i] = a[i][3] / a[i][i];
+    return true;
+  }
+
+  HalfSpace planes_[kMax];
+  uint32_t count_ = 0;
+};
+
+}  // namespace
+
 template <bool kActive>
 void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, uint8_t* flags,
                                       const ResponseParams& params, float s0, float s1) const {
   uint8_t result = kCollisionNone;
   Float3 position = *p1, vel = *velocity;
   uint32_t last_single = UINT32_MAX;  // the one collider resolved in the previous pass, if so
+  ContactPlanes planes;
   for (uint32_t pass = 0; pass < options_.gauss_seidel_passes; ++pass) {
     // Candidates for the current segment: a response may have moved the particle towards a
     // collider the original segment did not reach.
@@ -1549,6 +1687,8 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
       if (!c.contact) continue;
       ApplyResponse(c, params, &position, &vel);
       result |= static_cast<uint8_t>(kCollisionContact | c.flags);
+      planes.Add(c.normal, Dot(c.normal, c.point) + params.separation);
+      if (planes.count() > 1) planes.Enforce(&position);
     }
     last_single = hits == 1 ? candidates[order[0]] : UINT32_MAX;
   }

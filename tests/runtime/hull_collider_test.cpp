@@ -391,6 +391,41 @@ TEST(HullColliderTest, GaussSeidelLeavesParticlesOutsideTwoOverlappingBoxes) {
   }
 }
 
+// A V of two slabs crossing at 60 degrees (a thigh against a thigh, an arm against the chest): a
+// particle deep in their overlap is outside both after any number of passes, one included. Each
+// response re-imposes the supporting planes the particle was already pushed out through, so it
+// is never left in the collider it was pushed into.
+TEST(HullColliderTest, ParticlesInAWedgeOfOverlappingCollidersEndOutsideBoth) {
+  Float3 axes_a[3], axes_b[3];
+  RotatedAxes(30.0, {0.f, 0.f, 1.f}, axes_a);
+  RotatedAxes(-30.0, {0.f, 0.f, 1.f}, axes_b);
+  const HullColliderData a = MakeBox({0.04f, 0.2f, 0.05f}, {-0.05f, 0.f, 0.f}, axes_a);
+  const HullColliderData b = MakeBox({0.04f, 0.2f, 0.05f}, {0.05f, 0.f, 0.f}, axes_b);
+  for (uint32_t passes : {1u, 2u, 4u}) {
+    HullColliderOptions options;
+    options.gauss_seidel_passes = passes;
+    HullColliderSet set = BuildSet({a, b}, {}, 1, options);
+    std::mt19937 rng(17);
+    std::vector<Float3> previous, positions, velocities;
+    while (positions.size() < 4000) {
+      const Float3 p = RandomIn(rng, {-0.15f, -0.2f, -0.049f}, {0.15f, 0.2f, 0.049f});
+      if (MaxPlane(a, p) > 0.f || MaxPlane(b, p) > 0.f) continue;  // in both
+      previous.push_back(p);
+      positions.push_back(p);
+      velocities.push_back({0.f, -1.f, 0.f});
+    }
+    std::vector<uint8_t> flags(positions.size());
+    ResponseParams params;
+    params.separation = 1e-5f;
+    ASSERT_TRUE(set.CollideBatch(previous, positions, velocities, flags, params).ok());
+    for (size_t i = 0; i < positions.size(); ++i) {
+      ASSERT_GT(MaxPlane(a, positions[i]), 0.f) << "passes " << passes << ", particle " << i;
+      ASSERT_GT(MaxPlane(b, positions[i]), 0.f) << "passes " << passes << ", particle " << i;
+      EXPECT_TRUE(flags[i] & kCollisionContact);
+    }
+  }
+}
+
 std::vector<HullColliderData> SceneHulls() {
   std::vector<HullColliderData> hulls;
   for (int i = 0; i < 6; ++i) {
