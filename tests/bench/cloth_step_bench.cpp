@@ -3,17 +3,27 @@
 // joint spheres: hips, belly, thighs, knees, shins), with continuous collision and friction.
 // Arguments: OpenMP threads, substeps, colliders on (1) or off (0: the solver alone, the skirt
 // then falls freely below its waistband); 5 spring-correction iterations per substep (Verlet).
+// BM_BulletSkirt is the peer (issue #5): Bullet's soft body (tests/bench/peers) on the same skirt
+// mesh, masses and waistband, against the same 4 boxes (btConvexHullShape of their 8 corners)
+// and 16 spheres posed by the same walk, 5 position iterations per substep, single-threaded.
+// Both report the penetration of the particles into the boxes and spheres after each timed frame
+// (measured outside the timed region): max_depth_mm over all frames, frame_max_depth_mm the mean
+// of each frame's deepest particle, inside_per_frame the particles inside any collider.
 // Run: build-<name>/bin/bench_cloth_step --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <span>
 #include <vector>
+
+#include "bullet_cloth_peer.h"
 
 #include "drape/formats/hull_collider_data.h"
 #include "drape/runtime/cloth.h"
@@ -101,10 +111,11 @@ struct Scene {
   Cloth cloth;
   HullColliderSet hulls;
   size_t collider_count = 0;
+  GarmentMesh mesh;                      // the skirt the cloth was built from (for the peer)
+  std::vector<HullColliderData> boxes;   // the colliders in their bind frame (for the peer and
+  std::vector<JointSphereData> spheres;  // the penetration measure)
 
   Scene() {
-    std::vector<HullColliderData> boxes;
-    std::vector<JointSphereData> spheres;
     const auto sphere = [&](int32_t joint, Float3 c, float r) {
       JointSphereData s;
       s.joint = joint;
@@ -139,7 +150,6 @@ struct Scene {
     shape.length = 0.6f;
     shape.segments = 100;
     shape.rings = 100;
-    GarmentMesh mesh;
     if (!MakeSkirt(shape, &mesh).ok()) std::abort();
     ClothDescription d = DescribeAttachedGarment(mesh, 0);
     s = BuildCloth(d, &cloth);
@@ -154,6 +164,61 @@ Scene& GetScene() {
   static Scene scene;
   return scene;
 }
+
+// Penetration of the particles into the posed boxes and spheres (the colliders themselves, not
+// the solvers' margins): the deepest particle (metres, 0 when none is inside) and how many are
+// inside any collider. Brute force over particles x colliders (about 1 ms for the skirt).
+struct Penetration {
+  float max_depth = 0.f;
+  uint32_t inside = 0;
+};
+Penetration MeasurePenetration(const Scene& scene, const Mat34 skinning[kJoints],
+                               std::span<const Float3> positions) {
+  std::vector<Mat34> box_inverse;  // world -> box frame
+  for (const HullColliderData& box : scene.boxes)
+    box_inverse.push_back(InverseRigid(Multiply(skinning[box.joint], box.bind_frame)));
+  std::vector<Float3> sphere_centres;
+  for (const JointSphereData& sphere : scene.spheres)
+    sphere_centres.push_back(TransformPoint(skinning[sphere.joint], sphere.center));
+  Penetration result;
+  for (const Float3 p : positions) {
+    float depth = 0.f;  // deepest over the colliders containing p
+    for (size_t b = 0; b < scene.boxes.size(); ++b) {
+      const Obb& obb = scene.boxes[b].obb;  // axis-aligned in the box frame (BoxHull)
+      const Float3 q = TransformPoint(box_inverse[b], p) - obb.center;
+      const float inside_by =
+          std::min({obb.half_extents.x - std::abs(q.x), obb.half_extents.y - std::abs(q.y),
+                    obb.half_extents.z - std::abs(q.z)});
+      depth = std::max(depth, inside_by);
+    }
+    for (size_t s = 0; s < scene.spheres.size(); ++s)
+      depth = std::max(depth, scene.spheres[s].radius - Length(p - sphere_centres[s]));
+    if (depth > 0.f) {
+      ++result.inside;
+      result.max_depth = std::max(result.max_depth, depth);
+    }
+  }
+  return result;
+}
+
+// Accumulates Penetration over the timed frames and writes the counters.
+struct PenetrationCounters {
+  float max_depth = 0.f;
+  double sum_frame_max = 0.0, sum_inside = 0.0;
+  int frames = 0;
+  void Add(const Penetration& p) {
+    max_depth = std::max(max_depth, p.max_depth);
+    sum_frame_max += p.max_depth;
+    sum_inside += p.inside;
+    ++frames;
+  }
+  void Report(benchmark::State& state) const {
+    const double n = frames > 0 ? frames : 1;
+    state.counters["max_depth_mm"] = 1000.0 * max_depth;
+    state.counters["frame_max_depth_mm"] = 1000.0 * sum_frame_max / n;
+    state.counters["inside_per_frame"] = sum_inside / n;
+  }
+};
 
 void BM_ClothStep(benchmark::State& state) {
   const int threads = static_cast<int>(state.range(0));
@@ -194,14 +259,19 @@ void BM_ClothStep(benchmark::State& state) {
     if (!advance()) return;  // one second: the skirt settles onto the legs
   contacts = 0;
   int timed = 0;
+  PenetrationCounters penetration;
   for (auto _ : state) {
     if (!advance()) return;
     ++timed;
+    state.PauseTiming();
+    penetration.Add(MeasurePenetration(scene, end, cloth_state.positions));
+    state.ResumeTiming();
   }
   state.counters["particles"] = static_cast<double>(scene.cloth.particle_count());
   state.counters["springs"] = static_cast<double>(scene.cloth.springs().size());
   state.counters["colliders"] = static_cast<double>(scene.collider_count);
   state.counters["contacts_per_frame"] = timed > 0 ? static_cast<double>(contacts) / timed : 0.0;
+  penetration.Report(state);
 }
 BENCHMARK(BM_ClothStep)
     ->ArgNames({"threads", "substeps", "colliders"})
@@ -211,6 +281,102 @@ BENCHMARK(BM_ClothStep)
     ->Args({2, 2, 1})
     ->Args({1, 1, 0})
     ->Args({2, 1, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The same frame in Bullet. Mapping of the drape settings: the same particle masses (inverse
+// mass 0 for the waistband, driven to hips * bind position), stretch links with full correction
+// (kLST 1) and Bullet's distance-2 bending links with drape's bend correction (kLST 0.2), the
+// velocity damping of 0.2 1/s as kDP = 1 - exp(-0.2 h) per substep of h seconds, friction 0.3
+// (kDF), contact hardness 1 (kKHR: Bullet's 0.1 lets the cloth sink through), soft body margin
+// 2 mm, a 5 mm SDF voxel. Argument: substeps.
+void BM_BulletSkirt(benchmark::State& state) {
+  Scene& scene = GetScene();
+  const uint32_t substeps = static_cast<uint32_t>(state.range(0));
+  peers::BulletClothSetup setup;
+  setup.positions = scene.mesh.positions;
+  setup.triangles = scene.mesh.triangles;
+  const std::span<const float> inverse_masses = scene.cloth.inverse_masses();
+  setup.inverse_masses.assign(inverse_masses.begin(), inverse_masses.end());
+  setup.iterations = 5;
+  setup.substeps = substeps;
+  setup.damping = 1.f - std::exp(-0.2f * kFrame / static_cast<float>(substeps));
+  setup.friction = 0.3f;
+  setup.stretch_stiffness = scene.cloth.material(SpringKind::kStretch).correction;
+  setup.bend_stiffness = scene.cloth.material(SpringKind::kBend).correction;
+  std::vector<peers::BulletHullShape> hulls;
+  for (const HullColliderData& box : scene.boxes) hulls.push_back({box.vertices});
+  std::vector<float> radii;
+  for (const JointSphereData& sphere : scene.spheres) radii.push_back(sphere.radius);
+  peers::BulletClothPeer peer;
+  Status s = peer.Build(setup, hulls, radii);
+  if (!s.ok()) {
+    state.SkipWithError(s.message().c_str());
+    return;
+  }
+  // The attached particles in index order (Cloth::attachments() is sorted by particle) and
+  // their bind positions: their targets are skinning(joint) * bind_position.
+  const std::span<const ClothAttachment> attachments = scene.cloth.attachments();
+  if (attachments.size() != peer.attached_count()) {
+    state.SkipWithError("attachments and zero inverse masses differ");
+    return;
+  }
+  Mat34 skinning[kJoints];
+  std::vector<Mat34> hull_world(scene.boxes.size());
+  std::vector<Float3> sphere_centres(scene.spheres.size()), targets(attachments.size());
+  std::vector<Float3> positions(peer.particle_count());
+  const auto pose = [&](int frame) {
+    WalkPose(static_cast<float>(frame) * kFrame, skinning);
+    for (size_t b = 0; b < scene.boxes.size(); ++b)
+      hull_world[b] = Multiply(skinning[scene.boxes[b].joint], scene.boxes[b].bind_frame);
+    for (size_t c = 0; c < scene.spheres.size(); ++c)
+      sphere_centres[c] = TransformPoint(skinning[scene.spheres[c].joint], scene.spheres[c].center);
+    for (size_t a = 0; a < attachments.size(); ++a)
+      targets[a] = TransformPoint(skinning[attachments[a].joint], attachments[a].bind_position);
+  };
+  pose(0);
+  s = peer.SetInitialPose(hull_world, sphere_centres);
+  int step = 0;
+  uint64_t contacts = 0;
+  const auto advance = [&]() {
+    pose(step + 1);  // the end of the frame
+    const Status st = peer.Step(hull_world, sphere_centres, targets, kFrame);
+    if (!st.ok()) {
+      state.SkipWithError(st.message().c_str());
+      return false;
+    }
+    contacts += peer.last_contact_count();
+    ++step;
+    return true;
+  };
+  if (!s.ok()) {
+    state.SkipWithError(s.message().c_str());
+    return;
+  }
+  for (int warm = 0; warm < 60; ++warm)
+    if (!advance()) return;
+  contacts = 0;
+  int timed = 0;
+  PenetrationCounters penetration;
+  for (auto _ : state) {
+    if (!advance()) return;
+    ++timed;
+    state.PauseTiming();
+    peer.CopyPositions(positions);
+    penetration.Add(MeasurePenetration(scene, skinning, positions));
+    state.ResumeTiming();
+  }
+  state.counters["particles"] = static_cast<double>(peer.particle_count());
+  state.counters["springs"] = static_cast<double>(peer.link_count());  // edge + bending links
+  state.counters["colliders"] = static_cast<double>(scene.collider_count);
+  // Bullet's node contacts of the last substep of each frame.
+  state.counters["contacts_per_frame"] = timed > 0 ? static_cast<double>(contacts) / timed : 0.0;
+  penetration.Report(state);
+}
+BENCHMARK(BM_BulletSkirt)
+    ->ArgNames({"substeps"})
+    ->Arg(1)
+    ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
