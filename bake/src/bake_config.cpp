@@ -200,6 +200,11 @@ const std::vector<Parameter>& Parameters() {
            {"rgb8", NormalEncoding::kRgb8}},
           "how normals are stored (rgb8 is the paper's colour encoding)",
           [](BakeConfig& c) -> NormalEncoding& { return c.maps.normal_encoding; }),
+      MakeEnum<BodyMapLayout>(
+          "maps", "layout", {{"spans", BodyMapLayout::kRowSpans}, {"dense", BodyMapLayout::kDense}},
+          "spans: store only the covered texels, as row spans; dense: the whole rectangle around "
+          "them (format version 1's layout); the runtime answers the same",
+          [](BakeConfig& c) -> BodyMapLayout& { return c.maps.layout; }),
       MakeEnum<MapRenderer>(
           "maps", "renderer", {{"cpu", MapRenderer::kCpu}, {"osmesa", MapRenderer::kOsMesa}},
           "cpu: in-house deterministic rasterizer; osmesa: the paper's GL path (llvmpipe)",

@@ -122,17 +122,20 @@ Status BakeMaps(const BakeConfig& config, const Regions& regions, const Characte
       if (Status s = WriteBodyMapPreview(pose, preview_dir, prefix); !s.ok()) return s;
     }
     asset->body_maps.poses.push_back(std::move(pose));
-    (*report)["poses"].push_back({{"pose", name},
-                                  {"resolution", config.maps.resolution},
-                                  {"window_texels", {stats.window_width, stats.window_height}},
-                                  {"stored_texels", {stats.width, stats.height}},
-                                  {"texel_size_mm", stats.texel_size_mm},
-                                  {"coverage", stats.coverage},
-                                  {"bytes", stats.bytes},
-                                  {"render_ms_front", stats.render_ms_front},
-                                  {"render_ms_back", stats.render_ms_back},
-                                  {"renderer", stats.renderer},
-                                  {"silhouette_conflicts", stats.silhouette_conflicts}});
+    (*report)["poses"].push_back(
+        {{"pose", name},
+         {"resolution", config.maps.resolution},
+         {"window_texels", {stats.window_width, stats.window_height}},
+         {"rectangle_texels", {stats.width, stats.height}},
+         {"layout", config.maps.layout == BodyMapLayout::kRowSpans ? "spans" : "dense"},
+         {"stored_texels", stats.stored_texels},
+         {"texel_size_mm", stats.texel_size_mm},
+         {"coverage", stats.coverage},
+         {"bytes", stats.bytes},
+         {"render_ms_front", stats.render_ms_front},
+         {"render_ms_back", stats.render_ms_back},
+         {"renderer", stats.renderer},
+         {"silhouette_conflicts", stats.silhouette_conflicts}});
   }
   return Status::Ok();
 }

@@ -51,6 +51,9 @@ Status ValidateOptions(const BodyMapOptions& o) {
     return Invalid("unknown normal encoding " +
                    std::to_string(static_cast<int>(o.normal_encoding)));
   }
+  if (o.layout != BodyMapLayout::kDense && o.layout != BodyMapLayout::kRowSpans) {
+    return Invalid("unknown layout " + std::to_string(static_cast<int>(o.layout)));
+  }
   if (o.renderer != MapRenderer::kCpu && o.renderer != MapRenderer::kOsMesa) {
     return Invalid("unknown renderer " + std::to_string(static_cast<int>(o.renderer)));
   }
@@ -192,7 +195,9 @@ BodyMapTexel ReadBodyMapTexel(const BodyMapPose& pose, int view, uint32_t i, uin
   BodyMapTexel texel;
   texel.depth = pose.depth_range;
   if (view < 0 || view > 1 || i >= pose.width || j >= pose.height) return texel;
-  const size_t index = static_cast<size_t>(j) * pose.width + i;
+  const int64_t stored = BodyMapTexelIndex(pose, i, j);
+  if (stored < 0) return texel;  // outside the spans: background
+  const size_t index = static_cast<size_t>(stored);
   if (pose.depth_encoding == DepthEncoding::kFloat32) {
     if (index >= pose.depth_f32[view].size()) return texel;
     texel.depth = pose.depth_f32[view][index];
@@ -455,6 +460,14 @@ Status BakeBodyMapPose(std::span<const Float3> positions, std::span<const uint32
     }
   }
 
+  // The dense maps are complete; the row-span layout keeps exactly their non-background texels.
+  if (options.layout == BodyMapLayout::kRowSpans) {
+    BodyMapPose packed;
+    status = ConvertBodyMapLayout(result, BodyMapLayout::kRowSpans, &packed);
+    if (!status.ok()) return status;
+    result = std::move(packed);
+  }
+
   if (stats != nullptr) {
     BodyMapPoseStats s;
     s.width = width;
@@ -471,6 +484,10 @@ Status BakeBodyMapPose(std::span<const Float3> positions, std::span<const uint32
                  result.normal_oct16[view].size() * sizeof(uint16_t) +
                  result.normal_rgb8[view].size() * sizeof(uint8_t);
     }
+    s.stored_texels = BodyMapStoredTexels(result);
+    s.bytes += result.row_span_offsets.size() * sizeof(uint32_t) +
+               result.span_begin.size() * sizeof(uint16_t) +
+               result.span_texel_offsets.size() * sizeof(uint32_t);
     s.render_ms_front = view_ms[0];
     s.render_ms_back = view_ms[1];
     s.renderer = renderer_name;

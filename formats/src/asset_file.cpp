@@ -126,12 +126,13 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
     return Error(StatusCode::kChecksumMismatch, name, "header checksum mismatch (corrupt header)");
   }
   const uint32_t version = GetU32(header + 8);
-  if (version != kAssetFormatVersion) {
+  if (version < kOldestAssetFormatVersion || version > kAssetFormatVersion) {
     return Error(StatusCode::kUnsupportedVersion, name,
                  "format version " + std::to_string(version) + " is " +
                      (version > kAssetFormatVersion ? "newer" : "older") +
-                     " than the version this build reads (" + std::to_string(kAssetFormatVersion) +
-                     ")");
+                     " than the versions this build reads (" +
+                     std::to_string(kOldestAssetFormatVersion) + " to " +
+                     std::to_string(kAssetFormatVersion) + ")");
   }
   const uint32_t flags = GetU32(header + 12);
   if (flags != kCurrentFlags) {
@@ -162,6 +163,7 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
   detail::SpanBuffer buffer(payload.data(), payload.size());
   std::istream stream(&buffer);
   detail::g_decoding = &buffer;
+  detail::g_format_version = version;
   std::string failure;
   try {
     cereal::PortableBinaryInputArchive archive(
@@ -177,6 +179,7 @@ Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, Char
     failure = "payload does not decode: a count is too large";
   }
   detail::g_decoding = nullptr;
+  detail::g_format_version = 0;
   if (!failure.empty()) return Error(StatusCode::kCorrupt, name, failure);
   if (buffer.consumed() != payload.size()) {
     return Error(StatusCode::kCorrupt, name,

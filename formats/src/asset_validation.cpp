@@ -1,9 +1,12 @@
 // Every count, index and value range the runtime relies on, checked once at load so the runtime
-// can index without checks. Messages name the field path and the offending value.
+// can index without checks. Messages name the field path and the offending value. Also the
+// body-map layout helpers of body_map_data.h (at the end).
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string>
+#include <utility>
 
 #include "drape/formats/asset_file.h"
 
@@ -39,6 +42,11 @@ class Checker {
   bool Require(bool condition, const std::string& field, const std::string& reason) {
     if (!condition && message_.empty()) message_ = field + " " + reason;
     return condition;
+  }
+  // A message already in the "field reason" form.
+  bool Fail(const std::string& message) {
+    if (message_.empty()) message_ = message;
+    return false;
   }
   bool Finite(float v, const std::string& field) {
     return Require(std::isfinite(v), field, "is not finite");
@@ -192,7 +200,12 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
         !c.Require(static_cast<uint8_t>(pose.normal_encoding) <= 2, at + ".normal_encoding",
                    "is unknown"))
       return;
-    const size_t texels = static_cast<size_t>(pose.width) * pose.height;
+    // The span table before any array size that depends on it (row spans: the spans' total).
+    if (const std::string problem = CheckBodyMapLayout(pose); !problem.empty()) {
+      c.Fail(at + "." + problem);
+      return;
+    }
+    const size_t texels = BodyMapStoredTexels(pose);
     const bool f32 = pose.depth_encoding == DepthEncoding::kFloat32;
     for (int view = 0; view < 2; ++view) {
       const std::string v = view == 0 ? "front" : "back";
@@ -338,6 +351,267 @@ Status ValidateAsset(const CharacterAsset& asset) {
       c.Require(std::isfinite(s.radius) && s.radius > 0.f, at + ".radius", "is not > 0");
   }
   if (c.failed()) return Status(StatusCode::kCorrupt, c.message());
+  return Status::Ok();
+}
+
+}  // namespace drape
+
+// ---------------------------------------------------------------------------------------------
+// The row-span layout of a body-map pose (body_map_data.h): checking the span table, finding a
+// texel, converting between the dense and the row-span layouts. Shared by the validator above,
+// the bake (which bakes dense and converts) and the runtime (which expands spans into its own
+// grid). Here rather than in a file of its own so that every build of the validator (the fuzz
+// targets list their sources) has it.
+
+namespace drape {
+namespace {
+
+constexpr uint16_t kUnorm16Background = 65535;
+
+std::string Count(size_t actual, size_t expected, const std::string& field,
+                  const std::string& what) {
+  return field + " has " + std::to_string(actual) + " elements, expected " + what + " = " +
+         std::to_string(expected);
+}
+
+// "" or a message when the arrays of the chosen encodings do not hold `texels` texels each.
+std::string CheckArraySizes(const BodyMapPose& p, size_t texels) {
+  const bool f32 = p.depth_encoding == DepthEncoding::kFloat32;
+  for (int view = 0; view < 2; ++view) {
+    const std::string v = view == 0 ? "front" : "back";
+    const size_t sizes[5] = {p.depth_f32[view].size(), p.depth_u16[view].size(),
+                             p.normal_f32[view].size(), p.normal_oct16[view].size(),
+                             p.normal_rgb8[view].size()};
+    const size_t expected[5] = {f32 ? texels : 0, f32 ? 0 : texels,
+                                p.normal_encoding == NormalEncoding::kFloat32 ? 3 * texels : 0,
+                                p.normal_encoding == NormalEncoding::kOct16 ? 2 * texels : 0,
+                                p.normal_encoding == NormalEncoding::kRgb8 ? 3 * texels : 0};
+    const char* names[5] = {"depth_f32_", "depth_u16_", "normal_f32_", "normal_oct16_",
+                            "normal_rgb8_"};
+    for (int k = 0; k < 5; ++k) {
+      if (sizes[k] != expected[k]) {
+        return names[k] + v + " has " + std::to_string(sizes[k]) + " elements, expected " +
+               std::to_string(expected[k]);
+      }
+    }
+  }
+  return {};
+}
+
+// Every field except the per-texel arrays and the span table.
+BodyMapPose CopyHeader(const BodyMapPose& in, BodyMapLayout layout) {
+  BodyMapPose out;
+  out.clip = in.clip;
+  out.time = in.time;
+  out.width = in.width;
+  out.height = in.height;
+  out.origin_x = in.origin_x;
+  out.origin_y = in.origin_y;
+  out.texel_size = in.texel_size;
+  out.front_z = in.front_z;
+  out.depth_range = in.depth_range;
+  out.depth_encoding = in.depth_encoding;
+  out.normal_encoding = in.normal_encoding;
+  out.layout = layout;
+  return out;
+}
+
+// Sizes the arrays of the pose's encodings for `texels` texels, all background.
+void AssignBackground(BodyMapPose& p, size_t texels) {
+  for (int view = 0; view < 2; ++view) {
+    if (p.depth_encoding == DepthEncoding::kFloat32) {
+      p.depth_f32[view].assign(texels, p.depth_range);
+    } else {
+      p.depth_u16[view].assign(texels, kUnorm16Background);
+    }
+    switch (p.normal_encoding) {
+      case NormalEncoding::kFloat32:
+        p.normal_f32[view].assign(3 * texels, 0.f);
+        break;
+      case NormalEncoding::kOct16:
+        p.normal_oct16[view].assign(2 * texels, 0);
+        break;
+      case NormalEncoding::kRgb8:
+        p.normal_rgb8[view].assign(3 * texels, 0);
+        break;
+    }
+  }
+}
+
+void CopyTexel(const BodyMapPose& src, size_t from, BodyMapPose& dst, size_t to) {
+  for (int view = 0; view < 2; ++view) {
+    if (src.depth_encoding == DepthEncoding::kFloat32) {
+      dst.depth_f32[view][to] = src.depth_f32[view][from];
+    } else {
+      dst.depth_u16[view][to] = src.depth_u16[view][from];
+    }
+    switch (src.normal_encoding) {
+      case NormalEncoding::kFloat32:
+        for (size_t c = 0; c < 3; ++c)
+          dst.normal_f32[view][3 * to + c] = src.normal_f32[view][3 * from + c];
+        break;
+      case NormalEncoding::kOct16:
+        for (size_t c = 0; c < 2; ++c)
+          dst.normal_oct16[view][2 * to + c] = src.normal_oct16[view][2 * from + c];
+        break;
+      case NormalEncoding::kRgb8:
+        for (size_t c = 0; c < 3; ++c)
+          dst.normal_rgb8[view][3 * to + c] = src.normal_rgb8[view][3 * from + c];
+        break;
+    }
+  }
+}
+
+// Depth is not background in either view (NaN counts as valid, so the validator sees it).
+bool ValidInEitherView(const BodyMapPose& p, size_t index) {
+  for (int view = 0; view < 2; ++view) {
+    if (p.depth_encoding == DepthEncoding::kFloat32) {
+      if (!(p.depth_f32[view][index] >= p.depth_range)) return true;
+    } else if (p.depth_u16[view][index] != kUnorm16Background) {
+      return true;
+    }
+  }
+  return false;
+}
+
+BodyMapPose ExpandToDense(const BodyMapPose& in) {
+  BodyMapPose out = CopyHeader(in, BodyMapLayout::kDense);
+  AssignBackground(out, static_cast<size_t>(in.width) * in.height);
+  for (uint32_t j = 0; j < in.height; ++j) {
+    for (uint32_t s = in.row_span_offsets[j]; s < in.row_span_offsets[j + 1]; ++s) {
+      const uint32_t length = in.span_texel_offsets[s + 1] - in.span_texel_offsets[s];
+      const size_t to = static_cast<size_t>(j) * in.width + in.span_begin[s];
+      for (uint32_t t = 0; t < length; ++t)
+        CopyTexel(in, in.span_texel_offsets[s] + t, out, to + t);
+    }
+  }
+  return out;
+}
+
+BodyMapPose PackRowSpans(const BodyMapPose& dense) {
+  BodyMapPose out = CopyHeader(dense, BodyMapLayout::kRowSpans);
+  const size_t width = dense.width;
+  out.row_span_offsets.reserve(dense.height + 1u);
+  out.row_span_offsets.push_back(0);
+  out.span_texel_offsets.push_back(0);
+  uint32_t stored = 0;
+  for (size_t j = 0; j < dense.height; ++j) {
+    size_t i = 0;
+    while (i < width) {
+      if (!ValidInEitherView(dense, j * width + i)) {
+        ++i;
+        continue;
+      }
+      const size_t begin = i;
+      while (i < width && ValidInEitherView(dense, j * width + i)) ++i;
+      out.span_begin.push_back(static_cast<uint16_t>(begin));  // width <= 16384 (validated)
+      stored += static_cast<uint32_t>(i - begin);
+      out.span_texel_offsets.push_back(stored);
+    }
+    out.row_span_offsets.push_back(static_cast<uint32_t>(out.span_begin.size()));
+  }
+  AssignBackground(out, stored);
+  for (size_t j = 0; j < dense.height; ++j) {
+    for (uint32_t s = out.row_span_offsets[j]; s < out.row_span_offsets[j + 1]; ++s) {
+      const uint32_t length = out.span_texel_offsets[s + 1] - out.span_texel_offsets[s];
+      const size_t from = j * width + out.span_begin[s];
+      for (uint32_t t = 0; t < length; ++t)
+        CopyTexel(dense, from + t, out, out.span_texel_offsets[s] + t);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+size_t BodyMapStoredTexels(const BodyMapPose& pose) {
+  if (pose.layout == BodyMapLayout::kDense) return static_cast<size_t>(pose.width) * pose.height;
+  return pose.span_texel_offsets.empty() ? 0 : pose.span_texel_offsets.back();
+}
+
+std::string CheckBodyMapLayout(const BodyMapPose& p) {
+  if (p.layout == BodyMapLayout::kDense) {
+    if (!p.row_span_offsets.empty() || !p.span_begin.empty() || !p.span_texel_offsets.empty())
+      return "row_span_offsets, span_begin, span_texel_offsets are not empty in the dense layout";
+    return {};
+  }
+  if (p.layout != BodyMapLayout::kRowSpans)
+    return "layout = " + std::to_string(static_cast<int>(p.layout)) + " is unknown";
+  const std::vector<uint32_t>& rows = p.row_span_offsets;
+  const std::vector<uint32_t>& texels = p.span_texel_offsets;
+  const size_t spans = p.span_begin.size();
+  if (rows.size() != static_cast<size_t>(p.height) + 1)
+    return Count(rows.size(), static_cast<size_t>(p.height) + 1, "row_span_offsets", "height + 1");
+  if (rows.front() != 0) return "row_span_offsets does not start at 0";
+  for (size_t j = 1; j < rows.size(); ++j)
+    if (rows[j] < rows[j - 1]) return "row_span_offsets[" + std::to_string(j) + "] decreases";
+  if (rows.back() != spans)
+    return "row_span_offsets ends at " + std::to_string(rows.back()) + ", expected the " +
+           std::to_string(spans) + " spans of span_begin";
+  if (texels.size() != spans + 1)
+    return Count(texels.size(), spans + 1, "span_texel_offsets", "span count + 1");
+  if (texels.front() != 0) return "span_texel_offsets does not start at 0";
+  for (size_t j = 0; j < p.height; ++j) {
+    uint64_t previous_end = 0;  // texel column where the previous span of this row ended
+    for (uint32_t s = rows[j]; s < rows[j + 1]; ++s) {
+      const std::string at = "[" + std::to_string(s) + "]";
+      if (texels[s + 1] <= texels[s])
+        return "span_texel_offsets[" + std::to_string(s + 1) +
+               "] does not increase (an empty span)";
+      const uint64_t begin = p.span_begin[s];
+      const uint64_t end = begin + (texels[s + 1] - texels[s]);
+      if (begin < previous_end)
+        return "span_begin" + at + " = " + std::to_string(begin) +
+               " is before the end of the previous span of row " + std::to_string(j) + " (" +
+               std::to_string(previous_end) + ")";
+      if (end > p.width)
+        return "span_begin" + at + " = " + std::to_string(begin) + ": the span of row " +
+               std::to_string(j) + " ends at " + std::to_string(end) + ", beyond width " +
+               std::to_string(p.width);
+      previous_end = end;
+    }
+  }
+  return {};
+}
+
+int64_t BodyMapTexelIndex(const BodyMapPose& pose, uint32_t i, uint32_t j) {
+  if (i >= pose.width || j >= pose.height) return -1;
+  if (pose.layout == BodyMapLayout::kDense) return static_cast<int64_t>(j) * pose.width + i;
+  if (static_cast<size_t>(j) + 1 >= pose.row_span_offsets.size()) return -1;
+  const auto first = pose.span_begin.begin() + pose.row_span_offsets[j];
+  const auto last = pose.span_begin.begin() + pose.row_span_offsets[j + 1];
+  const auto after = std::upper_bound(
+      first, last, i, [](uint32_t column, uint16_t begin) { return column < begin; });
+  if (after == first) return -1;
+  const size_t s = static_cast<size_t>(after - pose.span_begin.begin()) - 1;
+  const uint32_t offset = i - pose.span_begin[s];
+  if (offset >= pose.span_texel_offsets[s + 1] - pose.span_texel_offsets[s]) return -1;
+  return static_cast<int64_t>(pose.span_texel_offsets[s]) + offset;
+}
+
+Status ConvertBodyMapLayout(const BodyMapPose& in, BodyMapLayout layout, BodyMapPose* out) {
+  const auto invalid = [](const std::string& reason) {
+    return Status(StatusCode::kInvalidArgument, "ConvertBodyMapLayout: " + reason);
+  };
+  if (layout != BodyMapLayout::kDense && layout != BodyMapLayout::kRowSpans)
+    return invalid("unknown target layout");
+  if (in.depth_encoding != DepthEncoding::kFloat32 && in.depth_encoding != DepthEncoding::kUnorm16)
+    return invalid("unknown depth encoding");
+  if (in.normal_encoding != NormalEncoding::kFloat32 &&
+      in.normal_encoding != NormalEncoding::kOct16 && in.normal_encoding != NormalEncoding::kRgb8)
+    return invalid("unknown normal encoding");
+  if (layout == BodyMapLayout::kRowSpans && in.width > 65536)
+    return invalid("width " + std::to_string(in.width) + " exceeds the 65536 of span_begin");
+  if (std::string problem = CheckBodyMapLayout(in); !problem.empty()) return invalid(problem);
+  if (std::string problem = CheckArraySizes(in, BodyMapStoredTexels(in)); !problem.empty())
+    return invalid(problem);
+  if (layout == in.layout) {
+    *out = in;
+  } else if (layout == BodyMapLayout::kDense) {
+    *out = ExpandToDense(in);
+  } else {
+    *out = PackRowSpans(in);
+  }
   return Status::Ok();
 }
 

@@ -38,6 +38,9 @@ class SpanBuffer : public std::streambuf {
   size_t remaining() const { return static_cast<size_t>(egptr() - gptr()); }
 };
 inline thread_local const SpanBuffer* g_decoding = nullptr;
+// The header's format version of the payload being decoded (0 when not decoding a file), so a
+// type can refuse a class version that this format version never contained.
+inline thread_local uint32_t g_format_version = 0;
 
 // Fewest payload bytes one element of T can take when encoded: a count of n elements needs at
 // least n times this many bytes, which is checked before the vector is allocated.
@@ -79,6 +82,16 @@ inline void CheckVersion(uint32_t version, uint32_t known, const char* type) {
   if (version != known) {
     throw DecodeError(std::string("unsupported version ") + std::to_string(version) + " of " +
                       type + " (this build reads version " + std::to_string(known) + ")");
+  }
+}
+
+// For types whose older class versions are still read: [oldest, newest].
+inline void CheckVersionRange(uint32_t version, uint32_t oldest, uint32_t newest,
+                              const char* type) {
+  if (version < oldest || version > newest) {
+    throw DecodeError(std::string("unsupported version ") + std::to_string(version) + " of " +
+                      type + " (this build reads versions " + std::to_string(oldest) + " to " +
+                      std::to_string(newest) + ")");
   }
 }
 
@@ -216,9 +229,17 @@ void serialize(Archive& ar, MeshData& m, const uint32_t version) {
   Array(ar, "influence_weights", m.influence_weights);
 }
 
+// Version 1 (format version 1): always dense, no layout field and no span table. Version 2
+// (format version 2): `layout` and the span table follow normal_encoding. Writing is always
+// version 2; a version-1 pose loads as dense with an empty span table.
 template <class Archive>
 void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
-  detail::CheckVersion(version, 1, "BodyMapPose");
+  detail::CheckVersionRange(version, 1, 2, "BodyMapPose");
+  if constexpr (Archive::is_loading::value) {
+    if (version == 2 && detail::g_format_version == 1) {
+      throw DecodeError("BodyMapPose version 2 in a format version 1 file");
+    }
+  }
   ar(cereal::make_nvp("clip", p.clip), cereal::make_nvp("time", p.time),
      cereal::make_nvp("width", p.width), cereal::make_nvp("height", p.height),
      cereal::make_nvp("origin_x", p.origin_x), cereal::make_nvp("origin_y", p.origin_y),
@@ -226,6 +247,17 @@ void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
      cereal::make_nvp("depth_range", p.depth_range),
      cereal::make_nvp("depth_encoding", p.depth_encoding),
      cereal::make_nvp("normal_encoding", p.normal_encoding));
+  if (version >= 2) {
+    ar(cereal::make_nvp("layout", p.layout));
+    Array(ar, "row_span_offsets", p.row_span_offsets);
+    Array(ar, "span_begin", p.span_begin);
+    Array(ar, "span_texel_offsets", p.span_texel_offsets);
+  } else {
+    p.layout = BodyMapLayout::kDense;
+    p.row_span_offsets.clear();
+    p.span_begin.clear();
+    p.span_texel_offsets.clear();
+  }
   static const char* const kViews[2] = {"front", "back"};
   for (int view = 0; view < 2; ++view) {
     const std::string v = kViews[view];
@@ -304,7 +336,7 @@ CEREAL_CLASS_VERSION(drape::AssetInfo, 1)
 CEREAL_CLASS_VERSION(drape::SkeletonData, 1)
 CEREAL_CLASS_VERSION(drape::ClipData, 1)
 CEREAL_CLASS_VERSION(drape::MeshData, 1)
-CEREAL_CLASS_VERSION(drape::BodyMapPose, 1)
+CEREAL_CLASS_VERSION(drape::BodyMapPose, 2)  // 2: layout and span table (format 2)
 CEREAL_CLASS_VERSION(drape::BodyMapSet, 1)
 CEREAL_CLASS_VERSION(drape::KirkpatrickHierarchy, 1)
 CEREAL_CLASS_VERSION(drape::MapTableData, 1)

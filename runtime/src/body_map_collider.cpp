@@ -473,6 +473,17 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   if (sampling != DepthSampling::kNearest && sampling != DepthSampling::kBilinear) {
     return fail("unknown depth sampling");
   }
+  if (const std::string problem = CheckBodyMapLayout(pose); !problem.empty()) return fail(problem);
+  if (pose.layout != BodyMapLayout::kDense) {
+    // Row spans: expand into the dense rectangle (background outside the spans) and build from
+    // that, so both layouts of one bake give the same grid bit for bit. Setup-time memory only.
+    BodyMapPose dense;
+    if (Status expanded = ConvertBodyMapLayout(pose, BodyMapLayout::kDense, &dense);
+        !expanded.ok()) {
+      return fail(expanded.message());
+    }
+    return Build(dense, sampling);
+  }
   const size_t n = static_cast<size_t>(pose.width) * pose.height;
   const char* view_name[2] = {"front", "back"};
 

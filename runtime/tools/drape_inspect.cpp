@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <sstream>
 #include <string>
 
@@ -38,13 +39,25 @@ std::string Quote(const std::string& s) {
   return out + "\"";
 }
 
+// The format version in the file's header (bytes 8-11, little-endian); the file has already been
+// read and validated, so the header is there. 0 if it cannot be read again.
+uint32_t FileFormatVersion(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[12] = {};
+  if (!in.read(reinterpret_cast<char*>(header), sizeof(header))) return 0;
+  return uint32_t{header[8]} | uint32_t{header[9]} << 8 | uint32_t{header[10]} << 16 |
+         uint32_t{header[11]} << 24;
+}
+
 size_t PoseBytes(const drape::BodyMapPose& p) {
   size_t bytes = 0;
   for (int v = 0; v < 2; ++v) {
     bytes += p.depth_f32[v].size() * 4 + p.depth_u16[v].size() * 2 + p.normal_f32[v].size() * 4 +
              p.normal_oct16[v].size() * 2 + p.normal_rgb8[v].size();
   }
-  return bytes;
+  // The row-span table of the sparse layout (empty for dense poses).
+  return bytes + p.row_span_offsets.size() * 4 + p.span_begin.size() * 2 +
+         p.span_texel_offsets.size() * 4;
 }
 
 const char* DepthName(drape::DepthEncoding e) {
@@ -64,7 +77,7 @@ const char* NormalName(drape::NormalEncoding e) {
 
 std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path) {
   std::ostringstream o;
-  o << "{\n  \"file\": " << Quote(path) << ",\n  \"format_version\": " << drape::kAssetFormatVersion
+  o << "{\n  \"file\": " << Quote(path) << ",\n  \"format_version\": " << FileFormatVersion(path)
     << ",\n  \"source\": " << Quote(a.info.source_name)
     << ",\n  \"tool_version\": " << Quote(a.info.tool_version)
     << ",\n  \"unit_scale\": " << a.info.unit_scale << ",\n  \"up_axis\": " << Quote(a.info.up_axis)
@@ -112,7 +125,7 @@ std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path)
 
 void PrintText(const drape::CharacterAsset& a, const std::string& path) {
   std::printf("%s: drape asset, format version %u, baked by drape %s from '%s'\n", path.c_str(),
-              drape::kAssetFormatVersion, a.info.tool_version.c_str(), a.info.source_name.c_str());
+              FileFormatVersion(path), a.info.tool_version.c_str(), a.info.source_name.c_str());
   std::printf("  units: %g m per source unit, source up axis %s\n", a.info.unit_scale,
               a.info.up_axis.c_str());
   std::printf("  skeleton: %u joints\n", a.skeleton.joint_count());

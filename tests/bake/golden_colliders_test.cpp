@@ -1,5 +1,5 @@
 // Golden colliders: today's bake of the built-in mannequin against the committed file
-// tests/golden/mannequin_colliders_v1.drape, compared with tolerances (not hashes), so a change
+// tests/golden/mannequin_colliders_v2.drape, compared with tolerances (not hashes), so a change
 // of numerics that moves a surface is seen, and a change of rounding is not.
 
 #include <gtest/gtest.h>
@@ -39,7 +39,7 @@ class GoldenColliders : public ::testing::Test {
  protected:
   // One bake for the whole suite.
   static void SetUpTestSuite() {
-    const std::string golden_path = test::GoldenDir() + "/mannequin_colliders_v1.drape";
+    const std::string golden_path = test::GoldenDir() + "/mannequin_colliders_v2.drape";
     golden_status_ = ReadAssetFile(golden_path, &golden_);
     bake::BakeConfig config;
     today_status_ = bake::LoadBakeConfig(test::GoldenDir() + "/mannequin_colliders.json", &config);

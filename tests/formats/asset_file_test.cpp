@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -258,13 +259,221 @@ TEST(AssetFile, WriterLeavesNoPartialFile) {
   EXPECT_EQ(missing.code(), StatusCode::kIoError);
 }
 
-// The committed golden file of the current version loads with its known content. Every
-// truncation fails cleanly; flips are tried on every header byte and spread over the payload.
-TEST(GoldenFile, MannequinVersion1LoadsWithExpectedContent) {
-  const std::string path = test::GoldenDir() + "/mannequin_v1.drape";
-  CharacterAsset a;
-  const Status s = ReadAssetFile(path, &a);
+// --- Body-map layouts (BodyMapPose class version 2, format version 2) ------------------------
+
+// SmallAsset plus a second pose in the row-span layout: 6 x 3 texels, float32 depth and rgb8
+// normals, two spans in row 0, one in row 1, none in row 2.
+CharacterAsset SpansAsset() {
+  CharacterAsset a = SmallAsset();
+  BodyMapPose dense;
+  dense.clip = 0;
+  dense.time = 0.1f;
+  dense.width = 6;
+  dense.height = 3;
+  dense.origin_x = -0.25f;
+  dense.origin_y = 0.5f;
+  dense.texel_size = 0.125f;
+  dense.front_z = 0.5f;
+  dense.depth_range = 1.f;
+  dense.depth_encoding = DepthEncoding::kFloat32;
+  dense.normal_encoding = NormalEncoding::kRgb8;
+  const char* covered =
+      "XX.XX."
+      ".XXXX."
+      "......";  // row 0 first
+  for (int v = 0; v < 2; ++v) {
+    dense.depth_f32[v].assign(18, dense.depth_range);
+    dense.normal_rgb8[v].assign(54, 0);
+    for (size_t k = 0; k < 18; ++k) {
+      if (covered[k] != 'X') continue;
+      dense.depth_f32[v][k] = 0.25f + 0.01f * static_cast<float>(k);
+      dense.normal_rgb8[v][3 * k + 2] = v == 0 ? 255 : 0;
+      dense.normal_rgb8[v][3 * k] = static_cast<uint8_t>(100 + k);
+    }
+  }
+  BodyMapPose spans;
+  EXPECT_TRUE(ConvertBodyMapLayout(dense, BodyMapLayout::kRowSpans, &spans).ok());
+  a.body_maps.poses.push_back(spans);
+  return a;
+}
+
+TEST(BodyMapLayout, SpansAreTheMaximalRunsOfCoveredTexels) {
+  const CharacterAsset asset = SpansAsset();
+  const BodyMapPose& p = asset.body_maps.poses[1];
+  EXPECT_EQ(p.layout, BodyMapLayout::kRowSpans);
+  EXPECT_EQ(p.row_span_offsets, (std::vector<uint32_t>{0, 2, 3, 3}));
+  EXPECT_EQ(p.span_begin, (std::vector<uint16_t>{0, 3, 1}));
+  EXPECT_EQ(p.span_texel_offsets, (std::vector<uint32_t>{0, 2, 4, 8}));
+  EXPECT_EQ(BodyMapStoredTexels(p), 8u);
+  EXPECT_EQ(p.depth_f32[1].size(), 8u);
+  EXPECT_EQ(p.normal_rgb8[0].size(), 24u);
+  EXPECT_EQ(BodyMapTexelIndex(p, 4, 0), 3);   // second span of row 0, second texel
+  EXPECT_EQ(BodyMapTexelIndex(p, 2, 0), -1);  // the gap
+  EXPECT_EQ(BodyMapTexelIndex(p, 5, 1), -1);  // after the last span
+  EXPECT_EQ(BodyMapTexelIndex(p, 0, 2), -1);  // an empty row
+  EXPECT_EQ(BodyMapTexelIndex(p, 6, 0), -1);  // outside the rectangle
+  EXPECT_FLOAT_EQ(p.depth_f32[0][static_cast<size_t>(BodyMapTexelIndex(p, 3, 1))],
+                  0.25f + 0.01f * 9.f);
+  // Back to dense: background everywhere else.
+  BodyMapPose dense;
+  ASSERT_TRUE(ConvertBodyMapLayout(p, BodyMapLayout::kDense, &dense).ok());
+  EXPECT_EQ(dense.depth_f32[0].size(), 18u);
+  EXPECT_EQ(dense.depth_f32[0][2], 1.f);
+  EXPECT_FLOAT_EQ(dense.depth_f32[0][9], 0.25f + 0.01f * 9.f);
+  EXPECT_EQ(dense.normal_rgb8[0][3 * 9], 109);
+  EXPECT_TRUE(dense.row_span_offsets.empty() && dense.span_begin.empty());
+}
+
+TEST(BodyMapLayout, RoundTripKeepsBothLayouts) {
+  const CharacterAsset a = SpansAsset();
+  const std::vector<uint8_t> bytes = Encode(a);
+  CharacterAsset b;
+  const Status s = DecodeAsset(bytes, "spans.drape", &b);
   ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(AssetToJson(a), AssetToJson(b));
+  ASSERT_EQ(b.body_maps.poses.size(), 2u);
+  EXPECT_EQ(b.body_maps.poses[0].layout, BodyMapLayout::kDense);
+  EXPECT_EQ(b.body_maps.poses[0].depth_u16[1][3], 300);
+  const BodyMapPose& spans = b.body_maps.poses[1];
+  EXPECT_EQ(spans.layout, BodyMapLayout::kRowSpans);
+  EXPECT_EQ(spans.span_begin, a.body_maps.poses[1].span_begin);
+  EXPECT_EQ(spans.span_texel_offsets, a.body_maps.poses[1].span_texel_offsets);
+  EXPECT_EQ(spans.depth_f32[0], a.body_maps.poses[1].depth_f32[0]);
+  EXPECT_EQ(spans.normal_rgb8[1], a.body_maps.poses[1].normal_rgb8[1]);
+  EXPECT_EQ(Encode(b), bytes);
+  // The writer writes format version 2.
+  EXPECT_EQ(bytes[8], 2);
+  EXPECT_EQ(kAssetFormatVersion, 2u);
+}
+
+TEST(BodyMapLayout, EveryTruncationAndByteFlipOfASpansFileFailsCleanly) {
+  const std::vector<uint8_t> bytes = Encode(SpansAsset());
+  for (size_t length = 0; length < bytes.size(); ++length) {
+    CharacterAsset out;
+    const Status s = DecodeAsset({bytes.data(), length}, "cut.drape", &out);
+    ASSERT_FALSE(s.ok()) << "length " << length;
+    EXPECT_EQ(s.message().rfind("cut.drape: ", 0), 0u) << s.message();
+    EXPECT_TRUE(out.body_maps.poses.empty()) << "half-loaded at length " << length;
+  }
+  for (size_t at = 0; at < bytes.size(); ++at) {
+    for (uint8_t flip : {uint8_t{0x01}, uint8_t{0x80}, uint8_t{0xFF}}) {
+      std::vector<uint8_t> bad = bytes;
+      bad[at] ^= flip;
+      CharacterAsset out;
+      ASSERT_FALSE(DecodeAsset(bad, "flip.drape", &out).ok())
+          << "byte " << at << " ^ " << int(flip);
+    }
+  }
+}
+
+// The validator names the pose and the field of a corrupt span table; nothing crashes.
+TEST(BodyMapLayout, CorruptSpanTablesAreRefusedWithTheField) {
+  const CharacterAsset good = SpansAsset();
+  ASSERT_TRUE(ValidateAsset(good).ok()) << ValidateAsset(good).message();
+  const auto expect = [](const CharacterAsset& a, const std::string& text) {
+    const Status s = ValidateAsset(a);
+    EXPECT_FALSE(s.ok()) << text;
+    EXPECT_NE(s.message().find(text), std::string::npos) << s.message();
+    std::vector<uint8_t> bytes;
+    EXPECT_FALSE(EncodeAsset(a, &bytes).ok()) << "the writer must refuse it: " << text;
+  };
+  const std::string at = "body_maps.poses[1].";
+  CharacterAsset a = good;
+  a.body_maps.poses[1].span_begin[1] = 1;  // overlaps the first span of row 0, [0, 2)
+  expect(a, at + "span_begin[1] = 1 is before the end of the previous span of row 0 (2)");
+  a = good;
+  a.body_maps.poses[1].span_begin[2] = 3;  // [3, 7) in a row of 6
+  expect(a, at + "span_begin[2] = 3: the span of row 1 ends at 7, beyond width 6");
+  a = good;
+  a.body_maps.poses[1].row_span_offsets = {0, 2, 3};  // height 3 needs 4 entries
+  expect(a, at + "row_span_offsets has 3 elements, expected height + 1 = 4");
+  a = good;
+  a.body_maps.poses[1].row_span_offsets = {0, 3, 2, 3};
+  expect(a, at + "row_span_offsets[2] decreases");
+  a = good;
+  a.body_maps.poses[1].row_span_offsets = {1, 2, 3, 3};
+  expect(a, at + "row_span_offsets does not start at 0");
+  a = good;
+  a.body_maps.poses[1].row_span_offsets = {0, 2, 2, 2};
+  expect(a, at + "row_span_offsets ends at 2, expected the 3 spans of span_begin");
+  a = good;
+  a.body_maps.poses[1].span_texel_offsets = {0, 2, 2, 8};
+  expect(a, at + "span_texel_offsets[2] does not increase (an empty span)");
+  a = good;
+  a.body_maps.poses[1].span_texel_offsets.pop_back();
+  expect(a, at + "span_texel_offsets has 3 elements, expected span count + 1 = 4");
+  a = good;
+  a.body_maps.poses[1].span_texel_offsets = {0, 2, 4, 10};  // row 1: [1, 7)
+  expect(a, at + "span_begin[2] = 1: the span of row 1 ends at 7, beyond width 6");
+  a = good;
+  a.body_maps.poses[1].span_texel_offsets = {0, 2, 4, 7};  // 7 texels, the arrays hold 8
+  expect(a, at + "depth_f32_front has 8 elements, expected 7");
+  a = good;
+  a.body_maps.poses[1].normal_rgb8[1].pop_back();
+  expect(a, at + "normal_rgb8_back has 23 elements, expected 24");
+  a = good;
+  a.body_maps.poses[1].layout = static_cast<BodyMapLayout>(2);
+  expect(a, at + "layout = 2 is unknown");
+  a = good;
+  a.body_maps.poses[0].span_begin = {0};
+  expect(a, "body_maps.poses[0].row_span_offsets, span_begin, span_texel_offsets are not empty");
+}
+
+// Byte edits in the file with valid checksums: the loader reports the field, never crashes.
+TEST(BodyMapLayout, CorruptSpanTableInAFileIsACorruptError) {
+  const std::vector<uint8_t> bytes = Encode(SpansAsset());
+  // span_begin of pose 1 in the payload: its uint64 count 3, then 0, 3, 1 as uint16.
+  const std::vector<uint8_t> pattern = {3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 1, 0};
+  const auto found = std::search(bytes.begin(), bytes.end(), pattern.begin(), pattern.end());
+  ASSERT_NE(found, bytes.end());
+  const size_t at = static_cast<size_t>(found - bytes.begin());
+  std::vector<uint8_t> bad = bytes;
+  bad[at + 8 + 2 * 2] = 200;  // span 2 begins at column 200 of a 6-texel row
+  FixChecksums(bad);
+  CharacterAsset out;
+  Status s = DecodeAsset(bad, "bad.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("bad.drape: body_maps.poses[1].span_begin[2] = 200"),
+            std::string::npos)
+      << s.message();
+  bad = bytes;
+  bad[at] = 0xFF;  // a count of 255 spans: more than the bytes left, or a mismatched table
+  bad[at + 5] = 0xFF;
+  FixChecksums(bad);
+  s = DecodeAsset(bad, "bad.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("payload bytes left"), std::string::npos) << s.message();
+  EXPECT_TRUE(out.body_maps.poses.empty());
+}
+
+// A format version 1 file holds only class version 1: a version 2 pose under a version 1 header
+// is refused, and an older class version of BodyMapPose is read as dense (the golden files).
+TEST(BodyMapLayout, FormatVersion1HoldsOnlyDensePoses) {
+  std::vector<uint8_t> bytes = Encode(SmallAsset());
+  bytes[8] = 1;
+  FixChecksums(bytes);
+  CharacterAsset out;
+  const Status s = DecodeAsset(bytes, "v1.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("BodyMapPose version 2 in a format version 1 file"), std::string::npos)
+      << s.message();
+  // mannequin_colliders_v1.drape was written by the format version 1 writer with a body-map pose.
+  CharacterAsset golden;
+  const Status g = ReadAssetFile(test::GoldenDir() + "/mannequin_colliders_v1.drape", &golden);
+  ASSERT_TRUE(g.ok()) << g.message();
+  ASSERT_EQ(golden.body_maps.poses.size(), 1u);
+  const BodyMapPose& pose = golden.body_maps.poses[0];
+  EXPECT_EQ(pose.layout, BodyMapLayout::kDense);
+  EXPECT_TRUE(pose.row_span_offsets.empty() && pose.span_begin.empty());
+  EXPECT_EQ(BodyMapStoredTexels(pose), static_cast<size_t>(pose.width) * pose.height);
+  EXPECT_EQ(pose.depth_u16[0].size(), static_cast<size_t>(pose.width) * pose.height);
+}
+
+// The committed golden files of every format version this build reads load with their known
+// content: mannequin_v1.drape (format 1, every class at version 1) and mannequin_v2.drape
+// (format 2: BodyMapPose version 2, a row-span pose). Every truncation fails cleanly; flips are
+// tried on every header byte and spread over the payload.
+void ExpectMannequinContent(const CharacterAsset& a) {
   EXPECT_EQ(a.info.source_name, "mannequin.gltf");
   ASSERT_EQ(a.skeleton.joint_count(), 17u);
   EXPECT_EQ(a.skeleton.joint_names[0], "hips");
@@ -279,19 +488,58 @@ TEST(GoldenFile, MannequinVersion1LoadsWithExpectedContent) {
   EXPECT_FLOAT_EQ(a.info.unit_scale, 1.f);
 }
 
-TEST(GoldenFile, EveryTruncationAndSampledFlipsFail) {
-  const std::vector<uint8_t> bytes = ReadBytes(test::GoldenDir() + "/mannequin_v1.drape");
+TEST(GoldenFile, MannequinVersion1LoadsWithExpectedContent) {
+  const std::string path = test::GoldenDir() + "/mannequin_v1.drape";
+  const std::vector<uint8_t> bytes = ReadBytes(path);
   ASSERT_GT(bytes.size(), kAssetHeaderSize);
-  for (size_t length = 0; length < bytes.size(); ++length) {
-    CharacterAsset out;
-    ASSERT_FALSE(DecodeAsset({bytes.data(), length}, "golden", &out).ok()) << length;
-  }
-  const size_t stride = bytes.size() / 2000 + 1;
-  for (size_t at = 0; at < bytes.size(); at += (at < kAssetHeaderSize ? 1 : stride)) {
-    std::vector<uint8_t> bad = bytes;
-    bad[at] ^= 0x20;
-    CharacterAsset out;
-    ASSERT_FALSE(DecodeAsset(bad, "golden", &out).ok()) << "byte " << at;
+  EXPECT_EQ(bytes[8], 1) << "format version 1";
+  CharacterAsset a;
+  const Status s = ReadAssetFile(path, &a);
+  ASSERT_TRUE(s.ok()) << s.message();
+  ExpectMannequinContent(a);
+}
+
+// tests/golden/mannequin_v2.json: N = 64, no hulls. Written once by the format version 2 writer;
+// never regenerated (a later format gets a file of its own beside it).
+TEST(GoldenFile, MannequinVersion2LoadsWithExpectedContent) {
+  const std::string path = test::GoldenDir() + "/mannequin_v2.drape";
+  const std::vector<uint8_t> bytes = ReadBytes(path);
+  ASSERT_GT(bytes.size(), kAssetHeaderSize);
+  EXPECT_EQ(bytes[8], 2) << "format version 2";
+  CharacterAsset a;
+  const Status s = ReadAssetFile(path, &a);
+  ASSERT_TRUE(s.ok()) << s.message();
+  ExpectMannequinContent(a);
+  ASSERT_EQ(a.body_maps.poses.size(), 1u);
+  EXPECT_EQ(a.body_maps.resolution, 64u);
+  const BodyMapPose& pose = a.body_maps.poses[0];
+  EXPECT_EQ(pose.layout, BodyMapLayout::kRowSpans);
+  EXPECT_EQ(pose.width, 54u);
+  EXPECT_EQ(pose.height, 66u);
+  EXPECT_EQ(BodyMapStoredTexels(pose), 744u);
+  EXPECT_EQ(pose.depth_u16[0].size(), 744u);
+  EXPECT_EQ(pose.normal_oct16[1].size(), 2u * 744u);
+  EXPECT_EQ(pose.row_span_offsets.size(), 67u);
+  EXPECT_EQ(a.joint_spheres.size(), 16u);
+  EXPECT_TRUE(a.hulls.empty());
+}
+
+TEST(GoldenFile, EveryTruncationAndSampledFlipsFail) {
+  for (const char* name : {"/mannequin_v1.drape", "/mannequin_v2.drape"}) {
+    SCOPED_TRACE(name);
+    const std::vector<uint8_t> bytes = ReadBytes(test::GoldenDir() + name);
+    ASSERT_GT(bytes.size(), kAssetHeaderSize);
+    for (size_t length = 0; length < bytes.size(); ++length) {
+      CharacterAsset out;
+      ASSERT_FALSE(DecodeAsset({bytes.data(), length}, "golden", &out).ok()) << length;
+    }
+    const size_t stride = bytes.size() / 2000 + 1;
+    for (size_t at = 0; at < bytes.size(); at += (at < kAssetHeaderSize ? 1 : stride)) {
+      std::vector<uint8_t> bad = bytes;
+      bad[at] ^= 0x20;
+      CharacterAsset out;
+      ASSERT_FALSE(DecodeAsset(bad, "golden", &out).ok()) << "byte " << at;
+    }
   }
 }
 

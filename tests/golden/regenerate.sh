@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Rewrites the golden files from the current build. Only for a deliberate change of the bake's
-# output: say why in the commit, and keep the old files while the loader still reads them.
+# output: say why in the commit, and keep the old files while the loader still reads them
+# (mannequin_colliders_v1.drape, format 1, stays as the backward-reading test of the loader).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-build/bin/drape-bake samples/mannequin/mannequin.gltf -o tests/golden/mannequin_colliders_v1.drape \
+build/bin/drape-bake samples/mannequin/mannequin.gltf -o tests/golden/mannequin_colliders_v2.drape \
   --config tests/golden/mannequin_colliders.json

@@ -1,5 +1,6 @@
 // Paper A's image-space collider at run time, on analytic maps built here (no bake dependency):
-// a sphere, a texel-aligned box, a slab thinner than one step, two boxes with a gap.
+// a sphere, a texel-aligned box, a slab thinner than one step, two boxes with a gap; the
+// row-span layout of the same maps answers bit for bit as the dense one.
 
 #include "drape/runtime/body_map_collider.h"
 
@@ -7,6 +8,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -760,6 +762,164 @@ TEST(BodyMapCollider, SilhouetteDisagreementIsBackgroundAndCounted) {
   // 16 bytes per texel plus small change.
   EXPECT_GE(c.memory_bytes(), 64u * 40u * 16u);
   EXPECT_LT(c.memory_bytes(), 64u * 40u * 16u + 2048u);
+}
+
+// --- Row-span layout: the same grid as the dense layout, bit for bit -------------------------
+
+uint32_t Bits(float v) { return std::bit_cast<uint32_t>(v); }
+
+// The bake writes zero normal codes on background and the row-span layout cannot carry any
+// other value there (expanding it writes zeros), so the dense reference gets the same.
+void ZeroBackgroundNormals(BodyMapPose& pose) {
+  const size_t n = static_cast<size_t>(pose.width) * pose.height;
+  for (size_t k = 0; k < n; ++k) {
+    const bool background =
+        pose.depth_encoding == DepthEncoding::kFloat32
+            ? pose.depth_f32[0][k] >= pose.depth_range && pose.depth_f32[1][k] >= pose.depth_range
+            : pose.depth_u16[0][k] == 65535 && pose.depth_u16[1][k] == 65535;
+    if (!background) continue;
+    for (int view = 0; view < 2; ++view) {
+      for (size_t c = 0; c < pose.normal_f32[view].size() / n; ++c)
+        pose.normal_f32[view][3 * k + c] = 0.f;
+      for (size_t c = 0; c < pose.normal_oct16[view].size() / n; ++c)
+        pose.normal_oct16[view][2 * k + c] = 0;
+      for (size_t c = 0; c < pose.normal_rgb8[view].size() / n; ++c)
+        pose.normal_rgb8[view][3 * k + c] = 0;
+    }
+  }
+}
+
+void ExpectSameBits(Float3 a, Float3 b, const char* what, int k) {
+  EXPECT_EQ(Bits(a.x), Bits(b.x)) << what << " " << k;
+  EXPECT_EQ(Bits(a.y), Bits(b.y)) << what << " " << k;
+  EXPECT_EQ(Bits(a.z), Bits(b.z)) << what << " " << k;
+}
+
+// Every texel's slab and normals, the bounds and stats, and `segments` random queries: equal bit
+// for bit. Segments run between points of the colliders' box widened by `pad` metres.
+void ExpectIdenticalColliders(const BodyMapCollider& a, const BodyMapCollider& b, int segments,
+                              float pad) {
+  ASSERT_EQ(a.width(), b.width());
+  ASSERT_EQ(a.height(), b.height());
+  EXPECT_EQ(Bits(a.origin_x()), Bits(b.origin_x()));
+  EXPECT_EQ(Bits(a.origin_y()), Bits(b.origin_y()));
+  EXPECT_EQ(Bits(a.texel_size()), Bits(b.texel_size()));
+  ExpectSameBits(a.bounds_min(), b.bounds_min(), "bounds_min", 0);
+  ExpectSameBits(a.bounds_max(), b.bounds_max(), "bounds_max", 0);
+  EXPECT_EQ(a.stats().valid_texels, b.stats().valid_texels);
+  EXPECT_EQ(a.stats().one_sided_texels, b.stats().one_sided_texels);
+  EXPECT_EQ(a.stats().inverted_texels, b.stats().inverted_texels);
+  EXPECT_EQ(a.stats().bilinear_blocks, b.stats().bilinear_blocks);
+  EXPECT_EQ(a.memory_bytes(), b.memory_bytes());
+  size_t different = 0;
+  for (uint32_t j = 0; j < a.height(); ++j) {
+    for (uint32_t i = 0; i < a.width(); ++i) {
+      float at = 0.f, ab = 0.f, bt = 0.f, bb = 0.f;
+      const bool av = a.TexelSlab(i, j, &at, &ab), bv = b.TexelSlab(i, j, &bt, &bb);
+      for (bool back : {false, true}) {
+        const Float3 an = a.TexelNormal(i, j, back), bn = b.TexelNormal(i, j, back);
+        different +=
+            Bits(an.x) != Bits(bn.x) || Bits(an.y) != Bits(bn.y) || Bits(an.z) != Bits(bn.z);
+      }
+      different += av != bv || Bits(at) != Bits(bt) || Bits(ab) != Bits(bb);
+    }
+  }
+  EXPECT_EQ(different, 0u) << "texels whose slab or normals differ";
+  const Float3 lo = a.bounds_min(), hi = a.bounds_max();
+  std::mt19937 rng(20261122);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  const auto point = [&] {
+    return Float3{lo.x - pad + unit(rng) * (hi.x - lo.x + 2.f * pad),
+                  lo.y - pad + unit(rng) * (hi.y - lo.y + 2.f * pad),
+                  lo.z - pad + unit(rng) * (hi.z - lo.z + 2.f * pad)};
+  };
+  int contacts = 0;
+  for (int k = 0; k < segments; ++k) {
+    const Float3 p0 = point();
+    // Alternately long segments across the box and short ones (a few texels).
+    const Float3 p1 = k % 2 == 0 ? point() : p0 + (point() - p0) * 0.02f;
+    const ContactQuery qa = a.Query(p0, p1), qb = b.Query(p0, p1);
+    EXPECT_EQ(qa.inside_end, qb.inside_end) << k;
+    EXPECT_EQ(qa.contact, qb.contact) << k;
+    EXPECT_EQ(Bits(qa.t), Bits(qb.t)) << k;
+    ExpectSameBits(qa.point, qb.point, "point", k);
+    ExpectSameBits(qa.normal, qb.normal, "normal", k);
+    EXPECT_EQ(Bits(qa.depth), Bits(qb.depth)) << k;
+    EXPECT_EQ(qa.flags, qb.flags) << k;
+    EXPECT_EQ(a.IsInside(p1), b.IsInside(p1)) << k;
+    contacts += qa.contact;
+  }
+  EXPECT_GT(contacts, segments / 20) << "the segments must exercise contacts";
+}
+
+TEST(BodyMapCollider, RowSpanLayoutAnswersExactlyAsDense) {
+  const NormalEncoding normals[3] = {NormalEncoding::kFloat32, NormalEncoding::kOct16,
+                                     NormalEncoding::kRgb8};
+  for (const bool sphere : {true, false}) {
+    for (DepthEncoding de : {DepthEncoding::kFloat32, DepthEncoding::kUnorm16}) {
+      for (NormalEncoding ne : normals) {
+        BodyMapPose dense =
+            sphere ? MakePose(SphereGrid(), Sphere, de, ne) : MakePose(BoxGrid(), Box, de, ne);
+        ZeroBackgroundNormals(dense);
+        BodyMapPose spans;
+        ASSERT_TRUE(ConvertBodyMapLayout(dense, BodyMapLayout::kRowSpans, &spans).ok());
+        ASSERT_EQ(spans.layout, BodyMapLayout::kRowSpans);
+        EXPECT_LT(BodyMapStoredTexels(spans), BodyMapStoredTexels(dense));
+        // Back to dense: the very same arrays.
+        BodyMapPose back;
+        ASSERT_TRUE(ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &back).ok());
+        EXPECT_EQ(back.depth_f32[1], dense.depth_f32[1]);
+        EXPECT_EQ(back.depth_u16[0], dense.depth_u16[0]);
+        EXPECT_EQ(back.normal_f32[0], dense.normal_f32[0]);
+        EXPECT_EQ(back.normal_oct16[1], dense.normal_oct16[1]);
+        EXPECT_EQ(back.normal_rgb8[1], dense.normal_rgb8[1]);
+        for (DepthSampling sampling : {DepthSampling::kNearest, DepthSampling::kBilinear}) {
+          SCOPED_TRACE(::testing::Message()
+                       << (sphere ? "sphere" : "box") << " depth " << int(de) << " normal "
+                       << int(ne) << " sampling " << int(sampling));
+          const BodyMapCollider a = BuildOrDie(dense, sampling);
+          const BodyMapCollider b = BuildOrDie(spans, sampling);
+          ExpectIdenticalColliders(a, b, 1000, 0.05f);
+        }
+      }
+    }
+  }
+}
+
+TEST(BodyMapCollider, BuildRejectsACorruptSpanTable) {
+  BodyMapPose good;
+  ASSERT_TRUE(ConvertBodyMapLayout(MakePose(BoxGrid(), Box), BodyMapLayout::kRowSpans, &good).ok());
+  ASSERT_TRUE(BodyMapCollider().Build(good).ok());
+  const auto expect_rejected = [](const BodyMapPose& pose, const char* field) {
+    BodyMapCollider c;
+    const Status status = c.Build(pose);
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << field;
+    EXPECT_NE(status.message().find(field), std::string::npos) << status.message();
+    EXPECT_TRUE(c.empty()) << field;
+  };
+  const size_t row = 10;  // a row of the box: one span [7, 57)
+  const uint32_t s = good.row_span_offsets[row];
+  BodyMapPose p = good;
+  p.span_begin[s] = 20;  // the span now ends at 70 > width 64
+  expect_rejected(p, "beyond width");
+  p = good;
+  p.row_span_offsets[row] = p.row_span_offsets[row + 1] + 1;
+  expect_rejected(p, "row_span_offsets");
+  p = good;
+  p.row_span_offsets.pop_back();
+  expect_rejected(p, "row_span_offsets");
+  p = good;
+  p.span_texel_offsets[s + 1] = p.span_texel_offsets[s];
+  expect_rejected(p, "span_texel_offsets");
+  p = good;
+  p.depth_f32[0].pop_back();
+  expect_rejected(p, "depth_f32_front");
+  p = good;
+  p.layout = static_cast<BodyMapLayout>(7);
+  expect_rejected(p, "layout");
+  p = good;
+  p.layout = BodyMapLayout::kDense;  // a dense pose with a span table: inconsistent
+  expect_rejected(p, "span");
 }
 
 TEST(BodyMapSequence, NearestAndBracketingPoses) {

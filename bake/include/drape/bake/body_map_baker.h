@@ -23,11 +23,14 @@
 //       texel_size = sqrt(L' * H') / N, window ceil(L'/t) x ceil(H'/t) texels. A tall body gets
 //       smaller texels (H54: about 1.0 mm instead of 1.77 mm at N = 1024). This departs from the
 //       paper, so it is an option.
-//     Only the rectangle of covered texels plus a one-texel background border is stored
+//     Only the rectangle of covered texels plus a one-texel background border exists
 //     (width x height); origin_x/origin_y are the asset-frame x,y of the lower-left corner of
 //     stored texel (0,0). Texel (i,j) covers x in [origin_x + i*t, origin_x + (i+1)*t), y
 //     likewise with j; its sample point is the centre (i + 1/2, j + 1/2). Storage is row-major,
-//     index j*width + i, j increasing with y (the lower row first).
+//     index j*width + i, j increasing with y (the lower row first). With layout kRowSpans (the
+//     default) only the texels valid in either view (after step 6) are stored, as maximal runs
+//     per row (body_map_data.h): the same maps as the dense layout, whose texels outside the
+//     spans all hold the background values below; ConvertBodyMapLayout turns one into the other.
 //  5. Views: index 0 = front (camera plane z = front_z, looking along -z), depth
 //     d = front_z - z. Index 1 = back (camera plane z = front_z - depth_range, looking along +z),
 //     depth d = z - (front_z - depth_range). The back map is NOT mirrored: texel (i,j) covers the
@@ -42,8 +45,9 @@
 //     normals mostly have n.z > 0, the back map's n.z < 0. A zero interpolated normal falls back to
 //     the triangle's face normal, then to (0,0,+1) front / (0,0,-1) back.
 //
-// Encodings (what a decoder must do; formats/body_map_data.h):
-//  - Depth kFloat32: depth_f32[view][j*width+i] in metres from that view's plane.
+// Encodings (what a decoder must do; formats/body_map_data.h). Texel k below is j*width+i in
+// the dense layout and BodyMapTexelIndex(pose, i, j) in the row-span layout:
+//  - Depth kFloat32: depth_f32[view][k] in metres from that view's plane.
 //    Valid texels hold a value in [0, depth_range); background holds exactly depth_range
 //    (a decoder tests `d >= depth_range`).
 //  - Depth kUnorm16: depth_u16 = min(round(d / depth_range * 65535), 65534) for valid texels,
@@ -86,18 +90,23 @@ struct BodyMapOptions {
   DepthEncoding depth_encoding = DepthEncoding::kFloat32;
   NormalEncoding normal_encoding = NormalEncoding::kOct16;
   MapRenderer renderer = MapRenderer::kCpu;
+  // kRowSpans: store only the covered texels (the mannequin at N = 512 is 18 % of its
+  // rectangle); kDense: the whole rectangle, as format version 1 did. Same maps either way.
+  BodyMapLayout layout = BodyMapLayout::kRowSpans;
 };
 
 struct BodyMapPoseStats {
-  uint32_t width = 0, height = 0;                // stored (cropped) rectangle, texels
+  uint32_t width = 0, height = 0;                // the cropped rectangle, texels
   uint32_t window_width = 0, window_height = 0;  // the full window, texels (N x N when square)
   float texel_size_mm = 0.f;                     // millimetres
   float coverage = 0.f;                          // fraction of window texels that are valid, [0, 1]
   size_t valid_texels = 0;                       // texels valid in both views
-  size_t bytes = 0;              // bytes of the map arrays stored (both views, depth + normals)
-  double render_ms_front = 0.0;  // wall time of rendering the view (CPU: rasterize + normals;
-  double render_ms_back = 0.0;   // OSMesa: upload + clear + draw + finish + readback)
-  const char* renderer = "";     // "cpu" or "osmesa (<GL_RENDERER>)"; static storage
+  size_t stored_texels = 0;  // texels the arrays hold: width*height, or the spans' total
+  size_t bytes = 0;  // bytes stored: the per-texel arrays (both views, depth + normals) plus the
+                     // span table (row spans: 4 per row + 1, 6 per span + 4)
+  double render_ms_front = 0.0;       // wall time of rendering the view (CPU: rasterize + normals;
+  double render_ms_back = 0.0;        // OSMesa: upload + clear + draw + finish + readback)
+  const char* renderer = "";          // "cpu" or "osmesa (<GL_RENDERER>)"; static storage
   uint32_t silhouette_conflicts = 0;  // texels covered in exactly one view, made background
 };
 
@@ -139,6 +148,7 @@ struct BodyMapTexel {
   float depth = 0.f;  // metres from the view's plane (depth_range on background)
   Float3 normal;      // unit length when valid, (0,0,0) on background
 };
+// Either layout; a texel outside the spans (or the rectangle) reads as background.
 BodyMapTexel ReadBodyMapTexel(const BodyMapPose& pose, int view, uint32_t i, uint32_t j);
 
 }  // namespace drape::bake

@@ -14,7 +14,10 @@
 
 namespace drape {
 
-inline constexpr uint32_t kAssetFormatVersion = 1;
+// The version the writer writes. 2: BodyMapPose class version 2 (layout and row spans).
+inline constexpr uint32_t kAssetFormatVersion = 2;
+// The oldest version the loader still reads (1: every class at version 1, body maps dense).
+inline constexpr uint32_t kOldestAssetFormatVersion = 1;
 inline constexpr size_t kAssetHeaderSize = 32;
 
 // Serialises the asset into the bytes of a .drape file. Fails if the asset does not validate.

@@ -108,18 +108,21 @@ class BodyMapSequence;
 // One pose's collider. Immutable after Build (or after BodyMapSequence fills it). Queries are
 // const, allocation-free and thread-safe.
 //
-// Memory (per texel of the stored rectangle): 8 bytes of slab (top, bottom z as float) + 8 bytes
-// of normals (front and back, re-encoded as oct16 whatever the input encoding: float32 input loses
-// < 0.004 degrees) + 1 byte of bilinear eligibility in kBilinear mode, plus 8 bytes per 8x8 block
-// for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB (17.1 MiB bilinear). memory_bytes() reports
-// the exact figure.
+// Memory (per texel of the pose's rectangle, whichever layout the file stored): 8 bytes of slab
+// (top, bottom z as float) + 8 bytes of normals (front and back, re-encoded as oct16 whatever the
+// input encoding: float32 input loses < 0.004 degrees) + 1 byte of bilinear eligibility in
+// kBilinear mode, plus 8 bytes per 8x8 block for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB
+// (17.1 MiB bilinear). memory_bytes() reports the exact figure.
 class BodyMapCollider {
  public:
-  // Validates the pose and decodes it into the internal layout (allocates). On error the collider
-  // is left empty (every point outside). Rejected: zero/huge width or height, texel size or depth
-  // range not finite and > 0, non-finite origin or front_z, an unknown encoding, an array of the
-  // chosen encoding whose length is not width*height (x3 / x2 for normals), a filled array of an
-  // encoding that was not chosen, a NaN or negative depth, a non-finite float normal.
+  // Validates the pose and decodes it into the internal layout (allocates). A row-span pose is
+  // first expanded into its dense rectangle (background outside the spans), so both layouts of
+  // one bake give identical answers. On error the collider is left empty (every point outside).
+  // Rejected: zero/huge width or height, texel size or depth range not finite and > 0,
+  // non-finite origin or front_z, an unknown encoding or layout, a span table that
+  // CheckBodyMapLayout refuses, an array of the chosen encoding whose length is not the stored
+  // texel count (x3 / x2 for normals), a filled array of an encoding that was not chosen, a NaN
+  // or negative depth, a non-finite float normal.
   Status Build(const BodyMapPose& pose, DepthSampling sampling = DepthSampling::kNearest);
 
   // Discrete test at one point (no allocation; about 3 ns per particle in cloth order, see
