@@ -103,6 +103,24 @@ std::map<std::string, int> IndexNodesByName(const std::vector<Node>& nodes) {
   return by_name;
 }
 
+// Names a bone cannot be resolved by: more than one node without meshes carries the name, or
+// several nodes carry it and all have meshes. assimp identifies bones by name only, so binding
+// such a bone to the first node would silently skin a mesh to the wrong joint (two skins whose
+// joints share a name; an unnamed glTF joint, called "nodes[<i>]" by assimp, next to a node
+// literally named so). Value: how many nodes carry the name.
+std::map<std::string, int> AmbiguousNodeNames(const std::vector<Node>& nodes) {
+  std::map<std::string, std::pair<int, int>> count;  // name -> (nodes without, with meshes)
+  for (const Node& n : nodes) {
+    auto& c = count[n.node->mName.C_Str()];
+    ++(n.node->mNumMeshes > 0 ? c.second : c.first);
+  }
+  std::map<std::string, int> ambiguous;
+  for (const auto& [name, c] : count) {
+    if (c.first > 1 || (c.first == 0 && c.second > 1)) ambiguous.emplace(name, c.first + c.second);
+  }
+  return ambiguous;
+}
+
 // Polar decomposition of an affine matrix into translation, rotation and per-axis scale.
 // A reflection is carried by a negative scale on z. Returns the relative size of the shear that
 // a TRS transform cannot represent (0 for a clean TRS matrix).
@@ -319,6 +337,7 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
   std::vector<Node> nodes;
   if (Status s = FlattenNodes(scene->mRootNode, path, &nodes); !s.ok()) return s;
   const std::map<std::string, int> node_by_name = IndexNodesByName(nodes);
+  const std::map<std::string, int> ambiguous_names = AmbiguousNodeNames(nodes);
 
   // Which node instances which mesh (a mesh may be instanced more than once; each counts).
   std::vector<std::pair<int, unsigned>> mesh_instances;  // (node, mesh index)
@@ -349,6 +368,13 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
       auto it = node_by_name.find(name);
       if (it == node_by_name.end())
         return fail(StatusCode::kCorrupt, "bone '" + name + "' has no node");
+      if (auto dup = ambiguous_names.find(name); dup != ambiguous_names.end()) {
+        return fail(StatusCode::kCorrupt,
+                    "duplicate joint name '" + name + "': " + std::to_string(dup->second) +
+                        " nodes carry it and bones are matched to nodes by name, so the skin "
+                        "cannot be bound (rename the nodes in the source; "
+                        "import.rename_duplicate_joints cannot repair this)");
+      }
       const Mat4 offset = ToEigen(m->mBones[b]->mOffsetMatrix);
       if (!AllFinite(offset) || std::fabs(offset.topLeftCorner<3, 3>().determinant()) < 1e-30) {
         return fail(StatusCode::kCorrupt,
@@ -571,6 +597,11 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
 
     std::map<std::tuple<float, float, float>, uint32_t> welded;
     std::vector<uint32_t> remap(m->mNumVertices);
+    // Per welded vertex of this mesh (from first_vertex on): its first copy's normalised skin,
+    // and the normalised skins of all its copies, averaged once the mesh is read.
+    const uint32_t first_vertex = out.vertex_count();
+    std::vector<std::vector<std::pair<int, double>>> first_skin, all_skins;
+    std::vector<uint32_t> copies;
     for (unsigned v = 0; v < m->mNumVertices; ++v) {
       const Vec3 p = TransformPoint(vertex_to_asset,
                                     Vec3(m->mVertices[v].x, m->mVertices[v].y, m->mVertices[v].z));
@@ -602,26 +633,51 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
       } else if (sum < 0.9 || sum > 1.1) {
         ++weight_sum_warnings;
       }
+      std::vector<std::pair<int, double>> skin;  // sorted by joint, sums to 1
+      for (const auto& [joint, weight] : merged) skin.emplace_back(joint, weight / sum);
       auto key = std::make_tuple(position.x, position.y, position.z);
       auto [it, inserted] = welded.emplace(key, out.vertex_count());
       remap[v] = it->second;
-      if (!inserted) {
-        // Same position, first wins; count when the skin differs (a seam with split weights).
-        const uint32_t w = it->second;
-        const uint32_t begin = out.influence_offsets[w], end = out.influence_offsets[w + 1];
-        bool same = end - begin == merged.size();
-        for (uint32_t k = begin; same && k < end; ++k) {
-          same = out.influence_joints[k] == merged[k - begin].first &&
-                 std::fabs(out.influence_weights[k] -
-                           static_cast<float>(merged[k - begin].second / sum)) < 1e-4f;
-        }
-        weld_conflicts += !same;
+      if (inserted) {
+        out.positions.push_back(position);
+        first_skin.push_back(skin);
+        all_skins.push_back(std::move(skin));
+        copies.push_back(1);
         continue;
       }
-      out.positions.push_back(position);
-      for (const auto& [joint, weight] : merged) {
+      // Same position: one vertex whose skin is the average of its copies' skins, which is what
+      // assimp's JoinIdenticalVertices already does to copies that differ only in their skin
+      // (it sums their weights); copies it keeps apart (other normals or UVs) get the same here.
+      // Counted when the skins differ (a seam with split weights).
+      const std::vector<std::pair<int, double>>& first = first_skin[it->second - first_vertex];
+      bool same = first.size() == skin.size();
+      for (size_t k = 0; same && k < skin.size(); ++k) {
+        same =
+            first[k].first == skin[k].first && std::fabs(first[k].second - skin[k].second) < 1e-4;
+      }
+      weld_conflicts += !same;
+      auto& skins = all_skins[it->second - first_vertex];
+      skins.insert(skins.end(), skin.begin(), skin.end());
+      ++copies[it->second - first_vertex];
+    }
+    for (size_t w = 0; w < all_skins.size(); ++w) {
+      std::vector<std::pair<int, double>>& skin = all_skins[w];
+      std::sort(skin.begin(), skin.end());
+      std::vector<std::pair<int, double>> averaged;
+      double total = 0;
+      for (const auto& [joint, weight] : skin) {
+        total += weight;
+        if (!averaged.empty() && averaged.back().first == joint) {
+          averaged.back().second += weight;
+        } else {
+          averaged.emplace_back(joint, weight);
+        }
+      }
+      for (const auto& [joint, weight] : averaged) {
         out.influence_joints.push_back(static_cast<uint16_t>(joint));
-        out.influence_weights.push_back(static_cast<float>(weight / sum));
+        // A single copy is stored as normalised above, bit for bit.
+        out.influence_weights.push_back(
+            static_cast<float>(copies[w] == 1 ? weight : weight / total));
       }
       out.influence_offsets.push_back(static_cast<uint32_t>(out.influence_joints.size()));
     }
@@ -656,7 +712,7 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
   warn_count(weight_sum_warnings, "vertices had raw weight sums outside [0.9, 1.1] (renormalised)");
   warn_count(zero_weight_vertices, "vertices had no weight (made rigid to their mesh's joint)");
   warn_count(degenerate_triangles, "degenerate or zero-area triangles were dropped");
-  warn_count(weld_conflicts, "welded vertices had differing weights (the first was kept)");
+  warn_count(weld_conflicts, "welded vertices had differing weights (averaged)");
   warn_count(mesh_space_mismatch,
              "bones disagree on their mesh's bind space (blended skin may be off)");
 
