@@ -241,7 +241,9 @@ json FrameJson(const FrameStats& f) {
           {"inside_particles", f.inside_particles},
           {"max_penetration_mm", f.max_penetration * 1000.f},
           {"max_stretch", f.max_stretch},
-          {"nan", !f.finite}};
+          {"nan", !f.finite},
+          {"rss_bytes", f.rss_bytes},
+          {"measure_ms", f.measure_ms}};
 }
 
 struct Options {
@@ -392,25 +394,23 @@ int RunScene(const Options& options) {
   std::vector<Thumb> thumbs;
 
   Progress progress(frames);
-  json frame_list = json::array();
-  double step_total = 0.0, step_max = 0.0, render_ms = 0.0;
+  // Reserved up front: the run's own bookkeeping must not grow the memory a long run measures.
+  std::vector<FrameStats> frame_stats;
+  frame_stats.reserve(static_cast<size_t>(frames));
+  double step_total = 0.0, render_ms = 0.0;
   uint64_t contact_total = 0;
-  uint32_t contact_max = 0, nan_frames = 0, frames_with_inside = 0;
-  float penetration_max = 0.f, stretch_max = 0.f;
+  uint32_t contact_max = 0;
+  float stretch_max = 0.f;
   int64_t written = 0;
   Status failure = Status::Ok();
   for (int64_t k = 0; k < frames; ++k) {
     FrameStats stats;
     failure = sim.Step(k, &stats);
-    frame_list.push_back(FrameJson(stats));
+    frame_stats.push_back(stats);
     step_total += stats.step_ms;
-    step_max = std::max(step_max, stats.step_ms);
     contact_total += stats.contacts;
     contact_max = std::max(contact_max, stats.contacts);
-    penetration_max = std::max(penetration_max, stats.max_penetration);
     stretch_max = std::max(stretch_max, stats.max_stretch);
-    if (!stats.finite) ++nan_frames;
-    if (stats.inside_particles > 0) ++frames_with_inside;
     if (!failure.ok()) break;
     if (k % every == 0) {
       const auto render_start = Clock::now();
@@ -439,7 +439,10 @@ int RunScene(const Options& options) {
     }
     progress.Update(k + 1, step_total / static_cast<double>(k + 1));
   }
-  const int64_t simulated = static_cast<int64_t>(frame_list.size());
+  const int64_t simulated = static_cast<int64_t>(frame_stats.size());
+  // Read before stats.json is built: the peak of the bake, setup and simulation.
+  const uint64_t rss_peak = PeakResidentSetBytes();
+  const RunSummary summary = SummarizeRun(frame_stats);
 
   // The animation: ffmpeg when it is there, else a contact sheet.
   std::string animation = "none";
@@ -494,18 +497,30 @@ int RunScene(const Options& options) {
       {"frames_written", written},
       {"particles", sim.particle_count()},
       {"step_ms_total", step_total},
-      {"step_ms_mean", simulated > 0 ? step_total / static_cast<double>(simulated) : 0.0},
-      {"step_ms_max", step_max},
+      {"step_ms_mean", summary.step_ms_mean},
+      {"step_ms_median", summary.step_ms_median},
+      {"step_ms_p99", summary.step_ms_p99},
+      {"step_ms_max", summary.step_ms_max},
+      {"step_ms_tenths", summary.step_ms_tenths},
+      {"measure_ms_mean", summary.measure_ms_mean},
       {"contacts_mean",
        simulated > 0 ? static_cast<double>(contact_total) / static_cast<double>(simulated) : 0.0},
       {"contacts_max", contact_max},
-      {"max_penetration_mm", penetration_max * 1000.f},
-      {"frames_with_particles_inside", frames_with_inside},
+      {"max_penetration_mm", summary.max_penetration * 1000.f},
+      {"max_penetration_frame", summary.max_penetration_frame},
+      {"frames_with_particles_inside", summary.frames_with_inside},
+      {"inside_particles_max", summary.inside_particles_max},
       {"max_stretch", stretch_max},
-      {"nan_frames", nan_frames},
+      {"nan_frames", summary.nan_frames},
+      {"rss_peak_bytes", rss_peak},
+      {"rss_after_100_frames_bytes", summary.rss_after_100_frames},
+      {"rss_end_bytes", summary.rss_end},
+      {"rss_growth_bytes", summary.rss_growth},
       {"render_ms_total", render_ms},
       {"wall_s", Seconds(wall_start)},
       {"threads", omp_get_max_threads()}};
+  json frame_list = json::array();
+  for (const FrameStats& f : frame_stats) frame_list.push_back(FrameJson(f));
   const json stats = {
       {"scene", options.scene_path},
       {"character", scene.character},
@@ -531,12 +546,16 @@ int RunScene(const Options& options) {
     return Fail(s.message());
   if (!failure.ok()) return Fail(failure.message());
 
+  constexpr double kMiB = 1024.0 * 1024.0;
   std::printf(
-      "drape-sim: %lld frames, %.2f ms/step mean (%.2f max), %.0f contacts/frame, max "
-      "penetration %.2f mm, %u NaN frames; %lld pictures, %s; %.1f s\n",
-      static_cast<long long>(simulated), totals["step_ms_mean"].get<double>(), step_max,
-      totals["contacts_mean"].get<double>(), static_cast<double>(penetration_max) * 1000.0,
-      nan_frames, static_cast<long long>(written), animation.c_str(), Seconds(wall_start));
+      "drape-sim: %lld frames, %.2f ms/step mean (%.2f p99, %.2f max), %.0f contacts/frame, max "
+      "penetration %.2f mm, %u NaN frames; RSS peak %.1f MiB, %+.1f MiB after frame 100; %lld "
+      "pictures, %s; %.1f s\n",
+      static_cast<long long>(simulated), summary.step_ms_mean, summary.step_ms_p99,
+      summary.step_ms_max, totals["contacts_mean"].get<double>(),
+      static_cast<double>(summary.max_penetration) * 1000.0, summary.nan_frames,
+      static_cast<double>(rss_peak) / kMiB, static_cast<double>(summary.rss_growth) / kMiB,
+      static_cast<long long>(written), animation.c_str(), Seconds(wall_start));
   return 0;
 }
 

@@ -1,8 +1,13 @@
 #include "simulation.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "drape/runtime/math.h"
@@ -13,7 +18,98 @@ namespace {
 
 bool Finite(Float3 p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
 
+// Reads a small /proc file into `buffer` (NUL-terminated, truncated to fit) without allocating;
+// the length read, 0 on failure.
+size_t ReadProcFile(const char* path, char* buffer, size_t capacity) {
+  const int fd = ::open(path, O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return 0;
+  size_t length = 0;
+  while (length + 1 < capacity) {
+    const ssize_t n = ::read(fd, buffer + length, capacity - 1 - length);
+    if (n <= 0) break;
+    length += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  buffer[length] = '\0';
+  return length;
+}
+
+// The unsigned decimal after optional spaces at `text`; false when there is none.
+bool ParseCount(const char* text, const char* end, uint64_t* value) {
+  while (text < end && (*text == ' ' || *text == '\t')) ++text;
+  return std::from_chars(text, end, *value).ec == std::errc();
+}
+
 }  // namespace
+
+uint64_t ResidentSetBytes() {
+  // statm: "size resident shared text lib data dt", in pages.
+  char buffer[256];
+  const size_t length = ReadProcFile("/proc/self/statm", buffer, sizeof(buffer));
+  const char* const end = buffer + length;
+  uint64_t size_pages = 0, resident_pages = 0;
+  const char* cursor = buffer;
+  if (!ParseCount(cursor, end, &size_pages)) return 0;
+  cursor = std::strchr(cursor, ' ');
+  if (cursor == nullptr || !ParseCount(cursor, end, &resident_pages)) return 0;
+  const long page_bytes = ::sysconf(_SC_PAGESIZE);
+  return page_bytes > 0 ? resident_pages * static_cast<uint64_t>(page_bytes) : 0;
+}
+
+uint64_t PeakResidentSetBytes() {
+  // status: one "Key:\tvalue" line each; "VmHWM:     123456 kB".
+  char buffer[8192];
+  const size_t length = ReadProcFile("/proc/self/status", buffer, sizeof(buffer));
+  const char* const line = std::strstr(buffer, "VmHWM:");
+  if (length == 0 || line == nullptr) return 0;
+  uint64_t kib = 0;
+  if (!ParseCount(line + 6, buffer + length, &kib)) return 0;
+  return kib * 1024;
+}
+
+RunSummary SummarizeRun(std::span<const FrameStats> frames) {
+  RunSummary summary;
+  const size_t n = frames.size();
+  summary.frames = static_cast<int64_t>(n);
+  if (n == 0) return summary;
+  std::vector<double> step_ms(n);
+  double total = 0.0;
+  for (size_t k = 0; k < n; ++k) {
+    const FrameStats& f = frames[k];
+    step_ms[k] = f.step_ms;
+    total += f.step_ms;
+    summary.measure_ms_mean += f.measure_ms / static_cast<double>(n);
+    if (!f.finite) ++summary.nan_frames;
+    if (f.inside_particles > 0) ++summary.frames_with_inside;
+    summary.inside_particles_max = std::max(summary.inside_particles_max, f.inside_particles);
+    if (f.max_penetration > summary.max_penetration) {
+      summary.max_penetration = f.max_penetration;
+      summary.max_penetration_frame = f.frame;
+    }
+  }
+  for (size_t tenth = 0; tenth < 10; ++tenth) {
+    const size_t begin = tenth * n / 10, end = (tenth + 1) * n / 10;
+    if (begin == end) continue;
+    double sum = 0.0;
+    for (size_t k = begin; k < end; ++k) sum += step_ms[k];
+    summary.step_ms_tenths.push_back(sum / static_cast<double>(end - begin));
+  }
+  summary.step_ms_mean = total / static_cast<double>(n);
+  std::sort(step_ms.begin(), step_ms.end());
+  // Nearest rank: the smallest value with at least p n values at or below it.
+  const auto rank = [&](double p) {
+    const auto r = static_cast<size_t>(std::ceil(p * static_cast<double>(n)));
+    return step_ms[std::clamp<size_t>(r, 1, n) - 1];
+  };
+  summary.step_ms_median = rank(0.5);
+  summary.step_ms_p99 = rank(0.99);
+  summary.step_ms_max = step_ms.back();
+  summary.rss_after_100_frames = frames[std::min<size_t>(100, n) - 1].rss_bytes;
+  summary.rss_end = frames.back().rss_bytes;
+  summary.rss_growth =
+      static_cast<int64_t>(summary.rss_end) - static_cast<int64_t>(summary.rss_after_100_frames);
+  return summary;
+}
 
 float ClipTimeOf(const ClipData& clip, float time, bool loop) {
   if (loop && clip.duration > 0.f) {
@@ -166,7 +262,12 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
                                          scene_->garments[g].path + ": " + result.message());
     }
   }
+  const auto measure_start = std::chrono::steady_clock::now();
   Measure(colliders.body_map, stats);
+  stats->measure_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - measure_start)
+          .count();
+  stats->rss_bytes = ResidentSetBytes();
   return result;
 }
 
@@ -174,18 +275,27 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
   // Point queries at the end pose: the hull set at exactly s = 1 (Step leaves its last substep
   // selected; the next Step poses it afresh).
   if (has_hull_set_) (void)hulls_.SelectSubstep(1.f, 1.f);
+  const HullColliderSet* hulls = has_hull_set_ ? &hulls_ : nullptr;
   for (const auto& g : garments_) {
     const ClothState& state = g->state;
-    for (size_t i = 0; i < state.positions.size(); ++i) {
-      const Float3 p = state.positions[i];
-      if (!Finite(p) || !Finite(state.velocities[i])) {
-        stats->finite = false;
+    const auto n = static_cast<int64_t>(state.positions.size());
+    // The queries are const and thread-safe; the reductions (a count, a max, an AND) do not
+    // depend on the order, so the figures are the same at any thread count.
+    uint32_t inside_count = 0;
+    float deepest = 0.f;
+    bool all_finite = true;
+#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : inside_count) \
+    reduction(max : deepest) reduction(&& : all_finite)
+    for (int64_t i = 0; i < n; ++i) {
+      const Float3 p = state.positions[static_cast<size_t>(i)];
+      if (!Finite(p) || !Finite(state.velocities[static_cast<size_t>(i)])) {
+        all_finite = false;
         continue;
       }
       bool inside = false;
       float depth = 0.f;
-      if (has_hull_set_) {
-        const ContactQuery q = hulls_.Query(p, p);
+      if (hulls != nullptr) {
+        const ContactQuery q = hulls->Query(p, p);
         if (q.inside_end) {
           inside = true;
           depth = std::max(depth, q.depth);
@@ -198,9 +308,12 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
           depth = std::max(depth, q.depth);
         }
       }
-      if (inside) ++stats->inside_particles;
-      stats->max_penetration = std::max(stats->max_penetration, depth);
+      if (inside) ++inside_count;
+      deepest = std::max(deepest, depth);
     }
+    stats->inside_particles += inside_count;
+    stats->max_penetration = std::max(stats->max_penetration, deepest);
+    stats->finite = stats->finite && all_finite;
   }
 }
 

@@ -35,7 +35,37 @@ struct FrameStats {
   float max_penetration = 0.f;
   float max_stretch = 0.f;  // max over stretch springs of L / R - 1
   bool finite = true;       // every position and velocity finite
+  uint64_t rss_bytes = 0;   // the process's resident set size after the frame (0: unknown)
+  double measure_ms = 0.0;  // wall time of the point queries above (not part of step_ms)
 };
+
+// The process's memory, for long runs (Linux /proc; 0 when the file cannot be read or parsed).
+// Neither allocates, so reading them every frame does not disturb what they measure.
+// The resident set size now, bytes: resident pages of /proc/self/statm times the page size.
+uint64_t ResidentSetBytes();
+// The peak resident set size so far, bytes: VmHWM of /proc/self/status.
+uint64_t PeakResidentSetBytes();
+
+// Figures over the frames of a run (settle frames excluded), for stats.json's totals and the
+// soak command's checks.
+struct RunSummary {
+  int64_t frames = 0;
+  // Step time, ms: mean per tenth of the run (frames [i n / 10, (i + 1) n / 10); an empty tenth,
+  // only when n < 10, is left out), overall mean, median and p99 (nearest rank), max.
+  std::vector<double> step_ms_tenths;
+  double step_ms_mean = 0.0, step_ms_median = 0.0, step_ms_p99 = 0.0, step_ms_max = 0.0;
+  double measure_ms_mean = 0.0;        // the per-frame point queries, ms
+  uint32_t nan_frames = 0;             // frames with a non-finite position or velocity
+  uint32_t frames_with_inside = 0;     // frames ending with a particle inside a collider
+  uint32_t inside_particles_max = 0;   // most particles inside at the end of one frame
+  float max_penetration = 0.f;         // metres, deepest over the run
+  int64_t max_penetration_frame = -1;  // the first frame reaching it (-1: none inside)
+  // Resident set size, bytes (0: unknown): after the first 100 frames (frame 99, or the last
+  // frame of a shorter run), after the last frame, and the growth between them (may be < 0).
+  uint64_t rss_after_100_frames = 0, rss_end = 0;
+  int64_t rss_growth = 0;
+};
+RunSummary SummarizeRun(std::span<const FrameStats> frames);
 
 class SceneSimulation {
  public:
