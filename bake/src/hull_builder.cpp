@@ -1858,7 +1858,14 @@ Status BuildHullGeometry(std::span<const Float3> points, const HullOptions& opti
     for (const auto& tri : result.triangles) {
       out_geometry.triangles.insert(out_geometry.triangles.end(), tri.begin(), tri.end());
     }
-    FillPlanes(result, groups, inputs, delta, &out_geometry);
+    // The paper's vertex-normal offset does not contain every delta-ball (reported above as
+    // uncovered points); pushing its planes out over the balls would make the plane set a larger
+    // polytope than the stored vertices, triangles, OBB, Kirkpatrick hierarchies and map table
+    // describe, and the runtime's OBB rejection would then miss points inside the planes. Its
+    // planes support its own vertices; only the guaranteed (Minkowski) hull adds the balls.
+    static const std::vector<Vec3> kNoBalls;
+    const bool balls_inside = inflation != InflationMode::kVertexNormalOffset;
+    FillPlanes(result, groups, balls_inside ? inputs : kNoBalls, delta, &out_geometry);
     stats->planes_ms = MillisecondsSince(planes_start);
 
     // 6. OBB.

@@ -20,8 +20,10 @@
 //     - kVertexNormalOffset (paper): hull of the input, each hull vertex moved by delta along
 //       its angle-weighted vertex normal (independent of how flat faces are triangulated),
 //       hulled again. No containment guarantee for the triangles: HullStats reports how many
-//       input delta-balls poke out of them and by how much (the float planes of step 5 still
-//       contain every delta-ball, so planes and triangles then disagree by that much). If the
+//       input delta-balls poke out of them and by how much. The float planes of step 5 support
+//       these vertices too (they are not pushed over the balls: planes beyond the vertices would
+//       hold points the OBB, the Kirkpatrick hierarchies and the map table know nothing of, and
+//       the runtime's OBB rejection would miss them; measured by drape-speed-vs-error). If the
 //       input is not full-dimensional there are no normals; the Minkowski inflation is used
 //       instead (noted in HullStats::note).
 //     delta = 0 is allowed only for full-dimensional input: H0 is then the hull of the input.
@@ -58,7 +60,8 @@
 //     every input point x with d >= n.x + delta*|n| plus the worst-case rounding error of a float
 //     dot product (3 float ulps of sum |n_i x_i|, and of the delta-ball point), rounded up to float
 //     and one more float ulp up. So the runtime test fl(dot(n, p)) <= d in float accepts every
-//     float point p within delta of an input point, and every collider vertex.
+//     float point p within delta of an input point, and every collider vertex. (kVertexNormalOffset:
+//     over the collider vertices only, see step 2.)
 //  6. OBB of the final collider: kCovariance = paper's statistical method, covariance of the hull
 //     surface (area weighted, Gottschalk); kCgalOptimal = CGAL::oriented_bounding_box with a fixed
 //     seed. Axes orthonormal, right-handed, axes[0] the longest. Half extents cover every collider
