@@ -156,19 +156,26 @@ Float3 ToFloat(const double p[3]) {
   return {static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])};
 }
 
+// The peers' batch: Query per particle, then paper A's response (OpenMP over particles).
+void CollideOneByOne(const Method& method, std::span<const Float3> previous,
+                     std::span<Float3> positions, std::span<Float3> velocities,
+                     std::span<uint8_t> flags) {
+  const long count = static_cast<long>(positions.size());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (long i = 0; i < count; ++i) {
+    const size_t k = static_cast<size_t>(i);
+    const ContactQuery c = method.Query(previous[k], positions[k]);
+    flags[k] = c.contact ? kCollisionContact : kCollisionNone;
+    if (c.contact) ApplyResponse(c, BenchResponse(), &positions[k], &velocities[k]);
+  }
+}
+
 class ExactMeshPeer final : public Method {
  public:
   explicit ExactMeshPeer(const bake::MeshReference& reference) : reference_(reference) {}
   void Collide(std::span<const Float3> previous, std::span<Float3> positions,
                std::span<Float3> velocities, std::span<uint8_t> flags) const override {
-    const long count = static_cast<long>(positions.size());
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < count; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      const ContactQuery c = Query(previous[k], positions[k]);
-      flags[k] = c.contact ? kCollisionContact : kCollisionNone;
-      if (c.contact) ApplyResponse(c, BenchResponse(), &positions[k], &velocities[k]);
-    }
+    CollideOneByOne(*this, previous, positions, velocities, flags);
   }
   ContactQuery Query(Float3 p0, Float3 p1) const override {
     ContactQuery c;
@@ -206,17 +213,10 @@ class FclPeer final : public Method {
  public:
   FclPeer(std::span<const Float3> positions, std::span<const uint32_t> triangles)
       : fcl_(std::make_unique<peers::FclMeshPeer>(positions, triangles)) {}
+  // Query ignores p0: FCL answers a distance at the current position.
   void Collide(std::span<const Float3> previous, std::span<Float3> positions,
                std::span<Float3> velocities, std::span<uint8_t> flags) const override {
-    (void)previous;
-    const long count = static_cast<long>(positions.size());
-#pragma omp parallel for schedule(dynamic, 64)
-    for (long i = 0; i < count; ++i) {
-      const size_t k = static_cast<size_t>(i);
-      const ContactQuery c = Query(positions[k], positions[k]);
-      flags[k] = c.contact ? kCollisionContact : kCollisionNone;
-      if (c.contact) ApplyResponse(c, BenchResponse(), &positions[k], &velocities[k]);
-    }
+    CollideOneByOne(*this, previous, positions, velocities, flags);
   }
   ContactQuery Query(Float3 p0, Float3 p1) const override {
     (void)p0;
