@@ -218,6 +218,43 @@ TEST(HullColliderTest, PushOutIsOnTheSurfaceAndMinimalForABox) {
   }
 }
 
+// Grazing: segments parallel to a face, on it, a hair outside and a hair inside, and along an
+// edge and through a vertex. On the surface counts as inside (both inside tests); a hair outside
+// is free; nothing is non-finite and every response ends on or outside the box.
+TEST(HullColliderTest, GrazingSegmentsAlongFacesEdgesAndVertices) {
+  const Float3 he{0.1f, 0.2f, 0.05f};
+  const HullColliderData box = MakeBox(he);
+  HullColliderSet set = BuildSet({box}, {}, 1);
+  const float top = he.z;
+  const float out = top + 1e-6f,
+              in = top - 1e-6f;  // a micrometre: beyond the planes' outward rounding
+  struct Case {
+    Float3 a, b;
+    bool contact;
+  };
+  const Case cases[] = {
+      {{-0.05f, 0.f, out}, {0.05f, 0.f, out}, false},  // a hair above the +z face
+      {{-0.05f, 0.f, top}, {0.05f, 0.f, top}, true},   // on the face
+      {{-0.05f, 0.f, in}, {0.05f, 0.f, in}, true},     // a hair below it
+      {{-0.3f, 0.f, top}, {0.3f, 0.f, top}, true},     // along the face, through two edges
+      {{-0.3f, he.y, top}, {0.3f, he.y, top}, true},   // along an edge
+      {{-0.3f, -0.3f, top}, {he.x, he.y, top}, true},  // ending on a vertex
+      {{-0.3f, he.y, out}, {0.3f, he.y, out}, false},  // a hair above an edge
+  };
+  for (size_t k = 0; k < std::size(cases); ++k) {
+    const Case& c = cases[k];
+    const ContactQuery q = set.QueryHullLocal(0, c.a, c.b);
+    EXPECT_EQ(q.contact, c.contact) << "case " << k;
+    EXPECT_TRUE(IsFinite(q.point) && IsFinite(q.normal)) << "case " << k;
+    std::vector<Float3> previous = {c.a}, positions = {c.b}, velocities = {c.b - c.a};
+    std::vector<uint8_t> flags(1);
+    ASSERT_TRUE(set.CollideBatch(previous, positions, velocities, flags, ResponseParams{}).ok());
+    EXPECT_EQ((flags[0] & kCollisionContact) != 0, c.contact) << "case " << k;
+    EXPECT_TRUE(IsFinite(positions[0]) && IsFinite(velocities[0])) << "case " << k;
+    EXPECT_GT(set.MaxPlaneDistanceLocal(0, positions[0]), 0.f) << "case " << k;
+  }
+}
+
 TEST(HullColliderTest, PushOutOfARotatedEllipsoidIsOnTheFaceOfTheMaxPlane) {
   Float3 axes[3];
   RotatedAxes(71.0, {1.f, 0.2f, -0.4f}, axes);
