@@ -1515,14 +1515,31 @@ class ContactPlanes {
   bool Enforce(Float3* x) const {
     const double x0[3] = {x->x, x->y, x->z};
     double p[3] = {x0[0], x0[1], x0[2]};
+    // The largest violation at the start: the projection may not move the particle much farther
+    // than that. Planes that nearly face each other (a pinch between two colliders a few degrees
+    // off parallel) meet in a line far away; following it would throw the particle across the
+    // body. Refusing keeps the last response (the Gauss-Seidel passes go on from there).
+    double start_violation = 0.0;
+    for (uint32_t i = 0; i < count_; ++i) {
+      start_violation = std::max(start_violation, Offset(i) - Dot3(i, x0));
+    }
     uint32_t active[3];
     uint32_t active_count = 0;
-    for (uint32_t round = 0; round < kMax; ++round) {
-      // The most violated plane not yet active.
+    bool skipped[kMax] = {false, false, false, false};  // redundant with the active planes
+    const auto build_and_solve = [&](double lambda[3]) {
+      double g[3][3], r[3];
+      for (uint32_t a = 0; a < active_count; ++a) {
+        for (uint32_t b = 0; b < active_count; ++b) g[a][b] = DotNormals(active[a], active[b]);
+        r[a] = Offset(active[a]) - Dot3(active[a], x0);
+      }
+      return Solve(g, r, active_count, lambda);
+    };
+    for (uint32_t round = 0; round < 2 * kMax; ++round) {
+      // The most violated plane not yet active (violations below kTolerance are rounding).
       uint32_t worst = kMax;
-      double worst_violation = 1e-9;  // metres
+      double worst_violation = kTolerance;
       for (uint32_t i = 0; i < count_; ++i) {
-        bool is_active = false;
+        bool is_active = skipped[i];
         for (uint32_t k = 0; k < active_count; ++k) is_active |= active[k] == i;
         const double v = Offset(i) - Dot3(i, p);
         if (!is_active && v > worst_violation) {
@@ -1534,22 +1551,20 @@ class ContactPlanes {
       if (active_count == 3) return false;
       active[active_count++] = worst;
       // p = x0 + sum_j lambda_j n_j with n_k . p = d_k for the active planes: G lambda = r.
-      double g[3][3], r[3], lambda[3] = {0.0, 0.0, 0.0};
-      for (uint32_t a = 0; a < active_count; ++a) {
-        for (uint32_t b = 0; b < active_count; ++b) g[a][b] = DotNormals(active[a], active[b]);
-        r[a] = Offset(active[a]) - Dot3(active[a], x0);
+      double lambda[3] = {0.0, 0.0, 0.0};
+      if (!build_and_solve(lambda)) {
+        // Dependent on the active planes (the same face met twice, coplanar neighbours): skip
+        // it; the final check says whether it holds anyway.
+        --active_count;
+        skipped[worst] = true;
+        if (!build_and_solve(lambda)) return false;
       }
-      if (!Solve(g, r, active_count, lambda)) return false;
       // A negative multiplier: that plane holds without being pushed on; drop it and re-solve.
       for (uint32_t a = 0; a < active_count;) {
-        if (lambda[a] < 0.0 && active_count > 1) {
+        if (lambda[a] < 0.0) {
           for (uint32_t b = a + 1; b < active_count; ++b) active[b - 1] = active[b];
           --active_count;
-          for (uint32_t c = 0; c < active_count; ++c) {
-            for (uint32_t d = 0; d < active_count; ++d) g[c][d] = DotNormals(active[c], active[d]);
-            r[c] = Offset(active[c]) - Dot3(active[c], x0);
-          }
-          if (!Solve(g, r, active_count, lambda)) return false;
+          if (!build_and_solve(lambda)) return false;
           a = 0;
           continue;
         }
@@ -1561,8 +1576,12 @@ class ContactPlanes {
       }
     }
     for (uint32_t i = 0; i < count_; ++i) {
-      if (Offset(i) - Dot3(i, p) > 1e-7) return false;  // not reached: infeasible
+      if (Offset(i) - Dot3(i, p) > kTolerance) return false;  // infeasible: a pinch
     }
+    const double moved =
+        std::sqrt((p[0] - x0[0]) * (p[0] - x0[0]) + (p[1] - x0[1]) * (p[1] - x0[1]) +
+                  (p[2] - x0[2]) * (p[2] - x0[2]));
+    if (moved > kMaxStretch * start_violation + kTolerance) return false;
     *x = Float3{static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])};
     // Rounding to float can leave a plane a few ulps short: nudge out along it.
     for (uint32_t i = 0; i < count_; ++i) {
@@ -1577,6 +1596,10 @@ class ContactPlanes {
 
  private:
   static constexpr uint32_t kMax = 4;
+  static constexpr double kTolerance = 1e-6;  // metres: violations below this are rounding
+  // The projection may move the particle at most this many times its largest violation: the
+  // planes then meet at 28 degrees or more (cot(14 deg) = 4); narrower wedges are refused.
+  static constexpr double kMaxStretch = 4.0;
   struct HalfSpace {
     Float3 normal;
     float offset;

@@ -477,6 +477,33 @@ std::vector<HullColliderData> SceneHulls() {
   return hulls;
 }
 
+// Two slabs that overlap by a centimetre and face each other 2 degrees off parallel (a thigh
+// pressed against a thigh): their response planes meet in a line far away. The particle must
+// not be thrown along it: it ends near where it started (the pinch has no room), finite.
+TEST(HullColliderTest, NearlyOpposingCollidersDoNotThrowAParticleAway) {
+  Float3 axes_b[3];
+  RotatedAxes(2.0, {0.f, 0.f, 1.f}, axes_b);
+  const HullColliderData a = MakeBox({0.05f, 0.2f, 0.05f}, {-0.045f, 0.f, 0.f});
+  const HullColliderData b = MakeBox({0.05f, 0.2f, 0.05f}, {0.045f, 0.f, 0.f}, axes_b);
+  HullColliderSet set = BuildSet({a, b}, {}, 1);
+  std::mt19937 rng(23);
+  std::vector<Float3> previous, positions, velocities;
+  while (positions.size() < 2000) {
+    const Float3 p = RandomIn(rng, {-0.01f, -0.15f, -0.04f}, {0.01f, 0.15f, 0.04f});
+    if (MaxPlane(a, p) > 0.f || MaxPlane(b, p) > 0.f) continue;  // in both
+    previous.push_back(p);
+    positions.push_back(p);
+    velocities.push_back({0.f, 0.f, 0.f});
+  }
+  std::vector<uint8_t> flags(positions.size());
+  ASSERT_TRUE(set.CollideBatch(previous, positions, velocities, flags, ResponseParams{}).ok());
+  for (size_t i = 0; i < positions.size(); ++i) {
+    ASSERT_TRUE(IsFinite(positions[i]));
+    // The overlap is 1 cm wide and 5 cm deep in z: no answer needs more than 6 cm.
+    EXPECT_LT(Length(positions[i] - previous[i]), 0.06f) << i;
+  }
+}
+
 TEST(HullColliderTest, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
   const std::vector<HullColliderData> hulls = SceneHulls();
   const std::vector<JointSphereData> spheres = {{1, 0, {0.2f, 0.05f, 0.f}, 0.06f},
