@@ -571,6 +571,17 @@ std::string CheckBodyMapLayout(const BodyMapPose& p) {
       previous_end = end;
     }
   }
+  // The runtime expands a row-span pose into its dense rectangle. A dense pose is bounded by its
+  // own arrays (hence by the file's size); keep a span pose's expansion proportional to what it
+  // stores, so a small file cannot declare a huge empty rectangle. The bake crops the rectangle
+  // to the covered texels (the mannequin's rectangle is 4.5x its stored texels).
+  constexpr uint64_t kMaxExpansion = 256;
+  const uint64_t area = static_cast<uint64_t>(p.width) * p.height;
+  const uint64_t stored = texels.back();
+  if (area > kMaxExpansion * std::max<uint64_t>(stored, 4096))
+    return "width x height = " + std::to_string(area) + " texels for " + std::to_string(stored) +
+           " stored: more than " + std::to_string(kMaxExpansion) +
+           "x (a sparse pose must be cropped to its covered texels)";
   return {};
 }
 

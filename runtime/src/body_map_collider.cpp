@@ -5,6 +5,7 @@
 #include <cfloat>
 #include <cstdlib>
 #include <limits>
+#include <new>
 #include <string>
 
 namespace drape {
@@ -477,12 +478,16 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   if (pose.layout != BodyMapLayout::kDense) {
     // Row spans: expand into the dense rectangle (background outside the spans) and build from
     // that, so both layouts of one bake give the same grid bit for bit. Setup-time memory only.
-    BodyMapPose dense;
-    if (Status expanded = ConvertBodyMapLayout(pose, BodyMapLayout::kDense, &dense);
-        !expanded.ok()) {
-      return fail(expanded.message());
+    try {
+      BodyMapPose dense;
+      if (Status expanded = ConvertBodyMapLayout(pose, BodyMapLayout::kDense, &dense);
+          !expanded.ok()) {
+        return fail(expanded.message());
+      }
+      return Build(dense, sampling);
+    } catch (const std::bad_alloc&) {
+      return fail("the expanded rectangle does not fit in memory");
     }
-    return Build(dense, sampling);
   }
   const size_t n = static_cast<size_t>(pose.width) * pose.height;
   const char* view_name[2] = {"front", "back"};
