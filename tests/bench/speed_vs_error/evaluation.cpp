@@ -77,8 +77,11 @@ std::vector<ReferenceAnswer> AnswerQueries(const bake::MeshReference& reference,
     if (!r.start_inside && !r.end_inside) {
       std::vector<double> ts;
       reference.Crossings(a, b, &ts);
-      if (ts.size() >= 2) {
-        const double t = 0.5 * (ts[0] + ts[1]);
+      // Inside somewhere between two consecutive crossings (a flap, a seam or a grazed fold can
+      // come first: every interval is tested, not only the first).
+      for (size_t c = 0; c + 1 < ts.size() && !r.contact_expected; ++c) {
+        if (!(ts[c + 1] > ts[c])) continue;
+        const double t = 0.5 * (ts[c] + ts[c + 1]);
         const double mid[3] = {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t,
                                a[2] + (b[2] - a[2]) * t};
         r.contact_expected = reference.Inside(mid);

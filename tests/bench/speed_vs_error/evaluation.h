@@ -1,9 +1,9 @@
 #pragma once
 // What the exact mesh says about each query, and the metrics of one method on one query set
 // against it (issue #6, "Metrics"). Definitions, for a motion p0 -> p1:
-//  - contact expected: p1 is inside the mesh (winding number > 1/2), or p0 is outside and the
-//    segment enters the mesh somewhere (the part between its first two crossings, or after its
-//    only crossing, is inside): a thin part crossed in one step counts (tunnelling).
+//  - contact expected: p1 is inside the mesh (winding number > 1/2), or p0 and p1 are outside and
+//    the segment is inside somewhere between two consecutive crossings (tested at the middle of
+//    each interval): a thin part crossed in one step counts (tunnelling).
 //  - missed: contact expected, and the method reports no contact.
 //  - false contact: no contact expected, and the method reports one (includes contacts with the
 //    method's deliberate inflation: epsilon for the maps, delta and growth for the hulls).
