@@ -417,6 +417,13 @@ TEST(BodyMapLayout, CorruptSpanTablesAreRefusedWithTheField) {
   a = good;
   a.body_maps.poses[0].span_begin = {0};
   expect(a, "body_maps.poses[0].row_span_offsets, span_begin, span_texel_offsets are not empty");
+  // A huge empty rectangle in a few bytes: the runtime would expand it to gigabytes.
+  a = good;
+  BodyMapPose& huge = a.body_maps.poses[1];
+  huge.height = 16384;
+  huge.width = 16384;
+  huge.row_span_offsets.resize(huge.height + 1, huge.row_span_offsets.back());
+  expect(a, at + "width x height = 268435456 texels for 8 stored: more than 256x");
 }
 
 // Byte edits in the file with valid checksums: the loader reports the field, never crashes.
