@@ -1598,8 +1598,8 @@ class ContactPlanes {
   static constexpr uint32_t kMax = 4;
   static constexpr double kTolerance = 1e-6;  // metres: violations below this are rounding
   // The projection may move the particle at most this many times its largest violation: the
-  // planes then meet at 28 degrees or more (cot(14 deg) = 4); narrower wedges are refused.
-  static constexpr double kMaxStretch = 4.0;
+  // planes then meet at 11.4 degrees or more (cot(5.7 deg) = 10); narrower wedges are refused.
+  static constexpr double kMaxStretch = 10.0;
   struct HalfSpace {
     Float3 normal;
     float offset;
