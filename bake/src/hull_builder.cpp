@@ -102,6 +102,19 @@ std::vector<uint32_t> GroupCoplanar(const Mesh& mesh, uint32_t* group_count,
                                     std::vector<uint32_t>* parent_out = nullptr);
 bool CanonicalTriangulation(Mesh* mesh);
 
+// Sorts the points lexicographically and removes exact duplicates (a deterministic input order
+// for the hull, whatever order the points were made in).
+void SortUnique(std::vector<Vec3>* points) {
+  std::sort(points->begin(), points->end(), [](const Vec3& a, const Vec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  });
+  points->erase(std::unique(points->begin(), points->end(),
+                            [](const Vec3& a, const Vec3& b) {
+                              return a.x == b.x && a.y == b.y && a.z == b.z;
+                            }),
+                points->end());
+}
+
 // ---------------------------------------------------------------------------------------------
 // Convex hull (CGAL). Returns false unless the hull is a closed polytope with >= 4 faces, i.e. the
 // points are not all coplanar.
@@ -1260,14 +1273,7 @@ class PlaneRemover {
         if (!Intersect(f[0], f[1], f[2], margin, &x)) continue;
         points.push_back(RoundToFloat(x));
       }
-      std::sort(points.begin(), points.end(), [](const Vec3& a, const Vec3& b) {
-        return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-      });
-      points.erase(std::unique(points.begin(), points.end(),
-                               [](const Vec3& a, const Vec3& b) {
-                                 return a.x == b.x && a.y == b.y && a.z == b.z;
-                               }),
-                   points.end());
+      SortUnique(&points);
       if (!ConvexHull(points, &result->mesh)) continue;
       result->kept_offsets.clear();
       for (uint32_t j = 0; j < normals_.size(); ++j) {
@@ -1318,14 +1324,7 @@ bool InflateMinkowski(const std::vector<Vec3>& base, double delta, double margin
   for (const Vec3& x : base) {
     for (const Vec3& u : ico) points.push_back(RoundToFloat(x + u * radius));
   }
-  std::sort(points.begin(), points.end(), [](const Vec3& a, const Vec3& b) {
-    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-  });
-  points.erase(std::unique(points.begin(), points.end(),
-                           [](const Vec3& a, const Vec3& b) {
-                             return a.x == b.x && a.y == b.y && a.z == b.z;
-                           }),
-               points.end());
+  SortUnique(&points);
   return ConvexHull(points, h0);
 }
 

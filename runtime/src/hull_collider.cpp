@@ -155,13 +155,6 @@ Mat34 ObbFromWorld(const RigidD& collider_to_world, Float3 center, const Float3 
   }
   return m;
 }
-Mat34 Translation(Float3 t) {
-  Mat34 m;
-  m.m[3] = t.x;
-  m.m[7] = t.y;
-  m.m[11] = t.z;
-  return m;
-}
 
 // ---- Watertight ray/triangle test (Woop, Benthin, Wald 2013) for a ray S + t d, t > 0. The
 // axes are permuted so that d's largest component is kz (indexing small arrays, no branches).
@@ -758,11 +751,11 @@ void HullColliderSet::ComputeFrames(uint32_t collider, float s0, float s1, Activ
     f->to_world_end = ToMat34(w1);
   } else {
     const Float3 c0 = Lerp(m.center0, m.center1, s0), c1 = Lerp(m.center0, m.center1, s1);
-    f->to_local_start = Translation(-c0);
-    f->to_local_end = Translation(-c1);
+    f->to_local_start = TranslationMatrix(-c0);
+    f->to_local_end = TranslationMatrix(-c1);
     f->to_obb_start = f->to_local_start;
     f->to_obb_end = f->to_local_end;
-    f->to_world_end = Translation(c1);
+    f->to_world_end = TranslationMatrix(c1);
   }
 }
 

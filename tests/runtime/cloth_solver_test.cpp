@@ -28,17 +28,9 @@ namespace {
 // Seconds at the start of frame `step`.
 float Time(int step, float dt) { return static_cast<float>(step) * dt; }
 
-Mat34 Translation(Float3 t) {
-  Mat34 m;
-  m.m[3] = t.x;
-  m.m[7] = t.y;
-  m.m[11] = t.z;
-  return m;
-}
-
 // Rotation about +y by `angle` radians, then translation t.
 Mat34 RotationY(float angle, Float3 t) {
-  Mat34 m = Translation(t);
+  Mat34 m = TranslationMatrix(t);
   const float c = std::cos(angle), s = std::sin(angle);
   m.m[0] = c;
   m.m[2] = s;
@@ -47,7 +39,7 @@ Mat34 RotationY(float angle, Float3 t) {
   return m;
 }
 
-// One joint sphere on joint 0: with skinning = Translation(t) its centre is center + t.
+// One joint sphere on joint 0: with skinning = TranslationMatrix(t) its centre is center + t.
 void BuildSphere(Float3 center, float radius, HullColliderSet* set) {
   JointSphereData sphere;
   sphere.joint = 0;
@@ -318,8 +310,8 @@ TEST(ClothSolver, RelativeSimulationRemovesRootTranslation) {
     ClothState state;
     state.Reset(cloth);
     for (int step = 0; step < 120; ++step) {
-      OneJointFrame joint{Translation({0.f, 0.f, 3.f * Time(step, dt)}),
-                          Translation({0.f, 0.f, 3.f * Time(step + 1, dt)})};
+      OneJointFrame joint{TranslationMatrix({0.f, 0.f, 3.f * Time(step, dt)}),
+                          TranslationMatrix({0.f, 0.f, 3.f * Time(step + 1, dt)})};
       ASSERT_TRUE(solver.Step(&state, ClothColliders{}, joint.Frame(dt)).ok());
     }
     const Float3 top = state.positions[shape.columns / 2];
@@ -374,8 +366,8 @@ TEST_P(MovingSphereLongRun, StaysBounded) {
   uint32_t contact_steps = 0;
   const int steps = static_cast<int>(std::lround(10.f / dt));
   for (int step = 0; step < steps; ++step) {
-    OneJointFrame joint{Translation(offset(Time(step, dt))),
-                        Translation(offset(Time(step + 1, dt)))};
+    OneJointFrame joint{TranslationMatrix(offset(Time(step, dt))),
+                        TranslationMatrix(offset(Time(step + 1, dt)))};
     ClothStepStats stats;
     ASSERT_TRUE(solver.Step(&state, colliders, joint.Frame(dt), &stats).ok()) << "step " << step;
     ASSERT_TRUE(AllFinite(state)) << "step " << step;
@@ -602,8 +594,8 @@ ClothState RunSheetScene(const Cloth& cloth, const ClothSolverSettings& settings
   ClothColliders colliders;
   colliders.hulls = &hulls;
   for (int step = 0; step < frames; ++step) {
-    OneJointFrame joint{Translation({0.f, Time(step, 0.002f), 0.f}),
-                        Translation({0.f, Time(step + 1, 0.002f), 0.f})};
+    OneJointFrame joint{TranslationMatrix({0.f, Time(step, 0.002f), 0.f}),
+                        TranslationMatrix({0.f, Time(step + 1, 0.002f), 0.f})};
     ClothStepStats stats;
     const Status s = solver.Step(&state, colliders, joint.Frame(1.f / 60.f), &stats);
     EXPECT_TRUE(s.ok()) << s.message();

@@ -79,6 +79,14 @@ inline Mat34 Multiply(const Mat34& a, const Mat34& b) {
   }
   return r;
 }
+// The pure translation by t.
+inline Mat34 TranslationMatrix(Float3 t) {
+  Mat34 m;
+  m.m[3] = t.x;
+  m.m[7] = t.y;
+  m.m[11] = t.z;
+  return m;
+}
 // Inverse of a rigid transform (rotation + translation).
 inline Mat34 InverseRigid(const Mat34& m) {
   Mat34 r;
