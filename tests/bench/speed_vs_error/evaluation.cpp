@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 namespace drape::bench {
@@ -100,6 +102,11 @@ Metrics Evaluate(const Method& method, const QuerySet& set,
   m.ns_one_thread = TimeCollide(method, set, 1, options.repetitions);
   if (options.two_threads) m.ns_two_threads = TimeCollide(method, set, 2, options.repetitions);
   if (!options.accuracy || method.speed_only) return m;
+  if (answers.size() != set.size()) {
+    std::fprintf(stderr, "speed_vs_error: %zu reference answers for %zu motions\n", answers.size(),
+                 set.size());
+    std::exit(1);
+  }
   m.has_accuracy = true;
 
   // One untimed batch for the positions after the response.

@@ -358,7 +358,7 @@ class Measurement {
                                 "hulls+spheres", hb.label + ", map-table ray", bytes));
       }
       if (!is_default) continue;
-      per_bone = PerBoneTable(spec.label, result.report);
+      per_bone = PerBoneTable(result.report);
       struct Variant {
         const char* label;
         InsideTest inside;
@@ -558,8 +558,7 @@ class Measurement {
                 method.setting.c_str(), m.ns_one_thread, c.peer_subset.size());
   }
 
-  static std::string PerBoneTable(const std::string& character, const nlohmann::json& report) {
-    (void)character;
+  static std::string PerBoneTable(const nlohmann::json& report) {
     std::ostringstream md;
     md << "Default bake: per bone, the collider's triangles, its growth beyond the inflated hull "
           "and its one-sided distance to the mesh (the farthest collider vertex from the "
