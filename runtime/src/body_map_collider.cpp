@@ -803,7 +803,108 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
 // ---------------------------------------------------------------------------------------------
 // Queries
 
+bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, ContactQuery* result) const {
+  const float u0 = (p0.x - origin_x_) * inv_texel_size_, v0 = (p0.y - origin_y_) * inv_texel_size_;
+  if (!(u0 >= 0.f && v0 >= 0.f && u0 < width_f_ && v0 < height_f_)) return false;
+  const float u1 = (p1.x - origin_x_) * inv_texel_size_, v1 = (p1.y - origin_y_) * inv_texel_size_;
+  const int i = static_cast<int>(u0), j = static_cast<int>(v0);
+  if (!(u1 >= 0.f && v1 >= 0.f) || static_cast<int>(u1) != i || static_cast<int>(v1) != j) {
+    return false;
+  }
+  const size_t texel = static_cast<size_t>(j) * width_ + static_cast<size_t>(i);
+  // A contact reads this texel's normals from their own array: start that load now.
+  __builtin_prefetch(&normals_[texel]);
+  const Slab slab = slabs_[texel];
+  const float z0 = p0.z, z1 = p1.z;
+  // A background texel holds nothing (the general path clips or walks it to the same answer).
+  // On a valid texel x and y lie in the clip box; the general path clips nothing only when z
+  // does too, and then its walk is one visit of this texel over s in [0, 1], which is below.
+  if (!(slab.top >= slab.bottom)) return true;
+  if (!(z0 >= clip_lo_[2] && z0 <= clip_hi_[2] && z1 >= clip_lo_[2] && z1 <= clip_hi_[2])) {
+    return false;
+  }
+  const bool inside_start = z0 <= slab.top && z0 >= slab.bottom;
+  const bool inside_end = z1 <= slab.top && z1 >= slab.bottom;
+  result->inside_end = inside_end;
+  if (inside_end) result->depth = std::min(slab.top - z1, z1 - slab.bottom);
+  if (inside_start) {
+    if (!inside_end) return true;                        // left through a surface, no entry
+    const bool back = z1 - slab.bottom < slab.top - z1;  // never left: pushed out along z
+    result->contact = true;
+    result->t = 0.f;
+    result->flags = kCollisionStartedInside;
+    result->point = Float3{p1.x, p1.y, back ? slab.bottom : slab.top};
+    result->normal = TexelNormal(static_cast<uint32_t>(i), static_cast<uint32_t>(j), back);
+    return true;
+  }
+  // Outside at the start: an entry only where the end values say a surface is crossed.
+  const bool from_front = z0 > slab.top;
+  const float surface = from_front ? slab.top : slab.bottom;
+  if (from_front ? !(z1 <= slab.top) : !(z1 >= slab.bottom)) return true;
+  const float s = std::min(std::max((surface - z0) / (z1 - z0), 0.f), 1.f);
+  result->contact = true;
+  result->t = s;
+  result->point =
+      Float3{BodyMapWalk::Along(p0.x, p1.x, s), BodyMapWalk::Along(p0.y, p1.y, s), surface};
+  result->normal = TexelNormal(static_cast<uint32_t>(i), static_cast<uint32_t>(j), !from_front);
+  return true;
+}
+
+bool BodyMapCollider::ClearlyFree(Float3 p0, Float3 p1) const {
+  const float u0 = (p0.x - origin_x_) * inv_texel_size_, v0 = (p0.y - origin_y_) * inv_texel_size_;
+  const float u1 = (p1.x - origin_x_) * inv_texel_size_, v1 = (p1.y - origin_y_) * inv_texel_size_;
+  const float u_lo = std::min(u0, u1), u_hi = std::max(u0, u1);
+  const float v_lo = std::min(v0, v1), v_hi = std::max(v0, v1);
+  if (!(u_lo >= 0.f && v_lo >= 0.f && u_hi < width_f_ && v_hi < height_f_)) return false;
+  // The walk's cells lie between the texels of its clipped ends, and the clipped ends lie
+  // between p0 and p1 (float rounding is monotone): the texel box of p0 and p1 holds every
+  // cell. Bilinear cells also read the texels one step down and left (their 2x2 block).
+  const int reach = sampling_ == DepthSampling::kBilinear ? 1 : 0;
+  const int i_lo = std::max(static_cast<int>(u_lo) - reach, 0);
+  const int j_lo = std::max(static_cast<int>(v_lo) - reach, 0);
+  const int i_hi = std::min(static_cast<int>(u_hi) + reach, static_cast<int>(width_) - 1);
+  const int j_hi = std::min(static_cast<int>(v_hi) + reach, static_cast<int>(height_) - 1);
+  // The walk's z values are interpolated in float and may step an ulp or two beyond the end
+  // values: pad by a millionth.
+  const float z_lo = std::min(p0.z, p1.z), z_hi = std::max(p0.z, p1.z);
+  const float pad = 1e-6f * (1.f + std::max(std::fabs(z_lo), std::fabs(z_hi)));
+  const float below = z_lo - pad, above = z_hi + pad;
+  bool free = true;
+  if ((i_hi - i_lo + 1) * (j_hi - j_lo + 1) <= kFreeTestMaxTexels) {
+    for (int j = j_lo; j <= j_hi; ++j) {
+      const Slab* row = slabs_.data() + static_cast<size_t>(j) * width_;
+      for (int i = i_lo; i <= i_hi; ++i) free &= (below > row[i].top) | (above < row[i].bottom);
+    }
+    return free;
+  }
+  // Longer motions: the 8x8 min/max blocks (each already widened by one texel and padded).
+  const int bi_lo = i_lo >> kBlockShift, bi_hi = i_hi >> kBlockShift;
+  const int bj_lo = j_lo >> kBlockShift, bj_hi = j_hi >> kBlockShift;
+  if ((bi_hi - bi_lo + 1) * (bj_hi - bj_lo + 1) > kFreeTestMaxTexels) return false;
+  for (int bj = bj_lo; bj <= bj_hi; ++bj) {
+    const BlockBounds* row = blocks_.data() + static_cast<size_t>(bj) * blocks_w_;
+    for (int bi = bi_lo; bi <= bi_hi; ++bi) {
+      free &= (below > row[bi].max_top) | (above < row[bi].min_bottom);
+    }
+  }
+  return free;
+}
+
 ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
+  ContactQuery result;
+  result.point = p1;
+  result.normal = Float3{0.f, 0.f, 1.f};
+  if (!IsFinite(p0) || !IsFinite(p1)) {
+    result.flags = kCollisionInvalidInput;
+    return result;
+  }
+  if (stats_.valid_texels == 0) return result;
+  if (sampling_ == DepthSampling::kNearest && QuerySingleTexel(p0, p1, &result)) return result;
+  if (ClearlyFree(p0, p1)) return result;
+  return QueryWalk(p0, p1);
+}
+
+ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
   ContactQuery result;
   result.point = p1;
   result.normal = Float3{0.f, 0.f, 1.f};

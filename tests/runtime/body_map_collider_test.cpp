@@ -18,6 +18,15 @@
 #include <vector>
 
 namespace drape {
+
+// Reaches the collider's general path (clip and walk), which Query skips for motions that stay
+// in one texel or clearly pass through air.
+struct BodyMapColliderTestAccess {
+  static ContactQuery QueryWalk(const BodyMapCollider& c, Float3 p0, Float3 p1) {
+    return c.QueryWalk(p0, p1);
+  }
+};
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -850,6 +859,78 @@ void ExpectIdenticalColliders(const BodyMapCollider& a, const BodyMapCollider& b
     contacts += qa.contact;
   }
   EXPECT_GT(contacts, segments / 20) << "the segments must exercise contacts";
+}
+
+// Query's quick paths (one texel, clearly through air) give exactly the general path's answer:
+// points, sub-texel motions, short and long ones, starting inside, beyond the box in z, on
+// texel edges, on the three analytic bodies, in both samplings.
+TEST(BodyMapCollider, QuickPathsAnswerBitForBitAsTheWalk) {
+  const BodyMapCollider bodies[3] = {BuildOrDie(MakePose(SphereGrid(), Sphere)),
+                                     BuildOrDie(MakePose(BoxGrid(), Box)),
+                                     BuildOrDie(MakePose(SphereGrid(), ThinSlab))};
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  for (int body = 0; body < 3; ++body) {
+    for (DepthSampling sampling : {DepthSampling::kNearest, DepthSampling::kBilinear}) {
+      SCOPED_TRACE(::testing::Message() << "body " << body << " sampling " << int(sampling));
+      const BodyMapCollider& c =
+          sampling == DepthSampling::kNearest
+              ? bodies[body]
+              : BuildOrDie(MakePose(body == 1 ? BoxGrid() : SphereGrid(), body == 0   ? Sphere
+                                                                          : body == 1 ? Box
+                                                                                      : ThinSlab),
+                           sampling);
+      const Float3 lo = c.bounds_min(), hi = c.bounds_max();
+      const auto point = [&](float pad) {
+        return Float3{lo.x - pad + unit(rng) * (hi.x - lo.x + 2.f * pad),
+                      lo.y - pad + unit(rng) * (hi.y - lo.y + 2.f * pad),
+                      lo.z - pad + unit(rng) * (hi.z - lo.z + 2.f * pad)};
+      };
+      int contacts = 0, started_inside = 0, same_texel = 0;
+      for (int k = 0; k < 40000; ++k) {
+        Float3 p0 = point(0.02f), p1 = p0;
+        const float texel = c.texel_size();
+        switch (k % 5) {
+          case 0:  // a point
+            break;
+          case 1:  // sub-texel, mostly along z through a surface
+            p1 = p0 + Float3{(unit(rng) - 0.5f) * 0.5f * texel, (unit(rng) - 0.5f) * 0.5f * texel,
+                             (unit(rng) - 0.5f) * 0.05f};
+            break;
+          case 2:  // one to three texels
+            p1 = p0 + Float3{(unit(rng) - 0.5f) * 6.f * texel, (unit(rng) - 0.5f) * 6.f * texel,
+                             (unit(rng) - 0.5f) * 0.02f};
+            break;
+          case 3:  // long, across the box
+            p1 = point(0.1f);
+            break;
+          default:  // on a texel edge, moving along z only
+            p0.x = c.origin_x() + std::floor((p0.x - c.origin_x()) / texel) * texel;
+            p1 = Float3{p0.x, p0.y, p0.z + (unit(rng) - 0.5f) * 0.1f};
+            break;
+        }
+        const ContactQuery quick = c.Query(p0, p1);
+        const ContactQuery walk = BodyMapColliderTestAccess::QueryWalk(c, p0, p1);
+        EXPECT_EQ(quick.inside_end, walk.inside_end) << k;
+        EXPECT_EQ(quick.contact, walk.contact) << k;
+        EXPECT_EQ(Bits(quick.t), Bits(walk.t)) << k;
+        ExpectSameBits(quick.point, walk.point, "point", k);
+        ExpectSameBits(quick.normal, walk.normal, "normal", k);
+        EXPECT_EQ(Bits(quick.depth), Bits(walk.depth)) << k;
+        EXPECT_EQ(quick.flags, walk.flags) << k;
+        contacts += walk.contact;
+        started_inside += (walk.flags & kCollisionStartedInside) != 0;
+        same_texel +=
+            std::floor((p0.x - c.origin_x()) / texel) ==
+                std::floor((p1.x - c.origin_x()) / texel) &&
+            std::floor((p0.y - c.origin_y()) / texel) == std::floor((p1.y - c.origin_y()) / texel);
+      }
+      // The sets must exercise every branch of the quick paths.
+      EXPECT_GT(contacts, 2000);
+      EXPECT_GT(started_inside, 200);
+      EXPECT_GT(same_texel, 16000);
+    }
+  }
 }
 
 TEST(BodyMapCollider, RowSpanLayoutAnswersExactlyAsDense) {

@@ -191,6 +191,7 @@ class BodyMapCollider {
  private:
   friend class BodyMapSequence;
   friend struct BodyMapWalk;
+  friend struct BodyMapColliderTestAccess;  // tests: QueryWalk against Query's quick paths
 
   struct Slab {
     float top;     // z of the front surface; -inf on background
@@ -207,6 +208,17 @@ class BodyMapCollider {
   static constexpr uint32_t kBlockShift = 3;  // 8x8 texels per min/max block
   static constexpr uint32_t kBlockTexels = 1u << kBlockShift;
 
+  // The quick answer for motions through air: true when every texel (or min/max block) the
+  // walk from p0 to p1 could visit holds no z of the segment, so Query has no contact and p1 is
+  // outside. Conservative: false whenever unsure (ends off the grid, long motions).
+  bool ClearlyFree(Float3 p0, Float3 p1) const;
+  // Query without its quick paths: clip, walk, answer. Query gives the same bits.
+  ContactQuery QueryWalk(Float3 p0, Float3 p1) const;
+  // Query for a motion that stays in one texel of the grid (kNearest): fills *result and
+  // returns true, bit for bit what the general path gives; false when the general path must
+  // answer (ends in different texels, off the grid, or outside the clip box in z).
+  bool QuerySingleTexel(Float3 p0, Float3 p1, ContactQuery* result) const;
+  static constexpr int kFreeTestMaxTexels = 9;  // texels (or blocks) ClearlyFree reads at most
   bool IsInsideBilinear(Float3 p) const;
   void InsideRange(const Float3* points, uint8_t* inside, size_t count) const;  // kNearest
   // top/bottom at texel coordinates (u, v) >= 0 inside the grid, in half-texel cell (ci, cj) =
