@@ -901,7 +901,8 @@ ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
   if (stats_.valid_texels == 0) return result;
   if (sampling_ == DepthSampling::kNearest && QuerySingleTexel(p0, p1, &result)) return result;
   if (ClearlyFree(p0, p1)) return result;
-  return QueryWalk(p0, p1);
+  WalkInto(p0, p1, &result);
+  return result;  // one named result on every path: built in place, never copied
 }
 
 ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
@@ -912,7 +913,12 @@ ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
     result.flags = kCollisionInvalidInput;
     return result;
   }
-  if (stats_.valid_texels == 0) return result;
+  if (stats_.valid_texels != 0) WalkInto(p0, p1, &result);
+  return result;
+}
+
+void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
+  ContactQuery& result = *out;
   result.inside_end = IsInside(p1);
 
   // Liang-Barsky in double (no overflow for any finite float input).
@@ -930,7 +936,7 @@ ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
   // Both ends in the box is the common case near the body: nothing to clip, no divisions.
   for (int k = 0; k < 3 && !(p0_in_box && p1_in_box); ++k) {
     if (d[k] == 0.0) {
-      if (a[k] < clip_lo_[k] || a[k] > clip_hi_[k]) return result;
+      if (a[k] < clip_lo_[k] || a[k] > clip_hi_[k]) return;
       continue;
     }
     double t_lo = (clip_lo_[k] - a[k]) / d[k];
@@ -945,7 +951,7 @@ ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
       end_axis = k;
     }
   }
-  if (t_start > t_end) return result;
+  if (t_start > t_end) return;
   // A clipped end: on the clipping plane exactly in its axis, and clamped into the box in the
   // others (for |p1 - p0| beyond ~1e9 m the double product loses metres; the clamp keeps the walk
   // bounded by the box whatever the input).
@@ -1040,7 +1046,7 @@ ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
       }
     }
     result.normal = normal_at(walk.hit_ci, walk.hit_cj, u, v, back);
-    return result;
+    return;
   }
   if (result.inside_end) {
     // Started inside and never left (or, defensively, any inside end the walk did not explain):
@@ -1054,7 +1060,6 @@ ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
     const float v = (p1.y - origin_y_) * inv_texel_size_;
     result.normal = normal_at(p1_ci, p1_cj, u, v, back);
   }
-  return result;
 }
 
 Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span<Float3> positions,

@@ -214,6 +214,9 @@ class BodyMapCollider {
   bool ClearlyFree(Float3 p0, Float3 p1) const;
   // Query without its quick paths: clip, walk, answer. Query gives the same bits.
   ContactQuery QueryWalk(Float3 p0, Float3 p1) const;
+  // QueryWalk's clip, walk and answer into *out, which holds the defaults of a miss (finite
+  // input, a non-empty map).
+  void WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const;
   // Query for a motion that stays in one texel of the grid (kNearest): fills *result and
   // returns true, bit for bit what the general path gives; false when the general path must
   // answer (ends in different texels, off the grid, or outside the clip box in z).
