@@ -1,11 +1,13 @@
-// Golden colliders: today's bake of the built-in mannequin against the committed file
-// tests/golden/mannequin_colliders_v2.drape, compared with tolerances (not hashes), so a change
-// of numerics that moves a surface is seen, and a change of rounding is not.
+// Golden colliders: today's bakes of the built-in mannequin and of the shared CesiumMan against
+// the committed files tests/golden/<name>_colliders_v2.drape, compared with tolerances (not
+// hashes), so a change of numerics that moves a surface is seen, and a change of rounding is not.
+// CesiumMan's cases skip with a message when ../shared is absent.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 
 #include "drape/bake/bake_config.h"
@@ -35,33 +37,60 @@ float WorstSurfaceGap(const HullColliderData& a, const HullColliderData& b) {
   return worst;
 }
 
-class GoldenColliders : public ::testing::Test {
- protected:
-  // One bake for the whole suite.
-  static void SetUpTestSuite() {
-    const std::string golden_path = test::GoldenDir() + "/mannequin_colliders_v2.drape";
-    golden_status_ = ReadAssetFile(golden_path, &golden_);
-    bake::BakeConfig config;
-    today_status_ = bake::LoadBakeConfig(test::GoldenDir() + "/mannequin_colliders.json", &config);
-    bake::BakeResult result;
-    if (today_status_.ok())
-      today_status_ = bake::BakeCharacter(test::MannequinPath(), config, &result);
-    today_ = std::move(result.asset);
-  }
-  void SetUp() override {
-    ASSERT_TRUE(golden_status_.ok()) << golden_status_.message();
-    ASSERT_TRUE(today_status_.ok()) << today_status_.message();
-  }
-  static inline CharacterAsset golden_, today_;
-  static inline Status golden_status_, today_status_;
+struct GoldenCase {
+  std::string name;    // the golden file is tests/golden/<name>_colliders_v2.drape
+  std::string source;  // the character file baked today
 };
 
-TEST_F(GoldenColliders, HullsKeepTheirSurfaces) {
-  ASSERT_EQ(today_.hulls.size(), golden_.hulls.size());
-  for (size_t h = 0; h < golden_.hulls.size(); ++h) {
-    const HullColliderData& g = golden_.hulls[h];
-    const HullColliderData& t = today_.hulls[h];
-    const std::string bone = golden_.skeleton.joint_names[g.joint];
+std::string PrintCase(const ::testing::TestParamInfo<GoldenCase>& info) { return info.param.name; }
+
+struct GoldenBakes {
+  CharacterAsset golden, today;
+  Status golden_status, today_status;
+};
+
+// One bake per character for the whole suite; both with tests/golden/mannequin_colliders.json.
+const GoldenBakes& BakesOf(const GoldenCase& c) {
+  static std::map<std::string, GoldenBakes> cache;
+  if (const auto found = cache.find(c.name); found != cache.end()) return found->second;
+  GoldenBakes& bakes = cache[c.name];
+  bakes.golden_status =
+      ReadAssetFile(test::GoldenDir() + "/" + c.name + "_colliders_v2.drape", &bakes.golden);
+  bake::BakeConfig config;
+  bakes.today_status =
+      bake::LoadBakeConfig(test::GoldenDir() + "/mannequin_colliders.json", &config);
+  bake::BakeResult result;
+  if (bakes.today_status.ok()) bakes.today_status = bake::BakeCharacter(c.source, config, &result);
+  bakes.today = std::move(result.asset);
+  return bakes;
+}
+
+class GoldenColliders : public ::testing::TestWithParam<GoldenCase> {
+ protected:
+  void SetUp() override {
+    DRAPE_REQUIRE_FILE(GetParam().source);
+    const GoldenBakes& bakes = BakesOf(GetParam());
+    ASSERT_TRUE(bakes.golden_status.ok()) << bakes.golden_status.message();
+    ASSERT_TRUE(bakes.today_status.ok()) << bakes.today_status.message();
+    golden_ = &bakes.golden;
+    today_ = &bakes.today;
+  }
+  const CharacterAsset* golden_ = nullptr;
+  const CharacterAsset* today_ = nullptr;
+};
+
+INSTANTIATE_TEST_SUITE_P(
+    Characters, GoldenColliders,
+    ::testing::Values(GoldenCase{"mannequin", test::MannequinPath()},
+                      GoldenCase{"CesiumMan", test::CharacterPath("CesiumMan/CesiumMan.glb")}),
+    PrintCase);
+
+TEST_P(GoldenColliders, HullsKeepTheirSurfaces) {
+  ASSERT_EQ(today_->hulls.size(), golden_->hulls.size());
+  for (size_t h = 0; h < golden_->hulls.size(); ++h) {
+    const HullColliderData& g = golden_->hulls[h];
+    const HullColliderData& t = today_->hulls[h];
+    const std::string bone = golden_->skeleton.joint_names[g.joint];
     ASSERT_EQ(t.joint, g.joint);
     for (int k = 0; k < 12; ++k) EXPECT_NEAR(t.bind_frame.m[k], g.bind_frame.m[k], 1e-5f) << bone;
     const float tolerance = 1e-3f;  // metres: one mm of surface movement is a visible change
@@ -75,22 +104,22 @@ TEST_F(GoldenColliders, HullsKeepTheirSurfaces) {
   }
 }
 
-TEST_F(GoldenColliders, JointSpheresKeepCentresAndRadii) {
-  ASSERT_EQ(today_.joint_spheres.size(), golden_.joint_spheres.size());
-  for (size_t s = 0; s < golden_.joint_spheres.size(); ++s) {
-    const JointSphereData& g = golden_.joint_spheres[s];
-    const JointSphereData& t = today_.joint_spheres[s];
+TEST_P(GoldenColliders, JointSpheresKeepCentresAndRadii) {
+  ASSERT_EQ(today_->joint_spheres.size(), golden_->joint_spheres.size());
+  for (size_t s = 0; s < golden_->joint_spheres.size(); ++s) {
+    const JointSphereData& g = golden_->joint_spheres[s];
+    const JointSphereData& t = today_->joint_spheres[s];
     EXPECT_EQ(t.joint, g.joint);
     EXPECT_LE(Length(t.center - g.center), 1e-5f);
     EXPECT_NEAR(t.radius, g.radius, 1e-5f);
   }
 }
 
-TEST_F(GoldenColliders, BodyMapsKeepCoverageAndDepth) {
-  ASSERT_EQ(today_.body_maps.poses.size(), golden_.body_maps.poses.size());
+TEST_P(GoldenColliders, BodyMapsKeepCoverageAndDepth) {
+  ASSERT_EQ(today_->body_maps.poses.size(), golden_->body_maps.poses.size());
   BodyMapCollider g, t;
-  ASSERT_TRUE(g.Build(golden_.body_maps.poses[0]).ok());
-  ASSERT_TRUE(t.Build(today_.body_maps.poses[0]).ok());
+  ASSERT_TRUE(g.Build(golden_->body_maps.poses[0]).ok());
+  ASSERT_TRUE(t.Build(today_->body_maps.poses[0]).ok());
   EXPECT_FLOAT_EQ(t.texel_size(), g.texel_size());
   // Compare texel by texel over the union of the two stored rectangles, in asset coordinates.
   const float s = g.texel_size();
@@ -122,7 +151,7 @@ TEST_F(GoldenColliders, BodyMapsKeepCoverageAndDepth) {
   EXPECT_LE(static_cast<double>(coverage_mismatch), 1e-4 * static_cast<double>(texels))
       << coverage_mismatch << " of " << texels << " texels changed coverage";
   // Two unorm16 quanta of the depth range (about 10 um here).
-  EXPECT_LE(worst_depth, 2.f * golden_.body_maps.poses[0].depth_range / 65535.f);
+  EXPECT_LE(worst_depth, 2.f * golden_->body_maps.poses[0].depth_range / 65535.f);
 }
 
 }  // namespace

@@ -6,3 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 build/bin/drape-bake samples/mannequin/mannequin.gltf -o tests/golden/mannequin_colliders_v2.drape \
   --config tests/golden/mannequin_colliders.json
+# A shared character's bake beside our own (../shared must be present; the character itself is
+# never copied here, only our bake of it).
+build/bin/drape-bake ../shared/assets/characters/CesiumMan/CesiumMan.glb \
+  -o tests/golden/CesiumMan_colliders_v2.drape --config tests/golden/mannequin_colliders.json
