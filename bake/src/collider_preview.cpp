@@ -87,7 +87,7 @@ Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, i
 
   struct Layer {
     MapViewImage image;
-    CpuRasterScratch scratch;
+    std::vector<uint32_t> face;  // winning triangle per pixel, ~0u where none
   };
   auto render = [&](const Soup& soup, Layer* layer) {
     const size_t n = soup.positions.size() / 3;
@@ -111,7 +111,7 @@ Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, i
     input.normals = soup.normals;
     input.positions = soup.positions;
     input.triangles = soup.triangles;
-    RasterizeViewCpu(input, 0, &layer->scratch, &layer->image);
+    RasterizeViewCpu(input, 0, &layer->image, &layer->face);
   };
   Layer body_layer, collider_layer;
   render(body, &body_layer);
@@ -128,13 +128,13 @@ Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, i
       const float* n = &layer.image.normal[3 * i];
       const float lambert = 0.35f + 0.65f * std::fabs(n[0] * l[0] + n[1] * l[1] + n[2] * l[2]);
       float colour[3];
-      OwnerColour(soup.owner[layer.scratch.face[i]], hull_count, colour);
+      OwnerColour(soup.owner[layer.face[i]], hull_count, colour);
       for (int k = 0; k < 3; ++k) rgb[k] = (1.f - alpha) * rgb[k] + alpha * colour[k] * lambert;
     };
     shade(body_layer, body, 1.f);
     const bool collider_here = !collider_layer.image.valid.empty() && collider_layer.image.valid[i];
     if (collider_here) {
-      const int32_t owner = colliders.owner[collider_layer.scratch.face[i]];
+      const int32_t owner = colliders.owner[collider_layer.face[i]];
       shade(collider_layer, colliders, owner >= hull_count ? 0.3f : 0.7f);
     }
     for (int k = 0; k < 3; ++k)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace drape::bake {
@@ -144,16 +145,63 @@ bool ClipSpan(const Edge& e, double row_term, int64_t* lo, int64_t* hi) {
   return *lo <= *hi;
 }
 
-}  // namespace
+// The working depth and triangle of each texel live in the texel's 12 bytes of the output
+// normal image (a double and a uint32), so a view needs no memory beyond its image: no extra
+// multi-megabyte buffer to fault in and fill per call. The normals pass reads a texel's slot
+// before it writes that texel's normal over it. memcpy: the floats' storage is reused as bytes.
+class TexelSlots {
+ public:
+  static_assert(sizeof(double) + sizeof(uint32_t) == 3 * sizeof(float));
+  TexelSlots() = default;
+  explicit TexelSlots(std::vector<float>* normal)
+      : bytes_(reinterpret_cast<unsigned char*>(normal->data())) {}
+  double Depth(size_t index) const {
+    double depth;
+    std::memcpy(&depth, bytes_ + kBytes * index, sizeof(double));
+    return depth;
+  }
+  uint32_t Face(size_t index) const {
+    uint32_t face;
+    std::memcpy(&face, bytes_ + kBytes * index + sizeof(double), sizeof(uint32_t));
+    return face;
+  }
+  void SetDepth(size_t index, double depth) {
+    std::memcpy(bytes_ + kBytes * index, &depth, sizeof(double));
+  }
+  void Set(size_t index, double depth, uint32_t face) {
+    SetDepth(index, depth);
+    std::memcpy(bytes_ + kBytes * index + sizeof(double), &face, sizeof(uint32_t));
+  }
 
-void RasterizeViewCpu(const MapRasterInput& in, int view, CpuRasterScratch* scratch,
-                      MapViewImage* image) {
+ private:
+  static constexpr size_t kBytes = 3 * sizeof(float);
+  unsigned char* bytes_ = nullptr;
+};
+
+// The rasterizer for `kViews` views (1 or 2) of the same triangles: the coverage of a texel
+// centre depends only on the window coordinates, so the edge tests, which are most of the work,
+// run once per triangle and texel for all views; each view keeps its own depth test, with exactly
+// the arithmetic of a single-view pass (so a view does not depend on which others share the pass).
+template <int kViews>
+void RasterizeViews(const MapRasterInput& in, const int (&views)[kViews],
+                    MapViewImage* const (&images)[kViews],
+                    std::vector<uint32_t>* const (&faces)[kViews]) {
   const size_t texels = static_cast<size_t>(in.width) * in.height;
-  std::vector<double>& depth = scratch->depth;
-  std::vector<uint32_t>& face = scratch->face;
-  depth.assign(texels, std::numeric_limits<double>::infinity());
-  face.assign(texels, kNoFace);
-  const std::span<const double> vertex_depth = in.view_depth[view];
+  // A texel's triangle is written exactly when its depth drops below +infinity (a depth of
+  // +infinity or NaN never wins), so only the depths need a start value; the triangles are read
+  // only where the depth is finite. Every texel of the images is written below, so resize()
+  // suffices and an image reused from an earlier call keeps no stale texel.
+  constexpr double kEmpty = std::numeric_limits<double>::infinity();
+  TexelSlots slots[kViews];
+  for (int k = 0; k < kViews; ++k) {
+    images[k]->valid.resize(texels);
+    images[k]->depth.resize(texels);
+    images[k]->normal.resize(3 * texels);
+    slots[k] = TexelSlots(&images[k]->normal);
+    for (size_t index = 0; index < texels; ++index) slots[k].SetDepth(index, kEmpty);
+  }
+  const double* vertex_depth[kViews];
+  for (int k = 0; k < kViews; ++k) vertex_depth[k] = in.view_depth[views[k]].data();
   const size_t triangle_count = in.triangles.size() / 3;
   const int64_t max_i = static_cast<int64_t>(in.width) - 1;
   const int64_t max_j = static_cast<int64_t>(in.height) - 1;
@@ -173,11 +221,16 @@ void RasterizeViewCpu(const MapRasterInput& in, int view, CpuRasterScratch* scra
     if (!SetUpEdges(in, v, &s)) continue;
     // Barycentric depth as a plane over the texel centres, clamped to the vertex depths (a
     // sliver's huge gradient cannot extrapolate, and a NaN from it becomes the minimum).
-    const double d0 = vertex_depth[v[0]], d1 = vertex_depth[v[1]], d2 = vertex_depth[v[2]];
     const double inverse_area2 = 1.0 / s.area2;
-    const double grad_x = ((d1 - d0) * (y2 - y0) - (d2 - d0) * (y1 - y0)) * inverse_area2;
-    const double grad_y = ((d2 - d0) * (x1 - x0) - (d1 - d0) * (x2 - x0)) * inverse_area2;
-    const double d_min = std::min({d0, d1, d2}), d_max = std::max({d0, d1, d2});
+    double d0[kViews], grad_x[kViews], grad_y[kViews], d_min[kViews], d_max[kViews];
+    for (int k = 0; k < kViews; ++k) {
+      const double a = vertex_depth[k][v[0]], b = vertex_depth[k][v[1]], c = vertex_depth[k][v[2]];
+      d0[k] = a;
+      grad_x[k] = ((b - a) * (y2 - y0) - (c - a) * (y1 - y0)) * inverse_area2;
+      grad_y[k] = ((c - a) * (x1 - x0) - (b - a) * (x2 - x0)) * inverse_area2;
+      d_min[k] = std::min({a, b, c});
+      d_max[k] = std::max({a, b, c});
+    }
     const uint32_t face_id = static_cast<uint32_t>(t);
     // Narrow triangles test every texel of the bounding box; wider ones find each row's span
     // (the same predicate, so both give the same coverage; a span costs 3 boundary estimates
@@ -189,9 +242,9 @@ void RasterizeViewCpu(const MapRasterInput& in, int view, CpuRasterScratch* scra
       const double row0 = s.edge[0].RowTerm(py);
       const double row1 = s.edge[1].RowTerm(py);
       const double row2 = s.edge[2].RowTerm(py);
-      const double row_depth = d0 + grad_y * (py - s.y0);
-      double* depth_row = depth.data() + static_cast<size_t>(j) * in.width;
-      uint32_t* face_row = face.data() + static_cast<size_t>(j) * in.width;
+      double row_depth[kViews];
+      for (int k = 0; k < kViews; ++k) row_depth[k] = d0[k] + grad_y[k] * (py - s.y0);
+      const size_t row_start = static_cast<size_t>(j) * in.width;
       int64_t lo = i0, hi = i1;
       if (!narrow &&
           (!ClipSpan(s.edge[0], row0, &lo, &hi) || !ClipSpan(s.edge[1], row1, &lo, &hi) ||
@@ -205,67 +258,105 @@ void RasterizeViewCpu(const MapRasterInput& in, int view, CpuRasterScratch* scra
                         s.edge[2].Inside(s.edge[2].Value(row2, px)))) {
           continue;
         }
-        // max(d_min, min(d, d_max)) also maps a NaN to d_min (the operand order matters).
-        const double d = std::max(d_min, std::min(row_depth + grad_x * (px - s.x0), d_max));
-        if (d < depth_row[i]) {
-          depth_row[i] = d;
-          face_row[i] = face_id;
+        for (int k = 0; k < kViews; ++k) {
+          // max(d_min, min(d, d_max)) also maps a NaN to d_min (the operand order matters).
+          const double d =
+              std::max(d_min[k], std::min(row_depth[k] + grad_x[k] * (px - s.x0), d_max[k]));
+          const size_t index = row_start + static_cast<size_t>(i);
+          if (d < slots[k].Depth(index)) slots[k].Set(index, d, face_id);
         }
       }
     }
   }
 
-  image->valid.assign(texels, 0);
-  image->depth.assign(texels, 0.f);
-  image->normal.assign(3 * texels, 0.f);
-  const double view_axis_z = view == 0 ? 1.0 : -1.0;
-  uint32_t cached_face = kNoFace;
-  bool cached_ok = false;
-  TriangleSetup s{};
-  const double* n0 = nullptr;
-  const double* n1 = nullptr;
-  const double* n2 = nullptr;
-  for (uint32_t j = 0; j < in.height; ++j) {
-    const double py = j + 0.5;
-    for (uint32_t i = 0; i < in.width; ++i) {
-      const size_t index = static_cast<size_t>(j) * in.width + i;
-      const uint32_t t = face[index];
-      if (t == kNoFace) continue;
-      const uint32_t v[3] = {in.triangles[3 * t], in.triangles[3 * t + 1], in.triangles[3 * t + 2]};
-      if (t != cached_face) {
-        cached_face = t;
-        cached_ok = SetUpBarycentrics(in, v, &s);
-        n0 = &in.normals[3 * v[0]];
-        n1 = &in.normals[3 * v[1]];
-        n2 = &in.normals[3 * v[2]];
+  for (int k = 0; k < kViews; ++k) {
+    MapViewImage* image = images[k];
+    const TexelSlots& slot = slots[k];
+    uint32_t* out_face = nullptr;
+    if (faces[k] != nullptr) {
+      faces[k]->resize(texels);
+      out_face = faces[k]->data();
+    }
+    uint8_t* out_valid = image->valid.data();
+    float* out_depth = image->depth.data();
+    float* out_normal = image->normal.data();
+    const double view_axis_z = views[k] == 0 ? 1.0 : -1.0;
+    uint32_t cached_face = kNoFace;
+    bool cached_ok = false;
+    TriangleSetup s{};
+    const double* n0 = nullptr;
+    const double* n1 = nullptr;
+    const double* n2 = nullptr;
+    for (uint32_t j = 0; j < in.height; ++j) {
+      const double py = j + 0.5;
+      for (uint32_t i = 0; i < in.width; ++i) {
+        const size_t index = static_cast<size_t>(j) * in.width + i;
+        const double texel_depth = slot.Depth(index);
+        if (!(texel_depth < kEmpty)) {
+          if (out_face != nullptr) out_face[index] = kNoFace;
+          out_valid[index] = 0;
+          out_depth[index] = 0.f;
+          out_normal[3 * index] = 0.f;
+          out_normal[3 * index + 1] = 0.f;
+          out_normal[3 * index + 2] = 0.f;
+          continue;
+        }
+        const uint32_t t = slot.Face(index);
+        if (out_face != nullptr) out_face[index] = t;
+        const uint32_t v[3] = {in.triangles[3 * t], in.triangles[3 * t + 1],
+                               in.triangles[3 * t + 2]};
+        if (t != cached_face) {
+          cached_face = t;
+          cached_ok = SetUpBarycentrics(in, v, &s);
+          n0 = &in.normals[3 * v[0]];
+          n1 = &in.normals[3 * v[1]];
+          n2 = &in.normals[3 * v[2]];
+        }
+        double lambda1 = 1.0 / 3.0, lambda2 = 1.0 / 3.0;
+        if (cached_ok) {
+          const double dx = (i + 0.5) - s.x0, dy = py - s.y0;
+          lambda1 = std::clamp(s.l1_x * dx + s.l1_y * dy, 0.0, 1.0);
+          lambda2 = std::clamp(s.l2_x * dx + s.l2_y * dy, 0.0, 1.0 - lambda1);
+        }
+        const double lambda0 = 1.0 - lambda1 - lambda2;
+        double n[3];
+        for (int c = 0; c < 3; ++c) n[c] = lambda0 * n0[c] + lambda1 * n1[c] + lambda2 * n2[c];
+        const double len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        if (!(len2 > 1e-24)) {
+          // Face normal of the offset triangle, then the view axis.
+          const double* p0 = &in.positions[3 * v[0]];
+          const double* p1 = &in.positions[3 * v[1]];
+          const double* p2 = &in.positions[3 * v[2]];
+          const double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+          const double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+          n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+          n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+          n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        }
+        NormalizeOr(n, 0.0, 0.0, view_axis_z);
+        out_valid[index] = 1;
+        out_depth[index] = static_cast<float>(texel_depth);
+        for (int c = 0; c < 3; ++c) out_normal[3 * index + c] = static_cast<float>(n[c]);
       }
-      double lambda1 = 1.0 / 3.0, lambda2 = 1.0 / 3.0;
-      if (cached_ok) {
-        const double dx = (i + 0.5) - s.x0, dy = py - s.y0;
-        lambda1 = std::clamp(s.l1_x * dx + s.l1_y * dy, 0.0, 1.0);
-        lambda2 = std::clamp(s.l2_x * dx + s.l2_y * dy, 0.0, 1.0 - lambda1);
-      }
-      const double lambda0 = 1.0 - lambda1 - lambda2;
-      double n[3];
-      for (int c = 0; c < 3; ++c) n[c] = lambda0 * n0[c] + lambda1 * n1[c] + lambda2 * n2[c];
-      const double len2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
-      if (!(len2 > 1e-24)) {
-        // Face normal of the offset triangle, then the view axis.
-        const double* p0 = &in.positions[3 * v[0]];
-        const double* p1 = &in.positions[3 * v[1]];
-        const double* p2 = &in.positions[3 * v[2]];
-        const double e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-        const double e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-      }
-      NormalizeOr(n, 0.0, 0.0, view_axis_z);
-      image->valid[index] = 1;
-      image->depth[index] = static_cast<float>(depth[index]);
-      for (int c = 0; c < 3; ++c) image->normal[3 * index + c] = static_cast<float>(n[c]);
     }
   }
+}
+
+}  // namespace
+
+void RasterizeViewCpu(const MapRasterInput& input, int view, MapViewImage* image,
+                      std::vector<uint32_t>* face) {
+  const int views[1] = {view};
+  MapViewImage* const outputs[1] = {image};
+  std::vector<uint32_t>* const faces[1] = {face};
+  RasterizeViews<1>(input, views, outputs, faces);
+}
+
+void RasterizeViewsCpu(const MapRasterInput& input, MapViewImage images[2]) {
+  const int views[2] = {0, 1};
+  MapViewImage* const outputs[2] = {&images[0], &images[1]};
+  std::vector<uint32_t>* const faces[2] = {nullptr, nullptr};
+  RasterizeViews<2>(input, views, outputs, faces);
 }
 
 }  // namespace drape::bake

@@ -28,18 +28,20 @@ struct MapViewImage {
   std::vector<float> normal;   // 3 per texel, unit length where valid, 0 elsewhere
 };
 
-// Per-texel working buffers of the CPU rasterizer, reused from one view to the next.
-struct CpuRasterScratch {
-  std::vector<double> depth;   // nearest depth so far, metres
-  std::vector<uint32_t> face;  // triangle index of that depth, or ~0u
-};
-
 // Rasterizes view `view` (0 front, 1 back): double-precision edge functions evaluated at texel
 // centres, canonical per-edge evaluation plus the top-left rule (a texel centre on an edge shared
 // by two triangles belongs to exactly one), no culling, barycentric depth, the minimum depth wins
 // (ties: the lower triangle index, like GL_LESS). Normals are the winning triangle's vertex
 // normals interpolated with its barycentrics, normalised. Single-threaded and deterministic.
-void RasterizeViewCpu(const MapRasterInput& input, int view, CpuRasterScratch* scratch,
-                      MapViewImage* image);
+// The image is resized to the raster and every texel written (its normal storage holds the
+// working depths during the pass, so no other buffer is allocated): an image reused from an
+// earlier call, of any size, keeps no stale texel and allocates nothing if it does not grow.
+// `face`, when not null, receives the winning triangle index per texel (~0u where none).
+void RasterizeViewCpu(const MapRasterInput& input, int view, MapViewImage* image,
+                      std::vector<uint32_t>* face = nullptr);
+
+// Both views (images[0] front, images[1] back) in one pass, bit-identical to two
+// RasterizeViewCpu() calls: the edge tests, most of the work, run once for both.
+void RasterizeViewsCpu(const MapRasterInput& input, MapViewImage images[2]);
 
 }  // namespace drape::bake

@@ -104,8 +104,9 @@ struct BodyMapPoseStats {
   size_t stored_texels = 0;  // texels the arrays hold: width*height, or the spans' total
   size_t bytes = 0;  // bytes stored: the per-texel arrays (both views, depth + normals) plus the
                      // span table (row spans: 4 per row + 1, 6 per span + 4)
-  double render_ms_front = 0.0;       // wall time of rendering the view (CPU: rasterize + normals;
-  double render_ms_back = 0.0;        // OSMesa: upload + clear + draw + finish + readback)
+  double render_ms_front = 0.0;       // wall time of rendering the view (CPU: both views share one
+  double render_ms_back = 0.0;        // pass, each is charged half of it: rasterize + normals;
+                                      // OSMesa: upload + clear + draw + finish + readback)
   const char* renderer = "";          // "cpu" or "osmesa (<GL_RENDERER>)"; static storage
   uint32_t silhouette_conflicts = 0;  // texels covered in exactly one view, made background
 };
