@@ -256,6 +256,13 @@ std::vector<HullBake> HullBakes(const bake::ImportOptions& import, bool quick) {
     c.hull.inflation = bake::InflationMode::kVertexNormalOffset;
     bakes.push_back({"paper's vertex-normal inflation", c});
   }
+  // Smoothly weighted rigs (CesiumMan, RiggedFigure) have few vertices at the default 0.99
+  // and so few hulls: what a lower threshold buys, and what the skinned mesh then pokes out.
+  for (float tau : {0.9f, 0.7f}) {
+    bake::BakeConfig c = base();
+    c.rigid_threshold = tau;
+    bakes.push_back({"rigid threshold " + std::to_string(tau).substr(0, 3), c});
+  }
   for (uint32_t rows : {8u, 32u}) {
     bake::BakeConfig c = base();
     c.map_table.sphere_rows = c.map_table.cylinder_rows = rows;
