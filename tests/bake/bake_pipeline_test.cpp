@@ -193,5 +193,32 @@ TEST(BakePipeline, ReportCarriesTheContractFields) {
   }
 }
 
+// A smoothly weighted rig (CesiumMan: 13 % of its vertices reach 0.99) gets a warning naming
+// the threshold; the mannequin (68 %) does not; a lower threshold removes it.
+TEST(BakePipeline, WarnsWhenFewVerticesAreRigid) {
+  const auto rigid_warnings = [](const nlohmann::json& report) {
+    int count = 0;
+    for (const auto& w : report["warnings"])
+      count += w.get<std::string>().find("hulls.rigid_threshold") != std::string::npos;
+    return count;
+  };
+  BakeConfig config;
+  config.maps_enabled = false;
+  BakeResult mannequin;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &mannequin).ok());
+  EXPECT_GT(mannequin.report["hulls"]["rigid_vertex_fraction"].get<double>(), 0.5);
+  EXPECT_EQ(rigid_warnings(mannequin.report), 0);
+  const std::string cesium = test::CharacterPath("CesiumMan/CesiumMan.glb");
+  DRAPE_REQUIRE_FILE(cesium);
+  BakeResult smooth;
+  ASSERT_TRUE(BakeCharacter(cesium, config, &smooth).ok());
+  EXPECT_LT(smooth.report["hulls"]["rigid_vertex_fraction"].get<double>(), 0.5);
+  EXPECT_EQ(rigid_warnings(smooth.report), 1);
+  config.rigid_threshold = 0.6f;
+  BakeResult lowered;
+  ASSERT_TRUE(BakeCharacter(cesium, config, &lowered).ok());
+  EXPECT_EQ(rigid_warnings(lowered.report), 0);
+}
+
 }  // namespace
 }  // namespace drape
