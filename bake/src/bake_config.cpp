@@ -215,6 +215,11 @@ const std::vector<Parameter>& Parameters() {
       MakeFloat("hulls", "rigid_threshold", "weight", 0.5, 1, true,
                 "a vertex is rigid to its heaviest bone when that weight reaches this",
                 [](BakeConfig& c) -> float& { return c.rigid_threshold; }),
+      MakeFloat("hulls", "shape_threshold", "weight", 0.5, 1, true,
+                "a flexible vertex also shapes its heaviest bone's hull (and stays in its joint "
+                "sphere) when that weight reaches min(this, rigid_threshold); 1: rigid vertices "
+                "only, as in paper B",
+                [](BakeConfig& c) -> float& { return c.shape_threshold; }),
       MakeFloat("hulls", "delta", "m", 0, 0.1, false,
                 "inflation: the delta-ball of every rigid vertex is inside",
                 [](BakeConfig& c) -> float& { return c.hull.delta; }),

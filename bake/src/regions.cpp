@@ -45,12 +45,17 @@ bool IsAncestor(const SkeletonData& s, int32_t ancestor, int32_t joint) {
 
 }  // namespace
 
-Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions) {
+Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions,
+                    float shape_threshold) {
   if (!(rigid_threshold > 0.5f && rigid_threshold <= 1.f)) {
     return Status(StatusCode::kInvalidArgument, "hulls.rigid_threshold must be in (0.5, 1]");
   }
+  if (!(shape_threshold > 0.5f && shape_threshold <= 1.f)) {
+    return Status(StatusCode::kInvalidArgument, "hulls.shape_threshold must be in (0.5, 1]");
+  }
   *regions = Regions{};
   regions->rigid_threshold = rigid_threshold;
+  regions->shape_threshold = std::min(shape_threshold, rigid_threshold);
   const SkeletonData& skeleton = character.skeleton;
   const MeshData& mesh = character.mesh;
   const uint32_t joints = skeleton.joint_count();
@@ -65,6 +70,7 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
   for (uint32_t j = 0; j < joints; ++j) regions->collider_frames[j] = RigidPart(pose.world()[j]);
 
   regions->rigid_vertices.assign(joints, {});
+  regions->shaping_vertices.assign(joints, {});
   std::map<std::pair<int32_t, int32_t>, size_t> joint_index;  // (child, parent) -> regions->joints
   for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
     // The two heaviest influences, ties broken by the lower joint index (deterministic).
@@ -85,6 +91,7 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
       regions->rigid_vertices[first].push_back(v);
       continue;
     }
+    if (w_first >= regions->shape_threshold) regions->shaping_vertices[first].push_back(v);
     // The joint between the two bones: the descendant carries it.
     int32_t child = first, parent = second;
     if (IsAncestor(skeleton, first, second)) child = second, parent = first;

@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
 #include <string>
 #include <vector>
@@ -193,13 +195,61 @@ TEST(BakePipeline, ReportCarriesTheContractFields) {
   }
 }
 
+// hulls.shape_threshold: flexible vertices at or above it also shape their heaviest bone's hull.
+// Every rigid and shaping vertex (and its delta-ball) is inside, the joint spheres are the
+// default bake's, and a hull can only grow: the default bake's rigid vertices stay inside.
+TEST(BakePipeline, ShapingVerticesGrowTheHullsAndKeepTheSpheres) {
+  for (const std::string& path :
+       {test::MannequinPath(), test::CharacterPath("CesiumMan/CesiumMan.glb")}) {
+    SCOPED_TRACE(path);
+    if (!std::filesystem::exists(path)) continue;  // CesiumMan: shared asset absent
+    BakeConfig config;
+    config.maps_enabled = false;
+    BakeResult plain, shaped;
+    ASSERT_TRUE(BakeCharacter(path, config, &plain).ok());
+    config.shape_threshold = 0.6f;
+    ASSERT_TRUE(BakeCharacter(path, config, &shaped).ok());
+    bake::Character character;
+    ASSERT_TRUE(bake::ImportCharacter(path, config.import, &character).ok());
+    bake::Regions regions;
+    ASSERT_TRUE(
+        bake::SplitRegions(character, config.rigid_threshold, &regions, config.shape_threshold)
+            .ok());
+    size_t shaping = 0;
+    for (const auto& vertices : regions.shaping_vertices) shaping += vertices.size();
+    EXPECT_GT(shaping, 0u);
+    ASSERT_EQ(plain.asset.joint_spheres.size(), shaped.asset.joint_spheres.size());
+    for (size_t k = 0; k < plain.asset.joint_spheres.size(); ++k) {
+      EXPECT_EQ(plain.asset.joint_spheres[k].radius, shaped.asset.joint_spheres[k].radius);
+    }
+    EXPECT_GE(shaped.asset.hulls.size(), plain.asset.hulls.size());
+    for (const HullColliderData& hull : shaped.asset.hulls) {
+      const std::string bone = shaped.asset.skeleton.joint_names[hull.joint];
+      EXPECT_TRUE(bake::HullIsConvex(hull)) << bone;
+      const Mat34 to_collider = InverseRigid(regions.collider_frames[hull.joint]);
+      std::vector<Float3> local;
+      for (uint32_t v : regions.rigid_vertices[hull.joint])
+        local.push_back(TransformPoint(to_collider, regions.rest_positions[v]));
+      for (uint32_t v : regions.shaping_vertices[hull.joint])
+        local.push_back(TransformPoint(to_collider, regions.rest_positions[v]));
+      EXPECT_TRUE(bake::HullContainsPoints(hull, local, config.hull.delta)) << bone;
+    }
+    // Each default hull's bone has a shaped hull too.
+    for (const HullColliderData& hull : plain.asset.hulls) {
+      EXPECT_TRUE(std::any_of(shaped.asset.hulls.begin(), shaped.asset.hulls.end(),
+                              [&](const HullColliderData& h) { return h.joint == hull.joint; }))
+          << plain.asset.skeleton.joint_names[hull.joint];
+    }
+  }
+}
+
 // A smoothly weighted rig (CesiumMan: 13 % of its vertices reach 0.99) gets a warning naming
-// the threshold; the mannequin (68 %) does not; a lower threshold removes it.
-TEST(BakePipeline, WarnsWhenFewVerticesAreRigid) {
+// the thresholds; the mannequin (68 %) does not; a lower rigid or shape threshold removes it.
+TEST(BakePipeline, WarnsWhenFewVerticesShapeTheHulls) {
   const auto rigid_warnings = [](const nlohmann::json& report) {
     int count = 0;
     for (const auto& w : report["warnings"])
-      count += w.get<std::string>().find("hulls.rigid_threshold") != std::string::npos;
+      count += w.get<std::string>().find("hulls.shape_threshold") != std::string::npos;
     return count;
   };
   BakeConfig config;
@@ -218,6 +268,13 @@ TEST(BakePipeline, WarnsWhenFewVerticesAreRigid) {
   BakeResult lowered;
   ASSERT_TRUE(BakeCharacter(cesium, config, &lowered).ok());
   EXPECT_EQ(rigid_warnings(lowered.report), 0);
+  config.rigid_threshold = 0.99f;
+  config.shape_threshold = 0.51f;
+  BakeResult shaped;
+  ASSERT_TRUE(BakeCharacter(cesium, config, &shaped).ok());
+  EXPECT_LT(shaped.report["hulls"]["rigid_vertex_fraction"].get<double>(), 0.5);
+  EXPECT_GT(shaped.report["hulls"]["hull_vertex_fraction"].get<double>(), 0.5);
+  EXPECT_EQ(rigid_warnings(shaped.report), 0);
 }
 
 }  // namespace

@@ -263,6 +263,13 @@ std::vector<HullBake> HullBakes(const bake::ImportOptions& import, bool quick) {
     c.rigid_threshold = tau;
     bakes.push_back({"rigid threshold " + std::to_string(tau).substr(0, 3), c});
   }
+  // Or keep the joint spheres as they are and let the flexible vertices also shape the hull of
+  // their heaviest bone: the covered volume can only grow.
+  for (float shape : {0.7f, 0.51f}) {
+    bake::BakeConfig c = base();
+    c.shape_threshold = shape;
+    bakes.push_back({"shape threshold " + std::to_string(shape).substr(0, 4), c});
+  }
   for (uint32_t rows : {8u, 32u}) {
     bake::BakeConfig c = base();
     c.map_table.sphere_rows = c.map_table.cylinder_rows = rows;

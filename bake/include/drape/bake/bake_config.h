@@ -31,6 +31,9 @@ struct BakeConfig {
 
   bool hulls_enabled = true;      // paper B: a convex collider per bone
   float rigid_threshold = 0.99f;  // a vertex is rigid to its heaviest bone at this weight, (0.5, 1]
+  // A flexible vertex also shapes its heaviest bone's hull at min(this, rigid_threshold), (0.5, 1]
+  // (it stays in its joint sphere too); 1: hulls are shaped by rigid vertices only (paper B).
+  float shape_threshold = 1.f;
   HullOptions hull;
   KirkpatrickOptions kirkpatrick;
   MapTableOptions map_table;

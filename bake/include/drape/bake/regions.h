@@ -20,15 +20,22 @@ struct JointRegion {
 
 struct Regions {
   float rigid_threshold = 0.99f;
+  float shape_threshold = 0.99f;       // effective: min(the config's, rigid_threshold)
   std::vector<Float3> rest_positions;  // the rest-pose skinned mesh
   std::vector<Mat34> rest_skinning;    // per joint: bind -> rest
   std::vector<Mat34> collider_frames;  // per joint: rigid rest-pose joint frame -> asset
   std::vector<std::vector<uint32_t>> rigid_vertices;  // per joint
-  std::vector<JointRegion> joints;                    // one per bone pair with flexible vertices
+  // Per joint: flexible vertices whose heaviest bone it is, at a weight in [shape_threshold,
+  // rigid_threshold). They shape the bone's hull as well as being in their joint sphere.
+  std::vector<std::vector<uint32_t>> shaping_vertices;
+  std::vector<JointRegion> joints;  // one per bone pair with flexible vertices
 };
 
 // rigid_threshold in (0.5, 1]: a vertex is rigid to its heaviest bone when that weight reaches it.
-Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions);
+// shape_threshold in (0.5, 1]: a flexible vertex also shapes its heaviest bone's hull when that
+// weight reaches min(shape_threshold, rigid_threshold) (1: no flexible vertex does).
+Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions,
+                    float shape_threshold = 1.f);
 
 // Joint spheres (paper B §2.3): centred on the joint, radius covering its flexible vertices plus
 // delta (metres). Written into the bind-pose frame the runtime expects.
