@@ -156,6 +156,17 @@ Mat34 ObbFromWorld(const RigidD& collider_to_world, Float3 center, const Float3 
   return m;
 }
 
+// condition ? if_true : if_false without a branch (bit masks on SSE2; a plain select elsewhere).
+inline float SelectIf(bool condition, float if_true, float if_false) {
+#if defined(__SSE2__)
+  const __m128 mask = _mm_castsi128_ps(_mm_set1_epi32(-static_cast<int>(condition)));
+  return _mm_cvtss_f32(
+      _mm_or_ps(_mm_and_ps(mask, _mm_set_ss(if_true)), _mm_andnot_ps(mask, _mm_set_ss(if_false))));
+#else
+  return condition ? if_true : if_false;
+#endif
+}
+
 // ---- Watertight ray/triangle test (Woop, Benthin, Wald 2013) for a ray S + t d, t > 0. The
 // axes are permuted so that d's largest component is kz (indexing small arrays, no branches).
 struct WatertightRay {
@@ -170,15 +181,25 @@ WatertightRay MakeRay(Float3 origin, Float3 d) {
   r.origin[2] = origin.z;
   const float dir[3] = {d.x, d.y, d.z};
   const float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
-  r.kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-  r.kx = (r.kz + 1) % 3;
-  r.ky = (r.kx + 1) % 3;
-  if (dir[r.kz] < 0.f) std::swap(r.kx, r.ky);  // keep the winding
+  // Integer selects (conditional moves): the axis choice is data dependent and unpredictable.
+  const int k_xy = ay > az ? 1 : 2, k_xz = ax > az ? 0 : 2;
+  r.kz = ax > ay ? k_xz : k_xy;
+  const int next = r.kz == 2 ? 0 : r.kz + 1;
+  const int after = next == 2 ? 0 : next + 1;
+  const bool flip = dir[r.kz] < 0.f;  // keep the winding
+  r.kx = flip ? after : next;
+  r.ky = flip ? next : after;
   r.sx = dir[r.kx] / dir[r.kz];
   r.sy = dir[r.ky] / dir[r.kz];
   r.sz = 1.f / dir[r.kz];
   return r;
 }
+// For a block of `lanes` (1 to 4) listed triangles: all-ones in the used lanes, and the list
+// entry each lane loads (unused lanes repeat the last used one).
+alignas(16) constexpr int32_t kLaneMasks[5][4] = {
+    {0, 0, 0, 0}, {-1, 0, 0, 0}, {-1, -1, 0, 0}, {-1, -1, -1, 0}, {-1, -1, -1, -1}};
+constexpr uint32_t kLaneSource[5][4] = {
+    {0, 0, 0, 0}, {0, 0, 0, 0}, {0, 1, 1, 1}, {0, 1, 2, 2}, {0, 1, 2, 3}};
 // Returns true and the ray parameter t > 0 on a hit (either side of the triangle).
 bool IntersectWatertight(const WatertightRay& r, const float* tri, float* t_hit) {
   const float a[3] = {tri[0] - r.origin[0], tri[1] - r.origin[1], tri[2] - r.origin[2]};
@@ -214,9 +235,10 @@ float FastAtan2(float y, float x) {
   const float a = lo / hi;
   const float s = a * a;
   float r = ((-0.0464964749f * s + 0.15931422f) * s - 0.327622764f) * s * a + a;
-  if (ay > ax) r = 1.57079637f - r;
-  if (x < 0.f) r = 3.14159274f - r;
-  return y < 0.f ? -r : r;
+  // The octant corrections as selects, not branches (the signs are unpredictable).
+  r = SelectIf(ay > ax, 1.57079637f - r, r);
+  r = SelectIf(x < 0.f, 3.14159274f - r, r);
+  return SelectIf(y < 0.f, -r, r);
 }
 
 // Moves p along the unit normal n until signed(p) >= 0 in float (a handful of steps at most).
@@ -224,7 +246,17 @@ template <typename SignedDistance>
 Float3 NudgeOut(Float3 p, Float3 n, float scale, SignedDistance signed_distance) {
   float f = signed_distance(p);
   float step = 1e-7f * scale;
-  for (int k = 0; f < 0.f && k < 24; ++k) {
+  // The first step is taken unconditionally and kept by selects: a point projected onto a plane
+  // lands on either side of it by rounding, so a branch here is mispredicted half of the time.
+  // Same steps and values as the plain loop.
+  const Float3 moved = p + n * std::max(-f, step);
+  const float f_moved = signed_distance(moved);
+  const bool needed = f < 0.f;
+  p = {SelectIf(needed, moved.x, p.x), SelectIf(needed, moved.y, p.y),
+       SelectIf(needed, moved.z, p.z)};
+  f = SelectIf(needed, f_moved, f);
+  step = SelectIf(needed, step * 2.f, step);
+  for (int k = 1; f < 0.f && k < 24; ++k) {
     p = p + n * std::max(-f, step);
     f = signed_distance(p);
     step *= 2.f;
@@ -591,6 +623,8 @@ Status HullColliderSet::Build(std::span<const HullColliderData> hulls,
       r.map_kind = t.kind;
       r.map_rows = t.rows;
       r.map_cols = t.cols;
+      r.map_row_scale = static_cast<float>(t.rows) / kPi;
+      r.map_col_scale = static_cast<float>(t.cols) / (2.f * kPi);
       r.map_origin = t.origin;
       r.map_axis = t.axis;
       r.map_reference = t.reference;
@@ -603,6 +637,9 @@ Status HullColliderSet::Build(std::span<const HullColliderData> hulls,
     }
     hulls_.push_back(r);
   }
+  // The map-table ray loads each vertex as 4 floats: the last triangle's third vertex reads 3
+  // floats past it.
+  ray_triangles_.insert(ray_triangles_.end(), 3, 0.f);
   for (const JointSphereData& s : spheres) spheres_.push_back({s.joint, s.center, s.radius});
 
   Status status = ValidateOptions(options);
@@ -810,6 +847,28 @@ Status HullColliderSet::SelectSubstep(float s0, float s1) {
     sweep_z_[k] = center.z;
     sweep_r_[k] = radius;
   }
+  // The union sphere, in double: centre the middle of the spheres' box, radius the farthest
+  // sphere surface, grown by 1e-4 relative and 1e-4 of the magnitude (far above the ~1e-6
+  // relative rounding of the float tests).
+  if (collider_count_ > 0) {
+    Vec3D lo{kPadCenter, kPadCenter, kPadCenter}, hi{-kPadCenter, -kPadCenter, -kPadCenter};
+    for (uint32_t k = 0; k < collider_count_; ++k) {
+      lo = {std::min(lo.x, double(sweep_x_[k]) - sweep_r_[k]),
+            std::min(lo.y, double(sweep_y_[k]) - sweep_r_[k]),
+            std::min(lo.z, double(sweep_z_[k]) - sweep_r_[k])};
+      hi = {std::max(hi.x, double(sweep_x_[k]) + sweep_r_[k]),
+            std::max(hi.y, double(sweep_y_[k]) + sweep_r_[k]),
+            std::max(hi.z, double(sweep_z_[k]) + sweep_r_[k])};
+    }
+    const Vec3D center = (lo + hi) * 0.5;
+    double radius = 0.0;
+    for (uint32_t k = 0; k < collider_count_; ++k)
+      radius = std::max(
+          radius, LengthD(Vec3D{sweep_x_[k], sweep_y_[k], sweep_z_[k]} - center) + sweep_r_[k]);
+    sweep_union_center_ = ToF(center);
+    sweep_union_radius_ =
+        static_cast<float>(radius * (1.0 + 1e-4) + 1e-4 * (LengthD(center) + radius) + 1e-6);
+  }
   return Status::Ok();
 }
 
@@ -874,6 +933,17 @@ DualResult DualScalar(const PlaneSoa& s, Float3 a, Float3 b) {
     r.max_a = fa > r.max_a ? fa : r.max_a;
     r.max_b = fb > r.max_b ? fb : r.max_b;
   }
+  return r;
+}
+// DualScalar(s, a, a) with half the work: the same per-plane values and reductions.
+DualResult DualSameScalar(const PlaneSoa& s, Float3 a) {
+  DualResult r{-kPadOffset, -kPadOffset, false};
+  for (uint32_t i = 0; i < s.padded; ++i) {
+    const float fa = ScalarValue(s, i, a);
+    if (fa > 0.f) return {0.f, 0.f, true};
+    r.max_a = fa > r.max_a ? fa : r.max_a;
+  }
+  r.max_b = r.max_a;
   return r;
 }
 ClipResult ClipScalar(const PlaneSoa& s, Float3 a, Float3 b) {
@@ -948,6 +1018,20 @@ DualResult DualSse(const PlaneSoa& s, Float3 a, Float3 b) {
     mb = _mm_max_ps(_mm_max_ps(fb0, fb1), mb);
   }
   return {HorizontalMax(ma), HorizontalMax(mb), false};
+}
+// DualSse(s, a, a) with half the work: the same per-plane values and the same reduction order.
+DualResult DualSameSse(const PlaneSoa& s, Float3 a) {
+  const __m128 ax = _mm_set1_ps(a.x), ay = _mm_set1_ps(a.y), az = _mm_set1_ps(a.z);
+  const __m128 zero = _mm_setzero_ps();
+  __m128 ma = _mm_set1_ps(-kPadOffset);
+  for (uint32_t i = 0; i < s.padded; i += 8) {
+    const __m128 fa0 = ValueSse(s, i, ax, ay, az), fa1 = ValueSse(s, i + 4, ax, ay, az);
+    const __m128 sep = _mm_or_ps(_mm_cmpgt_ps(fa0, zero), _mm_cmpgt_ps(fa1, zero));
+    if (_mm_movemask_ps(sep) != 0) return {0.f, 0.f, true};
+    ma = _mm_max_ps(_mm_max_ps(fa0, fa1), ma);
+  }
+  const float m = HorizontalMax(ma);
+  return {m, m, false};
 }
 ClipResult ClipSse(const PlaneSoa& s, Float3 a, Float3 b) {
   const __m128 ax = _mm_set1_ps(a.x), ay = _mm_set1_ps(a.y), az = _mm_set1_ps(a.z);
@@ -1029,6 +1113,19 @@ DRAPE_AVX2 DualResult DualAvx(const PlaneSoa& s, Float3 a, Float3 b) {
     mb = _mm256_max_ps(fb, mb);
   }
   return {HorizontalMaxAvx(ma), HorizontalMaxAvx(mb), false};
+}
+// DualAvx(s, a, a) with half the work: the same per-plane values and the same reduction order.
+DRAPE_AVX2 DualResult DualSameAvx(const PlaneSoa& s, Float3 a) {
+  const __m256 ax = _mm256_set1_ps(a.x), ay = _mm256_set1_ps(a.y), az = _mm256_set1_ps(a.z);
+  const __m256 zero = _mm256_setzero_ps();
+  __m256 ma = _mm256_set1_ps(-kPadOffset);
+  for (uint32_t i = 0; i < s.padded; i += 8) {
+    const __m256 fa = ValueAvx(s, i, ax, ay, az);
+    if (_mm256_movemask_ps(_mm256_cmp_ps(fa, zero, _CMP_GT_OQ)) != 0) return {0.f, 0.f, true};
+    ma = _mm256_max_ps(fa, ma);
+  }
+  const float m = HorizontalMaxAvx(ma);
+  return {m, m, false};
 }
 DRAPE_AVX2 ClipResult ClipAvx(const PlaneSoa& s, Float3 a, Float3 b) {
   const __m256 ax = _mm256_set1_ps(a.x), ay = _mm256_set1_ps(a.y), az = _mm256_set1_ps(a.z);
@@ -1126,10 +1223,111 @@ DRAPE_AVX2 uint32_t SphereFilterAvx(const float* xs, const float* ys, const floa
 }
 #endif
 
+#if defined(DRAPE_HULL_AVX2)
+// The SphereFilter test of eight midpoints and half lengths against one sphere.
+DRAPE_AVX2 inline __m256 SphereTestAvx(__m256 mx, __m256 my, __m256 mz, __m256 half, float cx,
+                                       float cy, float cz, float r) {
+  const __m256 dx = _mm256_sub_ps(mx, _mm256_set1_ps(cx));
+  const __m256 dy = _mm256_sub_ps(my, _mm256_set1_ps(cy));
+  const __m256 dz = _mm256_sub_ps(mz, _mm256_set1_ps(cz));
+  const __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+                                  _mm256_mul_ps(dz, dz));
+  const __m256 rr = _mm256_add_ps(_mm256_set1_ps(r), half);
+  return _mm256_cmp_ps(d2, _mm256_mul_ps(rr, rr), _CMP_LE_OQ);
+}
+// The broad phase of eight particles at once (lanes beyond `lanes` repeat the first): per
+// particle, the bit mask of the colliders k < total (<= 32) that BroadPhase keeps, by the same
+// arithmetic (mid = (p0 + p1) * 0.5, half = |p1 - p0| * 0.50001, the SphereFilter test). A group
+// wholly outside the union sphere (centre, radius) gets empty masks without the per-collider
+// tests. Returns the lanes whose previous and current positions and velocity are all finite (bit
+// l for lane l; IsFinite's answer, as x - x == 0).
+DRAPE_AVX2 uint32_t SphereMasksAvx(const Float3* p0, const Float3* p1, const Float3* velocity,
+                                   uint32_t lanes, const float* xs, const float* ys,
+                                   const float* zs, const float* rs, uint32_t total,
+                                   Float3 union_center, float union_radius, uint32_t* masks) {
+  alignas(32) float coordinates[9][8];
+  if (lanes == 8) {
+    // Eight Float3 are 24 contiguous floats: three per-axis vectors by two 128-bit loads per
+    // 256-bit register and five shuffles.
+    const Float3* sources[3] = {p0, p1, velocity};
+    for (int array = 0; array < 3; ++array) {
+      const float* f = &sources[array]->x;
+      const __m256 m03 =
+          _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f)), _mm_loadu_ps(f + 12), 1);
+      const __m256 m14 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f + 4)),
+                                              _mm_loadu_ps(f + 16), 1);
+      const __m256 m25 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(f + 8)),
+                                              _mm_loadu_ps(f + 20), 1);
+      const __m256 xy = _mm256_shuffle_ps(m14, m25, _MM_SHUFFLE(2, 1, 3, 2));
+      const __m256 yz = _mm256_shuffle_ps(m03, m14, _MM_SHUFFLE(1, 0, 2, 1));
+      _mm256_store_ps(coordinates[3 * array + 0],
+                      _mm256_shuffle_ps(m03, xy, _MM_SHUFFLE(2, 0, 3, 0)));
+      _mm256_store_ps(coordinates[3 * array + 1],
+                      _mm256_shuffle_ps(yz, xy, _MM_SHUFFLE(3, 1, 2, 0)));
+      _mm256_store_ps(coordinates[3 * array + 2],
+                      _mm256_shuffle_ps(yz, m25, _MM_SHUFFLE(3, 0, 3, 1)));
+    }
+  } else {
+    for (uint32_t l = 0; l < 8; ++l) {
+      const uint32_t from = l < lanes ? l : 0;
+      coordinates[0][l] = p0[from].x;
+      coordinates[1][l] = p0[from].y;
+      coordinates[2][l] = p0[from].z;
+      coordinates[3][l] = p1[from].x;
+      coordinates[4][l] = p1[from].y;
+      coordinates[5][l] = p1[from].z;
+      coordinates[6][l] = velocity[from].x;
+      coordinates[7][l] = velocity[from].y;
+      coordinates[8][l] = velocity[from].z;
+    }
+  }
+  const __m256 zero = _mm256_setzero_ps();
+  __m256 finite = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  for (int c = 0; c < 9; ++c) {
+    const __m256 x = _mm256_load_ps(coordinates[c]);
+    finite = _mm256_and_ps(finite, _mm256_cmp_ps(_mm256_sub_ps(x, x), zero, _CMP_EQ_OQ));
+  }
+  const __m256 ax = _mm256_load_ps(coordinates[0]), ay = _mm256_load_ps(coordinates[1]),
+               az = _mm256_load_ps(coordinates[2]), bx = _mm256_load_ps(coordinates[3]),
+               by = _mm256_load_ps(coordinates[4]), bz = _mm256_load_ps(coordinates[5]);
+  const __m256 one_half = _mm256_set1_ps(0.5f);
+  const __m256 mx = _mm256_mul_ps(_mm256_add_ps(ax, bx), one_half);
+  const __m256 my = _mm256_mul_ps(_mm256_add_ps(ay, by), one_half);
+  const __m256 mz = _mm256_mul_ps(_mm256_add_ps(az, bz), one_half);
+  const __m256 sx = _mm256_sub_ps(bx, ax), sy = _mm256_sub_ps(by, ay), sz = _mm256_sub_ps(bz, az);
+  const __m256 length2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(sx, sx), _mm256_mul_ps(sy, sy)),
+                                       _mm256_mul_ps(sz, sz));
+  const __m256 half = _mm256_mul_ps(_mm256_sqrt_ps(length2), _mm256_set1_ps(0.50001f));
+  const uint32_t finite_lanes = static_cast<uint32_t>(_mm256_movemask_ps(finite));
+  // Invalid lanes fail every test; the skip needs the valid ones outside the union sphere.
+  // The union test's sum is grown by 1e-5 relative (the float tests round by ~1e-7 relative), so
+  // a lane that passes any collider's test passes it whatever its half length.
+  const __m256 ux = _mm256_sub_ps(mx, _mm256_set1_ps(union_center.x));
+  const __m256 uy = _mm256_sub_ps(my, _mm256_set1_ps(union_center.y));
+  const __m256 uz = _mm256_sub_ps(mz, _mm256_set1_ps(union_center.z));
+  const __m256 ud2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ux, ux), _mm256_mul_ps(uy, uy)),
+                                   _mm256_mul_ps(uz, uz));
+  const __m256 urr =
+      _mm256_mul_ps(_mm256_add_ps(_mm256_set1_ps(union_radius), half), _mm256_set1_ps(1.00001f));
+  const __m256 near = _mm256_cmp_ps(ud2, _mm256_mul_ps(urr, urr), _CMP_LE_OQ);
+  __m256i acc = _mm256_setzero_si256();
+  if (_mm256_movemask_ps(_mm256_and_ps(near, finite)) != 0) {
+    for (uint32_t k = 0; k < total; ++k) {
+      const __m256 inside = SphereTestAvx(mx, my, mz, half, xs[k], ys[k], zs[k], rs[k]);
+      acc = _mm256_or_si256(acc, _mm256_and_si256(_mm256_castps_si256(inside),
+                                                  _mm256_set1_epi32(static_cast<int>(1u << k))));
+    }
+  }
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(masks), acc);
+  return finite_lanes;
+}
+#endif
+
 struct PlaneKernels {
   float (*max)(const PlaneSoa&, Float3);
   uint32_t (*first_equal)(const PlaneSoa&, Float3, float);
   DualResult (*dual)(const PlaneSoa&, Float3, Float3);
+  DualResult (*dual_same)(const PlaneSoa&, Float3);  // dual(s, a, a)
   ClipResult (*clip)(const PlaneSoa&, Float3, Float3);
   uint32_t (*entry)(const PlaneSoa&, Float3, Float3, float);
   uint32_t (*spheres)(const float*, const float*, const float*, const float*, uint32_t, Float3,
@@ -1137,15 +1335,17 @@ struct PlaneKernels {
 };
 // level: 0 portable scalar, 1 SSE, 2 AVX2.
 const PlaneKernels& Kernels(uint8_t level) {
-  static const PlaneKernels scalar{MaxScalar,  FirstEqualScalar, DualScalar,
+  static const PlaneKernels scalar{MaxScalar,  FirstEqualScalar, DualScalar,        DualSameScalar,
                                    ClipScalar, EntryScalar,      SphereFilterScalar};
 #if defined(__SSE2__)
-  static const PlaneKernels sse{MaxSse, FirstEqualSse, DualSse, ClipSse, EntrySse, SphereFilterSse};
+  static const PlaneKernels sse{MaxSse,  FirstEqualSse, DualSse,        DualSameSse,
+                                ClipSse, EntrySse,      SphereFilterSse};
 #else
   static const PlaneKernels& sse = scalar;
 #endif
 #if defined(DRAPE_HULL_AVX2)
-  static const PlaneKernels avx{MaxAvx, FirstEqualAvx, DualAvx, ClipAvx, EntryAvx, SphereFilterAvx};
+  static const PlaneKernels avx{MaxAvx,  FirstEqualAvx, DualAvx,        DualSameAvx,
+                                ClipAvx, EntryAvx,      SphereFilterAvx};
 #else
   static const PlaneKernels& avx = sse;
 #endif
@@ -1260,26 +1460,114 @@ bool HullColliderSet::MapRay(const HullRecord& h, Float3 p, Float3* point, uint3
     const float radial =
         std::sqrt(along_reference * along_reference + along_binormal * along_binormal);
     const float theta = FastAtan2(radial, Dot(d, h.map_axis));  // in [0, pi]
-    row = std::min(h.map_rows - 1,
-                   static_cast<uint32_t>(theta * (static_cast<float>(h.map_rows) / kPi)));
+    row = std::min(h.map_rows - 1, static_cast<uint32_t>(theta * h.map_row_scale));
   }
   float phi = FastAtan2(along_binormal, along_reference);
-  if (phi < 0.f) phi += 2.f * kPi;
-  const uint32_t col = std::min(
-      h.map_cols - 1, static_cast<uint32_t>(phi * (static_cast<float>(h.map_cols) / (2.f * kPi))));
+  phi = SelectIf(phi < 0.f, phi + 2.f * kPi, phi);
+  const uint32_t col = std::min(h.map_cols - 1, static_cast<uint32_t>(phi * h.map_col_scale));
   const uint32_t cell = h.map_cell_begin + row * h.map_cols + col;
   const WatertightRay ray = MakeRay(source, d);
   float best = std::numeric_limits<float>::infinity();
   uint32_t best_triangle = 0;
-  for (uint32_t e = map_cell_offsets_[cell]; e < map_cell_offsets_[cell + 1]; ++e) {
+  const float* triangles = &ray_triangles_[9 * size_t(h.triangle_begin)];
+  const uint32_t list_begin = map_cell_offsets_[cell], list_end = map_cell_offsets_[cell + 1];
+#if defined(__SSE2__)
+  // Four listed triangles per iteration, each lane the scalar test's arithmetic in the same order
+  // (so the same bits); a lane with an edge function of exactly 0 is redone by the scalar test
+  // (its double fallback). The nearest hit wins, the first in list order on ties, as in the loop.
+  const __m128 origin[3] = {_mm_set1_ps(ray.origin[0]), _mm_set1_ps(ray.origin[1]),
+                            _mm_set1_ps(ray.origin[2])};
+  const __m128 shear_x = _mm_set1_ps(ray.sx), shear_y = _mm_set1_ps(ray.sy);
+  const __m128 scale_z = _mm_set1_ps(ray.sz), zero = _mm_setzero_ps();
+  for (uint32_t e = list_begin; e < list_end; e += 4) {
+    const uint32_t lanes = std::min(4u, list_end - e);
+    uint32_t index[4];
+    for (uint32_t l = 0; l < 4; ++l) index[l] = map_triangles_[e + kLaneSource[lanes][l]];
+    // vertex[k][axis]: vertex k of the four triangles minus the origin (the loads read 4 floats;
+    // ray_triangles_ is padded so the last triangle's third vertex stays in bounds).
+    __m128 vertex[3][3];
+    for (int k = 0; k < 3; ++k) {
+      __m128 r0 = _mm_loadu_ps(triangles + 9 * size_t(index[0]) + 3 * k);
+      __m128 r1 = _mm_loadu_ps(triangles + 9 * size_t(index[1]) + 3 * k);
+      __m128 r2 = _mm_loadu_ps(triangles + 9 * size_t(index[2]) + 3 * k);
+      __m128 r3 = _mm_loadu_ps(triangles + 9 * size_t(index[3]) + 3 * k);
+      _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+      vertex[k][0] = _mm_sub_ps(r0, origin[0]);
+      vertex[k][1] = _mm_sub_ps(r1, origin[1]);
+      vertex[k][2] = _mm_sub_ps(r2, origin[2]);
+    }
+    const __m128 az = vertex[0][ray.kz], bz = vertex[1][ray.kz], cz = vertex[2][ray.kz];
+    const __m128 ax = _mm_sub_ps(vertex[0][ray.kx], _mm_mul_ps(shear_x, az));
+    const __m128 ay = _mm_sub_ps(vertex[0][ray.ky], _mm_mul_ps(shear_y, az));
+    const __m128 bx = _mm_sub_ps(vertex[1][ray.kx], _mm_mul_ps(shear_x, bz));
+    const __m128 by = _mm_sub_ps(vertex[1][ray.ky], _mm_mul_ps(shear_y, bz));
+    const __m128 cx = _mm_sub_ps(vertex[2][ray.kx], _mm_mul_ps(shear_x, cz));
+    const __m128 cy = _mm_sub_ps(vertex[2][ray.ky], _mm_mul_ps(shear_y, cz));
+    const __m128 u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+    const __m128 v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+    const __m128 w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+    const int valid = (1 << lanes) - 1;
+    int redo = _mm_movemask_ps(_mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
+                                         _mm_cmpeq_ps(w, zero))) &
+               valid;
+    const __m128 negative =
+        _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
+    const __m128 positive =
+        _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
+    const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
+    const __m128 t_scaled = _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(scale_z, az)), _mm_mul_ps(v, _mm_mul_ps(scale_z, bz))),
+        _mm_mul_ps(w, _mm_mul_ps(scale_z, cz)));
+    const __m128 det_positive = _mm_cmpgt_ps(det, zero);
+    const __m128 forward = _mm_or_ps(_mm_and_ps(det_positive, _mm_cmpgt_ps(t_scaled, zero)),
+                                     _mm_andnot_ps(det_positive, _mm_cmplt_ps(t_scaled, zero)));
+    const __m128 accepted = _mm_andnot_ps(_mm_and_ps(negative, positive),
+                                          _mm_and_ps(_mm_cmpneq_ps(det, zero), forward));
+    const __m128 t_lanes = _mm_div_ps(t_scaled, det);
+    // A NaN t (only with overflowing coordinates) goes to the scalar loop too: the vector minimum
+    // below would not skip it the way "hit < best" does.
+    redo |= _mm_movemask_ps(_mm_and_ps(accepted, _mm_cmpunord_ps(t_lanes, t_lanes))) & valid;
+    const int hits = _mm_movemask_ps(accepted) & valid & ~redo;
+    if (redo == 0) {
+      // The smallest t of the accepted lanes (+inf for the others) and its first lane: what the
+      // sequential strict "hit < best" keeps.
+      const __m128 lane_valid = _mm_load_ps(reinterpret_cast<const float*>(kLaneMasks[lanes]));
+      const __m128 kept = _mm_and_ps(accepted, lane_valid);
+      const __m128 t_kept =
+          _mm_or_ps(_mm_and_ps(kept, t_lanes), _mm_andnot_ps(kept, _mm_set1_ps(best)));
+      __m128 t_min = _mm_min_ps(t_kept, _mm_shuffle_ps(t_kept, t_kept, _MM_SHUFFLE(2, 3, 0, 1)));
+      t_min = _mm_min_ps(t_min, _mm_shuffle_ps(t_min, t_min, _MM_SHUFFLE(1, 0, 3, 2)));
+      const float lane_best = _mm_cvtss_f32(t_min);
+      const int at = _mm_movemask_ps(_mm_and_ps(kept, _mm_cmpeq_ps(t_kept, t_min)));
+      const uint32_t first = static_cast<uint32_t>(__builtin_ctz(static_cast<unsigned>(at | 16)));
+      const bool better = lane_best < best;
+      best_triangle = better ? index[first & 3] : best_triangle;
+      best = better ? lane_best : best;
+      continue;
+    }
+    alignas(16) float t[4];
+    _mm_store_ps(t, t_lanes);
+    for (uint32_t l = 0; l < lanes; ++l) {
+      float hit = t[l];
+      const bool is_hit = (redo >> l) & 1
+                              ? IntersectWatertight(ray, triangles + 9 * size_t(index[l]), &hit)
+                              : ((hits >> l) & 1) != 0;
+      if (is_hit && hit < best) {
+        best = hit;
+        best_triangle = index[l];
+      }
+    }
+  }
+#else
+  for (uint32_t e = list_begin; e < list_end; ++e) {
     const uint32_t t = map_triangles_[e];
     float hit;
-    if (IntersectWatertight(ray, &ray_triangles_[9 * (size_t(h.triangle_begin) + t)], &hit) &&
-        hit < best) {
+    if (IntersectWatertight(ray, triangles + 9 * size_t(t), &hit) && hit < best) {
       best = hit;
       best_triangle = t;
     }
   }
+#endif
   if (!(best < std::numeric_limits<float>::infinity())) return false;
   *point = source + d * best;
   *plane = ray_triangle_planes_[h.triangle_begin + best_triangle];
@@ -1307,7 +1595,9 @@ ContactQuery HullColliderSet::HullNarrow(const HullRecord& h, Float3 a, Float3 b
   const PlaneKernels& kernels = Kernels(simd_level_);
   float max_a = 1.f, max_b;
   if (options_.continuous) {
-    const DualResult dual = kernels.dual(soa, a, b);
+    // A particle at rest (or a point query) tests one point: the same answer for half the work.
+    const DualResult dual = std::memcmp(&a, &b, sizeof(Float3)) == 0 ? kernels.dual_same(soa, a)
+                                                                     : kernels.dual(soa, a, b);
     if (dual.separated) return c;  // one plane has both ends outside: no contact
     max_a = dual.max_a;
     max_b = dual.max_b;
@@ -1425,21 +1715,20 @@ ContactQuery HullColliderSet::ColliderContact(uint32_t collider, const ActiveFra
   if (collider < hull_total) {
     const HullRecord& h = hulls_[collider];
     // OBB rejection in the OBB frame: the end point, then (continuous) the segment.
+    // Both ends are transformed and all compares evaluated without short circuits: one branch
+    // on the whole test (whether the end is inside is a coin toss near the hull, and a
+    // mispredicted branch costs more than the arithmetic).
     const Float3 bo = TransformPoint(f.to_obb_end, p1);
-    // Non-short-circuit: three compares are cheaper than a mispredicted branch.
-    const bool end_in = (std::fabs(bo.x) <= h.obb_half.x) & (std::fabs(bo.y) <= h.obb_half.y) &
-                        (std::fabs(bo.z) <= h.obb_half.z);
-    if (!end_in) {
-      if (!options_.continuous) return c;
-      const Float3 ao = TransformPoint(f.to_obb_start, p0);
-      if ((ao.x > h.obb_half.x && bo.x > h.obb_half.x) ||
-          (ao.x < -h.obb_half.x && bo.x < -h.obb_half.x) ||
-          (ao.y > h.obb_half.y && bo.y > h.obb_half.y) ||
-          (ao.y < -h.obb_half.y && bo.y < -h.obb_half.y) ||
-          (ao.z > h.obb_half.z && bo.z > h.obb_half.z) ||
-          (ao.z < -h.obb_half.z && bo.z < -h.obb_half.z))
-        return c;
-    }
+    const Float3 ao = TransformPoint(f.to_obb_start, p0);
+    const Float3 half = h.obb_half;
+    const bool end_in =
+        (std::fabs(bo.x) <= half.x) & (std::fabs(bo.y) <= half.y) & (std::fabs(bo.z) <= half.z);
+    const bool beyond_one_face =
+        ((ao.x > half.x) & (bo.x > half.x)) | ((ao.x < -half.x) & (bo.x < -half.x)) |
+        ((ao.y > half.y) & (bo.y > half.y)) | ((ao.y < -half.y) & (bo.y < -half.y)) |
+        ((ao.z > half.z) & (bo.z > half.z)) | ((ao.z < -half.z) & (bo.z < -half.z));
+    const bool reject = !end_in && (!options_.continuous || beyond_one_face);
+    if (reject) return c;
     const Float3 a = TransformPoint(f.to_local_start, p0);
     const Float3 b = TransformPoint(f.to_local_end, p1);
     c = HullNarrow(h, a, b);
@@ -1644,7 +1933,8 @@ class ContactPlanes {
 
 template <bool kActive>
 void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, uint8_t* flags,
-                                      const ResponseParams& params, float s0, float s1) const {
+                                      const ResponseParams& params, float s0, float s1,
+                                      const uint32_t* first_candidates) const {
   uint8_t result = kCollisionNone;
   Float3 position = *p1, vel = *velocity;
   uint32_t last_single = UINT32_MAX;  // the one collider resolved in the previous pass, if so
@@ -1653,7 +1943,13 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
     // Candidates for the current segment: a response may have moved the particle towards a
     // collider the original segment did not reach.
     uint32_t candidates[kMaxCandidates];
-    const uint32_t count = BroadPhase(p0, position, s0, s1, kActive, candidates);
+    uint32_t count = 0;
+    if (pass == 0 && first_candidates != nullptr) {
+      for (uint32_t mask = *first_candidates; mask != 0; mask &= mask - 1)
+        candidates[count++] = static_cast<uint32_t>(__builtin_ctz(mask));
+    } else {
+      count = BroadPhase(p0, position, s0, s1, kActive, candidates);
+    }
     if (count == 0) break;
     // Only the collider just resolved: its response left the particle on or outside it.
     if (pass > 0 && count == 1 && candidates[0] == last_single) break;
@@ -1735,6 +2031,41 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
   const bool active = substep_start == active_s0_ && substep_end == active_s1_;
   const int64_t count = static_cast<int64_t>(n);
   uint32_t contacts = 0;
+#if defined(DRAPE_HULL_AVX2)
+  if (active && simd_level_ >= 2 && collider_count_ <= 32) {
+    // The first broad phase of eight particles at once (no branch per particle and collider); a
+    // particle without candidates is done (ResolveParticle would leave it as it is).
+    const int64_t groups = (count + 7) / 8;
+#pragma omp parallel for schedule(dynamic, 32) reduction(+ : contacts) if (count > 4096)
+    for (int64_t g = 0; g < groups; ++g) {
+      const size_t first = static_cast<size_t>(g) * 8;
+      const uint32_t lanes = static_cast<uint32_t>(std::min<size_t>(8, n - first));
+      alignas(32) uint32_t masks[8];
+      const uint32_t finite =
+          SphereMasksAvx(&previous[first], &positions[first], &velocities[first], lanes,
+                         sweep_x_.data(), sweep_y_.data(), sweep_z_.data(), sweep_r_.data(),
+                         collider_count_, sweep_union_center_, sweep_union_radius_, masks);
+      // Only the invalid lanes and those with candidates need more; the others are done.
+      uint32_t work = ~finite;
+      for (uint32_t l = 0; l < 8; ++l) work |= masks[l] != 0 ? 1u << l : 0u;
+      work &= (1u << lanes) - 1;
+      std::memset(&flags[first], kCollisionNone, lanes);
+      for (; work != 0; work &= work - 1) {
+        const uint32_t l = static_cast<uint32_t>(__builtin_ctz(work));
+        const size_t k = first + l;
+        if (!((finite >> l) & 1u)) {
+          flags[k] = kCollisionInvalidInput;
+          continue;
+        }
+        ResolveParticle<true>(previous[k], &positions[k], &velocities[k], &flags[k], params,
+                              substep_start, substep_end, &masks[l]);
+        if (flags[k] & kCollisionContact) ++contacts;
+      }
+    }
+    if (contact_count != nullptr) *contact_count = contacts;
+    return Status::Ok();
+  }
+#endif
   // Small batches stay on the calling thread: waking a team costs more than it saves, and on a
   // loaded machine far more (measured: a 961-particle sheet 25x slower with 2 threads).
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : contacts) if (count > 4096)

@@ -53,7 +53,8 @@
 //    double when one is 0). The nearest hit with positive ray parameter is the contact point, the
 //    hit triangle's plane gives the normal. No hit (or a particle on the source): the push-out,
 //    flagged kCollisionFallback. Cell angles come from a polynomial atan2 (max error ~1e-5 rad,
-//    inside the builder's cell margin of >= 1e-4 rad).
+//    inside the builder's cell margin of >= 1e-4 rad). The cell's triangles are tested four at a
+//    time (SSE), each lane with the scalar test's operations in its order, so the same bits.
 // Continuous handling (HullColliderOptions::continuous, default on): if the segment starts outside
 // the hull (or sphere), it is clipped by the half-spaces (Cyrus-Beck: entering t = max over planes
 // of the entry t, valid if <= the min exit t). When it enters within [0, 1], the contact is on the
@@ -81,11 +82,17 @@
 // sphere around each hull's OBB, swept along its interpolated path, 4 or 8 colliders per
 // instruction), then the OBB test of the segment in the collider frame (reject when both ends are
 // beyond the same face), then the plane kernel (one pass giving the max signed distance of both
-// ends, stopping early once one plane has both ends outside: no contact), then the vectorised
-// clip or the response. Measured figures: tests/bench/hull_query_bench.cpp.
+// ends, stopping early once one plane has both ends outside: no contact; a segment with both ends
+// equal evaluates one point), then the vectorised clip or the response. CollideBatch at the
+// selected substep with AVX2 and at most 32 colliders runs the first broad phase for eight
+// particles at a time (8 particles per instruction, one bit mask of candidates per particle,
+// after one test of the group against a sphere around all swept spheres) and resolves only the
+// particles with candidates; the candidates and all answers are the same bits as one particle at
+// a time. Measured figures: tests/bench/hull_query_bench.cpp, docs/PERFORMANCE.md.
 
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <span>
 #include <vector>
 
@@ -260,6 +267,7 @@ class HullColliderSet {
     uint32_t map_rows = 0, map_cols = 0, map_cell_begin = 0;  // map_cell_offsets_ base
     Float3 map_origin, map_axis, map_reference, map_binormal;
     float map_length = 0.f;
+    float map_row_scale = 0.f, map_col_scale = 0.f;  // rows / pi and cols / (2 pi), in float
   };
   struct SphereRecord {
     int32_t joint = -1;
@@ -305,10 +313,33 @@ class HullColliderSet {
   static constexpr uint32_t kMaxCandidates = 32;
   uint32_t BroadPhase(Float3 p0, Float3 p1, float s0, float s1, bool active, uint32_t* out) const;
   // kActive: the fractions are the selected substep's (cached transforms and swept spheres).
+  // first_candidates (optional): the first pass's broad phase already done, as a bit mask of
+  // collider indices (only with at most 32 colliders).
   template <bool kActive>
   void ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, uint8_t* flags,
-                       const ResponseParams& params, float s0, float s1) const;
+                       const ResponseParams& params, float s0, float s1,
+                       const uint32_t* first_candidates = nullptr) const;
   void Clear();
+
+  // Storage for the arrays the SIMD kernels load 8 floats at a time from: 64-byte aligned, so a
+  // hull's plane range (a multiple of 8 floats from the start) never splits a load across cache
+  // lines, whatever the heap handed out.
+  template <typename T>
+  struct SimdAllocator {
+    using value_type = T;
+    SimdAllocator() = default;
+    template <typename U>
+    SimdAllocator(const SimdAllocator<U>&) {}
+    T* allocate(size_t n) {
+      return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{64}));
+    }
+    void deallocate(T* p, size_t) { ::operator delete (p, std::align_val_t{64}); }
+    template <typename U>
+    bool operator==(const SimdAllocator<U>&) const {
+      return true;
+    }
+  };
+  using SimdFloats = std::vector<float, SimdAllocator<float>>;
 
   HullColliderOptions options_;
   uint8_t simd_level_ = 1;  // plane kernels: 0 scalar, 1 SSE2, 2 AVX2
@@ -317,7 +348,7 @@ class HullColliderSet {
   std::vector<HullRecord> hulls_;
   std::vector<SphereRecord> spheres_;
   // Planes, SoA, each hull's range padded to a multiple of 8 with planes that never win.
-  std::vector<float> plane_nx_, plane_ny_, plane_nz_, plane_d_;
+  SimdFloats plane_nx_, plane_ny_, plane_nz_, plane_d_;
   std::vector<Plane> planes_;  // unpadded copy, plane_begin-relative as in the SoA
   // Triangles for the map-table ray: 9 floats (3 vertices) each, plus their planes.
   std::vector<float> ray_triangles_;
@@ -339,8 +370,12 @@ class HullColliderSet {
   float active_s0_ = 0.f, active_s1_ = 1.f;
   // Broad phase, SoA padded to a multiple of 8 (padding never overlaps): swept spheres over the
   // selected substep and over the whole step.
-  std::vector<float> sweep_x_, sweep_y_, sweep_z_, sweep_r_;
-  std::vector<float> full_x_, full_y_, full_z_, full_r_;
+  SimdFloats sweep_x_, sweep_y_, sweep_z_, sweep_r_;
+  SimdFloats full_x_, full_y_, full_z_, full_r_;
+  // A sphere around all swept spheres of the selected substep, grown to cover the rounding of the
+  // per-collider test: a group of particles outside it skips the per-collider tests.
+  Float3 sweep_union_center_;
+  float sweep_union_radius_ = 0.f;
 };
 
 }  // namespace drape
