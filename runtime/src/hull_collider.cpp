@@ -2135,14 +2135,6 @@ int32_t HullColliderSet::LocateLocal(uint32_t hull, Float3 p, bool upper, uint32
                                  ProjectHullUv(p, h.uv_origin, h.uv_u, h.uv_v), steps)];
 }
 
-bool HullColliderSet::ObbMayContainLocal(uint32_t hull, Float3 p) const {
-  const HullRecord& h = hulls_[hull];
-  const Float3 d = p - h.obb_center;
-  return (std::fabs(Dot(d, h.obb_axes[0])) <= h.obb_half.x) &
-         (std::fabs(Dot(d, h.obb_axes[1])) <= h.obb_half.y) &
-         (std::fabs(Dot(d, h.obb_axes[2])) <= h.obb_half.z);
-}
-
 ContactQuery HullColliderSet::QueryHullLocal(uint32_t hull, Float3 a, Float3 b) const {
   if (!IsFinite(a) || !IsFinite(b)) {
     ContactQuery c;

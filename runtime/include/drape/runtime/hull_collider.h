@@ -90,6 +90,7 @@
 // particles with candidates; the candidates and all answers are the same bits as one particle at
 // a time. Measured figures: tests/bench/hull_query_bench.cpp, docs/PERFORMANCE.md.
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <new>
@@ -221,8 +222,15 @@ class HullColliderSet {
   // projected hull (or when the hull has no hierarchy). steps (optional) receives the number of
   // node tests.
   int32_t LocateLocal(uint32_t hull, Float3 p, bool upper, uint32_t* steps = nullptr) const;
-  // The OBB quick rejection: false means p is certainly outside the hull.
-  bool ObbMayContainLocal(uint32_t hull, Float3 p) const;
+  // The OBB quick rejection: false means p is certainly outside the hull. Inline, as on the
+  // query path (which applies it with the OBB frame folded into the pose transform).
+  bool ObbMayContainLocal(uint32_t hull, Float3 p) const {
+    const HullRecord& h = hulls_[hull];
+    const Float3 d = p - h.obb_center;
+    return (std::fabs(Dot(d, h.obb_axes[0])) <= h.obb_half.x) &
+           (std::fabs(Dot(d, h.obb_axes[1])) <= h.obb_half.y) &
+           (std::fabs(Dot(d, h.obb_axes[2])) <= h.obb_half.z);
+  }
   // The full narrow phase for the collider-frame segment a -> b with the current options (point
   // and normal in the collider frame).
   ContactQuery QueryHullLocal(uint32_t hull, Float3 a, Float3 b) const;
