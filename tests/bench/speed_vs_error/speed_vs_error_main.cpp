@@ -29,6 +29,8 @@
 #include "drape/bake/mesh_reference.h"
 #include "drape/bake/regions.h"
 #include "drape/formats/asset_file.h"
+#include "drape/runtime/skeleton_pose.h"
+#include "drape/runtime/skinning.h"
 #include "evaluation.h"
 #include "methods.h"
 #include "query_sets.h"
@@ -417,6 +419,62 @@ class Measurement {
 
     if (spec.label == "mannequin" && !options_.quick) ResolutionIndependence(spec, context);
     if (spec.label == "mannequin") ClothSolvers(spec, import);
+    if (!options_.quick) RunPosed(spec, import, character);
+  }
+
+  // The same character in a pose of its first clip, 40 % into it (limbs bent, unlike the rest
+  // pose): maps baked for that pose, hulls and spheres posed by its skinning matrices (what the
+  // runtime does every frame), against the posed exact mesh. A shorter sweep: the defaults and
+  // the settings the rest pose singles out.
+  void RunPosed(const CharacterSpec& spec, const bake::ImportOptions& import,
+                const bake::Character& character) {
+    if (character.clips.empty()) return;
+    const ClipData& clip = character.clips.front();
+    const float time = 0.4f * clip.duration;
+    SkeletonPose pose;
+    std::vector<Float3> positions(character.mesh.vertex_count());
+    if (!pose.Init(character.skeleton).ok() || !pose.SampleClip(clip, time, false).ok() ||
+        !SkinMesh(character.mesh, pose.skinning(), positions).ok()) {
+      Fail(spec.label + ": cannot pose the first clip");
+    }
+    const std::vector<Mat34> skinning(pose.skinning().begin(), pose.skinning().end());
+    const std::vector<uint32_t>& triangles = character.mesh.triangles;
+    CharacterSpec posed = spec;
+    char label[96];
+    std::snprintf(label, sizeof(label), " posed (%s t=%.2f s)",
+                  clip.name.empty() ? "clip 0" : clip.name.c_str(), time);
+    posed.label += label;
+    std::printf("%s\n", posed.label.c_str());
+    const bake::MeshReference reference(positions, triangles);
+    Context context = MakeContext(posed, positions, triangles, reference);
+    for (const MapSetting& m : MapSweep(true)) {
+      if (m.sampling != DepthSampling::kNearest || m.fitted || m.epsilon != 0.005f) continue;
+      bake::BodyMapOptions o;
+      o.resolution = m.resolution;
+      BodyMapPose map;
+      bake::BodyMapPoseStats stats;
+      if (!bake::BakeBodyMapPose(positions, triangles, o, &map, &stats).ok()) {
+        Fail(posed.label + ": cannot bake maps " + Describe(m));
+      }
+      Measure(context, *MakeBodyMapMethod(map, m.sampling, Describe(m), stats.bytes));
+    }
+    for (const HullBake& hb : HullBakes(import, false)) {
+      const bool wanted = hb.label.rfind("default", 0) == 0 ||
+                          hb.label.rfind("shape threshold", 0) == 0 ||
+                          hb.label.rfind("rigid threshold", 0) == 0;
+      if (!wanted) continue;
+      bake::BakeResult result;
+      if (!bake::BakeCharacter(spec.path, hb.config, &result).ok()) {
+        Fail(posed.label + ": cannot bake hulls " + hb.label);
+      }
+      const CharacterAsset& a = result.asset;
+      const std::string counts = " (" + std::to_string(a.hulls.size()) + " hulls, " +
+                                 std::to_string(a.joint_spheres.size()) + " spheres)";
+      Measure(context, *MakeHullMethod(a.hulls, a.joint_spheres, a.skeleton.joint_count(), skinning,
+                                       HullColliderOptions{}, "hulls+spheres", hb.label + counts,
+                                       HullBakedBytes(a)));
+    }
+    MeasurePeer(context, *MakeExactMeshPeer(reference));
   }
 
   void Finish() {
