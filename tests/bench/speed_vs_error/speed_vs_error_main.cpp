@@ -422,14 +422,16 @@ class Measurement {
     if (!options_.quick) RunPosed(spec, import, character);
   }
 
-  // The same character in a pose of its first clip, 40 % into it (limbs bent, unlike the rest
+  // The same character in a pose of its longest clip, 40 % into it (limbs bent, unlike the rest
   // pose): maps baked for that pose, hulls and spheres posed by its skinning matrices (what the
   // runtime does every frame), against the posed exact mesh. A shorter sweep: the defaults and
   // the settings the rest pose singles out.
   void RunPosed(const CharacterSpec& spec, const bake::ImportOptions& import,
                 const bake::Character& character) {
     if (character.clips.empty()) return;
-    const ClipData& clip = character.clips.front();
+    const ClipData& clip = *std::max_element(
+        character.clips.begin(), character.clips.end(),
+        [](const ClipData& a, const ClipData& b) { return a.duration < b.duration; });
     const float time = 0.4f * clip.duration;
     SkeletonPose pose;
     std::vector<Float3> positions(character.mesh.vertex_count());
