@@ -330,9 +330,9 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
           std::to_string(config.rigid_threshold).substr(0, 4) + " (" +
           std::to_string(asset.hulls.size()) +
           " hulls): the skin weights are smooth and the joint spheres carry most of the body; "
-          "hulls.shape_threshold 0.51 lets the flexible vertices shape their heaviest bone's "
-          "hull too (CesiumMan: 0 % of the measured motions missed instead of 6 %; "
-          "docs/PERFORMANCE.md)");
+          "hulls.shape_threshold 0.51 (the default) lets the flexible vertices shape their "
+          "heaviest bone's hull too (CesiumMan: 0 % of the measured motions missed instead of "
+          "6 %; docs/PERFORMANCE.md)");
     }
   }
   if (config.spheres_enabled) {

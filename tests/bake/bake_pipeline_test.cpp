@@ -205,6 +205,7 @@ TEST(BakePipeline, ShapingVerticesGrowTheHullsAndKeepTheSpheres) {
     if (!std::filesystem::exists(path)) continue;  // CesiumMan: shared asset absent
     BakeConfig config;
     config.maps_enabled = false;
+    config.shape_threshold = 1.f;  // paper B: rigid vertices only
     BakeResult plain, shaped;
     ASSERT_TRUE(BakeCharacter(path, config, &plain).ok());
     config.shape_threshold = 0.6f;
@@ -243,8 +244,9 @@ TEST(BakePipeline, ShapingVerticesGrowTheHullsAndKeepTheSpheres) {
   }
 }
 
-// A smoothly weighted rig (CesiumMan: 13 % of its vertices reach 0.99) gets a warning naming
-// the thresholds; the mannequin (68 %) does not; a lower rigid or shape threshold removes it.
+// With paper B's rigid-only hulls, a smoothly weighted rig (CesiumMan: 13 % of its vertices
+// reach 0.99) gets a warning naming the thresholds; the mannequin (68 %) does not; a lower rigid
+// or shape threshold (the default 0.51) removes it.
 TEST(BakePipeline, WarnsWhenFewVerticesShapeTheHulls) {
   const auto rigid_warnings = [](const nlohmann::json& report) {
     int count = 0;
@@ -254,6 +256,7 @@ TEST(BakePipeline, WarnsWhenFewVerticesShapeTheHulls) {
   };
   BakeConfig config;
   config.maps_enabled = false;
+  config.shape_threshold = 1.f;
   BakeResult mannequin;
   ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &mannequin).ok());
   EXPECT_GT(mannequin.report["hulls"]["rigid_vertex_fraction"].get<double>(), 0.5);
