@@ -890,15 +890,23 @@ bool BodyMapCollider::ClearlyFree(Float3 p0, Float3 p1) const {
   return free;
 }
 
-ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
+namespace {
+
+// The answer of a motion without contact (flagged when the input is not finite): what every
+// path of the continuous test starts from.
+ContactQuery NoContact(Float3 p0, Float3 p1) {
   ContactQuery result;
   result.point = p1;
   result.normal = Float3{0.f, 0.f, 1.f};
-  if (!IsFinite(p0) || !IsFinite(p1)) {
-    result.flags = kCollisionInvalidInput;
-    return result;
-  }
-  if (stats_.valid_texels == 0) return result;
+  if (!IsFinite(p0) || !IsFinite(p1)) result.flags = kCollisionInvalidInput;
+  return result;
+}
+
+}  // namespace
+
+ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
+  ContactQuery result = NoContact(p0, p1);
+  if (result.flags == kCollisionInvalidInput || stats_.valid_texels == 0) return result;
   if (sampling_ == DepthSampling::kNearest && QuerySingleTexel(p0, p1, &result)) return result;
   if (ClearlyFree(p0, p1)) return result;
   WalkInto(p0, p1, &result);
@@ -906,14 +914,10 @@ ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
 }
 
 ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
-  ContactQuery result;
-  result.point = p1;
-  result.normal = Float3{0.f, 0.f, 1.f};
-  if (!IsFinite(p0) || !IsFinite(p1)) {
-    result.flags = kCollisionInvalidInput;
-    return result;
+  ContactQuery result = NoContact(p0, p1);
+  if (result.flags != kCollisionInvalidInput && stats_.valid_texels != 0) {
+    WalkInto(p0, p1, &result);
   }
-  if (stats_.valid_texels != 0) WalkInto(p0, p1, &result);
   return result;
 }
 

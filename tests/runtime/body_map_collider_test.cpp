@@ -804,6 +804,17 @@ void ExpectSameBits(Float3 a, Float3 b, const char* what, int k) {
   EXPECT_EQ(Bits(a.z), Bits(b.z)) << what << " " << k;
 }
 
+// Every field of two answers, bit for bit (query k).
+void ExpectSameAnswer(const ContactQuery& a, const ContactQuery& b, int k) {
+  EXPECT_EQ(a.inside_end, b.inside_end) << k;
+  EXPECT_EQ(a.contact, b.contact) << k;
+  EXPECT_EQ(Bits(a.t), Bits(b.t)) << k;
+  ExpectSameBits(a.point, b.point, "point", k);
+  ExpectSameBits(a.normal, b.normal, "normal", k);
+  EXPECT_EQ(Bits(a.depth), Bits(b.depth)) << k;
+  EXPECT_EQ(a.flags, b.flags) << k;
+}
+
 // Every texel's slab and normals, the bounds and stats, and `segments` random queries: equal bit
 // for bit. Segments run between points of the colliders' box widened by `pad` metres.
 void ExpectIdenticalColliders(const BodyMapCollider& a, const BodyMapCollider& b, int segments,
@@ -848,13 +859,7 @@ void ExpectIdenticalColliders(const BodyMapCollider& a, const BodyMapCollider& b
     // Alternately long segments across the box and short ones (a few texels).
     const Float3 p1 = k % 2 == 0 ? point() : p0 + (point() - p0) * 0.02f;
     const ContactQuery qa = a.Query(p0, p1), qb = b.Query(p0, p1);
-    EXPECT_EQ(qa.inside_end, qb.inside_end) << k;
-    EXPECT_EQ(qa.contact, qb.contact) << k;
-    EXPECT_EQ(Bits(qa.t), Bits(qb.t)) << k;
-    ExpectSameBits(qa.point, qb.point, "point", k);
-    ExpectSameBits(qa.normal, qb.normal, "normal", k);
-    EXPECT_EQ(Bits(qa.depth), Bits(qb.depth)) << k;
-    EXPECT_EQ(qa.flags, qb.flags) << k;
+    ExpectSameAnswer(qa, qb, k);
     EXPECT_EQ(a.IsInside(p1), b.IsInside(p1)) << k;
     contacts += qa.contact;
   }
@@ -911,13 +916,7 @@ TEST(BodyMapCollider, QuickPathsAnswerBitForBitAsTheWalk) {
         }
         const ContactQuery quick = c.Query(p0, p1);
         const ContactQuery walk = BodyMapColliderTestAccess::QueryWalk(c, p0, p1);
-        EXPECT_EQ(quick.inside_end, walk.inside_end) << k;
-        EXPECT_EQ(quick.contact, walk.contact) << k;
-        EXPECT_EQ(Bits(quick.t), Bits(walk.t)) << k;
-        ExpectSameBits(quick.point, walk.point, "point", k);
-        ExpectSameBits(quick.normal, walk.normal, "normal", k);
-        EXPECT_EQ(Bits(quick.depth), Bits(walk.depth)) << k;
-        EXPECT_EQ(quick.flags, walk.flags) << k;
+        ExpectSameAnswer(quick, walk, k);
         contacts += walk.contact;
         started_inside += (walk.flags & kCollisionStartedInside) != 0;
         same_texel +=
