@@ -808,7 +808,9 @@ bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, ContactQuery* resul
   if (!(u0 >= 0.f && v0 >= 0.f && u0 < width_f_ && v0 < height_f_)) return false;
   const float u1 = (p1.x - origin_x_) * inv_texel_size_, v1 = (p1.y - origin_y_) * inv_texel_size_;
   const int i = static_cast<int>(u0), j = static_cast<int>(v0);
-  if (!(u1 >= 0.f && v1 >= 0.f) || static_cast<int>(u1) != i || static_cast<int>(v1) != j) {
+  // On the grid before the conversion (a float beyond int's range does not convert).
+  if (!(u1 >= 0.f && v1 >= 0.f && u1 < width_f_ && v1 < height_f_) || static_cast<int>(u1) != i ||
+      static_cast<int>(v1) != j) {
     return false;
   }
   const size_t texel = static_cast<size_t>(j) * width_ + static_cast<size_t>(i);

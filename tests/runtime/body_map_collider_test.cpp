@@ -25,6 +25,14 @@ struct BodyMapColliderTestAccess {
   static ContactQuery QueryWalk(const BodyMapCollider& c, Float3 p0, Float3 p1) {
     return c.QueryWalk(p0, p1);
   }
+  // Whether each quick path answers this motion (nearest sampling for the first).
+  static bool SingleTexelAnswers(const BodyMapCollider& c, Float3 p0, Float3 p1) {
+    ContactQuery unused;
+    return c.sampling() == DepthSampling::kNearest && c.QuerySingleTexel(p0, p1, &unused);
+  }
+  static bool ClearlyFree(const BodyMapCollider& c, Float3 p0, Float3 p1) {
+    return c.ClearlyFree(p0, p1);
+  }
 };
 
 namespace {
@@ -891,11 +899,11 @@ TEST(BodyMapCollider, QuickPathsAnswerBitForBitAsTheWalk) {
                       lo.y - pad + unit(rng) * (hi.y - lo.y + 2.f * pad),
                       lo.z - pad + unit(rng) * (hi.z - lo.z + 2.f * pad)};
       };
-      int contacts = 0, started_inside = 0, same_texel = 0;
-      for (int k = 0; k < 40000; ++k) {
+      int contacts = 0, started_inside = 0, single_texel = 0, clearly_free = 0;
+      for (int k = 0; k < 48000; ++k) {
         Float3 p0 = point(0.02f), p1 = p0;
         const float texel = c.texel_size();
-        switch (k % 5) {
+        switch (k % 6) {
           case 0:  // a point
             break;
           case 1:  // sub-texel, mostly along z through a surface
@@ -909,25 +917,42 @@ TEST(BodyMapCollider, QuickPathsAnswerBitForBitAsTheWalk) {
           case 3:  // long, across the box
             p1 = point(0.1f);
             break;
-          default:  // on a texel edge, moving along z only
+          case 4:  // on a texel edge, moving along z only
             p0.x = c.origin_x() + std::floor((p0.x - c.origin_x()) / texel) * texel;
             p1 = Float3{p0.x, p0.y, p0.z + (unit(rng) - 0.5f) * 0.1f};
             break;
+          default: {  // starting or ending exactly on a surface value of the texel's slab
+            const float u = (p0.x - c.origin_x()) / texel, v = (p0.y - c.origin_y()) / texel;
+            float top = 0.f, bottom = 0.f;
+            if (u >= 0.f && v >= 0.f &&
+                c.TexelSlab(static_cast<uint32_t>(u), static_cast<uint32_t>(v), &top, &bottom)) {
+              const float surface = unit(rng) < 0.5f ? top : bottom;
+              if (unit(rng) < 0.5f) {
+                p0.z = surface;
+                p1 = Float3{p0.x, p0.y, surface + (unit(rng) - 0.5f) * 0.01f};
+              } else {
+                p1 = Float3{p0.x, p0.y, surface};
+              }
+            }
+            break;
+          }
         }
         const ContactQuery quick = c.Query(p0, p1);
         const ContactQuery walk = BodyMapColliderTestAccess::QueryWalk(c, p0, p1);
         ExpectSameAnswer(quick, walk, k);
         contacts += walk.contact;
         started_inside += (walk.flags & kCollisionStartedInside) != 0;
-        same_texel +=
-            std::floor((p0.x - c.origin_x()) / texel) ==
-                std::floor((p1.x - c.origin_x()) / texel) &&
-            std::floor((p0.y - c.origin_y()) / texel) == std::floor((p1.y - c.origin_y()) / texel);
+        const bool single = BodyMapColliderTestAccess::SingleTexelAnswers(c, p0, p1);
+        single_texel += single;
+        clearly_free += !single && BodyMapColliderTestAccess::ClearlyFree(c, p0, p1);
       }
-      // The sets must exercise every branch of the quick paths.
+      // The sets must exercise both quick paths and the walk.
       EXPECT_GT(contacts, 2000);
       EXPECT_GT(started_inside, 200);
-      EXPECT_GT(same_texel, 16000);
+      if (sampling == DepthSampling::kNearest) {
+        EXPECT_GT(single_texel, 4000);  // the thin slab's 2 mm clip box sends most to the walk
+      }
+      EXPECT_GT(clearly_free, 2000);
     }
   }
 }
