@@ -177,9 +177,10 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
   json left_out = json::array();
   for (uint32_t j = 0; j < joints; ++j) {
     const std::string& bone = skeleton.joint_names[j];
-    if (points[j].empty()) continue;  // no rigid vertices: nothing to cover
+    if (points[j].empty()) continue;  // no rigid or shaping vertices: nothing to cover
     if (!status[j].ok()) {
-      // Too few rigid vertices for a solid: the joint sphere shared with the parent covers them.
+      // Too few points for a solid: the joint sphere shared with the parent covers the rigid
+      // vertices (the shaping ones are in their joint spheres already).
       std::string where = "not covered (no parent joint)";
       for (JointRegion& region : regions.joints) {
         if (region.child == static_cast<int32_t>(j) || region.parent == static_cast<int32_t>(j)) {
@@ -324,15 +325,22 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     timings["hulls_ms"] = MillisecondsSince(start);
     const double fraction = hulls["hull_vertex_fraction"].get<double>();
     if (fraction < kLowHullVertexFraction) {
+      const auto value = [](float v) { return std::to_string(v).substr(0, 4); };
+      std::string advice =
+          config.shape_threshold > 0.51f
+              ? "; hulls.shape_threshold 0.51 (the default; " + value(config.shape_threshold) +
+                    " here) lets the flexible vertices shape their heaviest bone's hull too "
+                    "(CesiumMan: 0 % of the measured motions missed instead of 6 %; "
+                    "docs/PERFORMANCE.md)"
+              : "; most vertices are blended with no bone above half their weight, which no "
+                "hull can follow: use the body maps for this character";
       character.warnings.push_back(
           "only " + std::to_string(static_cast<int>(std::lround(fraction * 100.0))) +
           " % of the vertices shape a hull at hulls.rigid_threshold " +
-          std::to_string(config.rigid_threshold).substr(0, 4) + " (" +
-          std::to_string(asset.hulls.size()) +
-          " hulls): the skin weights are smooth and the joint spheres carry most of the body; "
-          "hulls.shape_threshold 0.51 (the default) lets the flexible vertices shape their "
-          "heaviest bone's hull too (CesiumMan: 0 % of the measured motions missed instead of "
-          "6 %; docs/PERFORMANCE.md)");
+          value(config.rigid_threshold) + " and hulls.shape_threshold " +
+          value(config.shape_threshold) + " (" + std::to_string(asset.hulls.size()) +
+          " hulls): the skin weights are smooth and the joint spheres carry most of the body" +
+          advice);
     }
   }
   if (config.spheres_enabled) {

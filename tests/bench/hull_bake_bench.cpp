@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "drape/bake/bake_config.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
 #include "drape/bake/regions.h"
@@ -104,7 +105,8 @@ void BM_HullBakeObb(benchmark::State& state) {
 }
 BENCHMARK(BM_HullBakeObb)->ArgName("obb")->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
 
-// Every bone of CesiumMan, as the bake pipeline feeds them (rigid vertices in the collider frame).
+// Every bone of CesiumMan, as the bake pipeline feeds them with its default config (rigid and
+// shaping vertices in the collider frame).
 void BM_CesiumManHulls(benchmark::State& state) {
   const std::string path = test::CharacterPath("CesiumMan/CesiumMan.glb");
   if (!std::filesystem::exists(path)) {
@@ -114,7 +116,8 @@ void BM_CesiumManHulls(benchmark::State& state) {
   Character character;
   Regions regions;
   if (!ImportCharacter(path, ImportOptions{}, &character).ok() ||
-      !SplitRegions(character, 0.99f, &regions).ok()) {
+      !SplitRegions(character, BakeConfig{}.rigid_threshold, &regions, BakeConfig{}.shape_threshold)
+           .ok()) {
     state.SkipWithError("CesiumMan import or region split failed");
     return;
   }
@@ -123,6 +126,9 @@ void BM_CesiumManHulls(benchmark::State& state) {
     const Mat34 to_collider = InverseRigid(regions.collider_frames[j]);
     std::vector<Float3> points;
     for (uint32_t v : regions.rigid_vertices[j]) {
+      points.push_back(TransformPoint(to_collider, regions.rest_positions[v]));
+    }
+    for (uint32_t v : regions.shaping_vertices[j]) {
       points.push_back(TransformPoint(to_collider, regions.rest_positions[v]));
     }
     if (!points.empty()) bones.push_back(std::move(points));
