@@ -175,6 +175,17 @@ std::string Describe(const MapSetting& m) {
   return s.str();
 }
 
+// The bake options of a setting (everything else at the bake's defaults).
+bake::BodyMapOptions BodyMapOptionsFor(const MapSetting& m) {
+  bake::BodyMapOptions o;
+  o.resolution = m.resolution;
+  o.fitted_window = m.fitted;
+  o.epsilon = m.epsilon;
+  o.depth_encoding = m.depth;
+  o.normal_encoding = m.normals;
+  return o;
+}
+
 std::vector<MapSetting> MapSweep(bool quick) {
   std::vector<MapSetting> sweep;
   const std::vector<uint32_t> sizes =
@@ -336,12 +347,7 @@ class Measurement {
     // Paper A: body maps of the rest pose.
     std::unique_ptr<Method> default_maps;
     for (const MapSetting& m : MapSweep(options_.quick)) {
-      bake::BodyMapOptions o;
-      o.resolution = m.resolution;
-      o.fitted_window = m.fitted;
-      o.epsilon = m.epsilon;
-      o.depth_encoding = m.depth;
-      o.normal_encoding = m.normals;
+      const bake::BodyMapOptions o = BodyMapOptionsFor(m);
       BodyMapPose pose;
       bake::BodyMapPoseStats stats;
       const Status baked = bake::BakeBodyMapPose(positions, triangles, o, &pose, &stats);
@@ -439,22 +445,25 @@ class Measurement {
     std::vector<Float3> positions(character.mesh.vertex_count());
     if (!pose.Init(character.skeleton).ok() || !pose.SampleClip(clip, time, false).ok() ||
         !SkinMesh(character.mesh, pose.skinning(), positions).ok()) {
-      Fail(spec.label + ": cannot pose the first clip");
+      Fail(spec.label + ": cannot pose its longest clip");
     }
     const std::vector<Mat34> skinning(pose.skinning().begin(), pose.skinning().end());
     const std::vector<uint32_t>& triangles = character.mesh.triangles;
     CharacterSpec posed = spec;
     char label[96];
     std::snprintf(label, sizeof(label), " posed (%s t=%.2f s)",
-                  clip.name.empty() ? "clip 0" : clip.name.c_str(), time);
+                  clip.name.empty() ? "unnamed clip" : clip.name.c_str(), time);
     posed.label += label;
     std::printf("%s\n", posed.label.c_str());
     const bake::MeshReference reference(positions, triangles);
     Context context = MakeContext(posed, positions, triangles, reference);
     for (const MapSetting& m : MapSweep(true)) {
-      if (m.sampling != DepthSampling::kNearest || m.fitted || m.epsilon != 0.005f) continue;
-      bake::BodyMapOptions o;
-      o.resolution = m.resolution;
+      const MapSetting defaults;
+      if (m.sampling != DepthSampling::kNearest || m.fitted || m.epsilon != defaults.epsilon ||
+          m.depth != defaults.depth || m.normals != defaults.normals) {
+        continue;
+      }
+      const bake::BodyMapOptions o = BodyMapOptionsFor(m);
       BodyMapPose map;
       bake::BodyMapPoseStats stats;
       if (!bake::BakeBodyMapPose(positions, triangles, o, &map, &stats).ok()) {
