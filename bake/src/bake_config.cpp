@@ -221,7 +221,7 @@ const std::vector<Parameter>& Parameters() {
                 "only, as in paper B",
                 [](BakeConfig& c) -> float& { return c.shape_threshold; }),
       MakeFloat("hulls", "delta", "m", 0, 0.1, false,
-                "inflation: the delta-ball of every rigid vertex is inside",
+                "inflation: the delta-ball of every rigid and shaping vertex is inside",
                 [](BakeConfig& c) -> float& { return c.hull.delta; }),
       MakeEnum<InflationMode>(
           "hulls", "inflation",
