@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "cloth_peer_comparison.h"
@@ -360,13 +361,16 @@ class Measurement {
       if (combo) default_maps = MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes);
     }
 
-    // Paper B: hulls and joint spheres, rest pose.
+    // Paper B: hulls and joint spheres, rest pose. The bake does not depend on the pose: the
+    // settings the posed run measures keep their asset for it.
     std::string per_bone;
+    std::vector<std::pair<std::string, CharacterAsset>> for_posed;
     for (const HullBake& hb : HullBakes(import, options_.quick)) {
       bake::BakeResult result;
       const Status baked = bake::BakeCharacter(spec.path, hb.config, &result);
       if (!baked.ok()) Fail(spec.label + " hulls " + hb.label + ": " + baked.message());
       const CharacterAsset& a = result.asset;
+      if (MeasuredPosed(hb.label)) for_posed.emplace_back(hb.label, a);
       const uint32_t joints = a.skeleton.joint_count();
       const size_t bytes = HullBakedBytes(a);
       const bool is_default = hb.label.rfind("default", 0) == 0;
@@ -427,15 +431,24 @@ class Measurement {
 
     if (spec.label == "mannequin" && !options_.quick) ResolutionIndependence(spec, context);
     if (spec.label == "mannequin") ClothSolvers(spec, import);
-    if (!options_.quick) RunPosed(spec, import, character);
+    if (!options_.quick) RunPosed(spec, character, for_posed);
+  }
+
+  // The hull settings the posed run measures: the defaults and the thresholds.
+  static bool MeasuredPosed(const std::string& label) {
+    for (const char* prefix :
+         {"default", "shape threshold", "paper B's rigid-only", "rigid threshold"}) {
+      if (label.rfind(prefix, 0) == 0) return true;
+    }
+    return false;
   }
 
   // The same character in a pose of its longest clip, 40 % into it (limbs bent, unlike the rest
   // pose): maps baked for that pose, hulls and spheres posed by its skinning matrices (what the
   // runtime does every frame), against the posed exact mesh. A shorter sweep: the defaults and
   // the settings the rest pose singles out.
-  void RunPosed(const CharacterSpec& spec, const bake::ImportOptions& import,
-                const bake::Character& character) {
+  void RunPosed(const CharacterSpec& spec, const bake::Character& character,
+                const std::vector<std::pair<std::string, CharacterAsset>>& hull_assets) {
     if (character.clips.empty()) return;
     const ClipData& clip = *std::max_element(
         character.clips.begin(), character.clips.end(),
@@ -471,21 +484,11 @@ class Measurement {
       }
       Measure(context, *MakeBodyMapMethod(map, m.sampling, Describe(m), stats.bytes));
     }
-    for (const HullBake& hb : HullBakes(import, false)) {
-      const bool wanted = hb.label.rfind("default", 0) == 0 ||
-                          hb.label.rfind("shape threshold", 0) == 0 ||
-                          hb.label.rfind("paper B's rigid-only", 0) == 0 ||
-                          hb.label.rfind("rigid threshold", 0) == 0;
-      if (!wanted) continue;
-      bake::BakeResult result;
-      if (!bake::BakeCharacter(spec.path, hb.config, &result).ok()) {
-        Fail(posed.label + ": cannot bake hulls " + hb.label);
-      }
-      const CharacterAsset& a = result.asset;
+    for (const auto& [setting, a] : hull_assets) {
       const std::string counts = " (" + std::to_string(a.hulls.size()) + " hulls, " +
                                  std::to_string(a.joint_spheres.size()) + " spheres)";
       Measure(context, *MakeHullMethod(a.hulls, a.joint_spheres, a.skeleton.joint_count(), skinning,
-                                       HullColliderOptions{}, "hulls+spheres", hb.label + counts,
+                                       HullColliderOptions{}, "hulls+spheres", setting + counts,
                                        HullBakedBytes(a)));
     }
     MeasurePeer(context, *MakeExactMeshPeer(reference));
