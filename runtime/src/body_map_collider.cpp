@@ -803,10 +803,10 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
 // ---------------------------------------------------------------------------------------------
 // Queries
 
-bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, ContactQuery* result) const {
-  const float u0 = (p0.x - origin_x_) * inv_texel_size_, v0 = (p0.y - origin_y_) * inv_texel_size_;
+bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& t,
+                                       ContactQuery* result) const {
+  const float u0 = t.u0, v0 = t.v0, u1 = t.u1, v1 = t.v1;
   if (!(u0 >= 0.f && v0 >= 0.f && u0 < width_f_ && v0 < height_f_)) return false;
-  const float u1 = (p1.x - origin_x_) * inv_texel_size_, v1 = (p1.y - origin_y_) * inv_texel_size_;
   const int i = static_cast<int>(u0), j = static_cast<int>(v0);
   // On the grid before the conversion (a float beyond int's range does not convert).
   if (!(u1 >= 0.f && v1 >= 0.f && u1 < width_f_ && v1 < height_f_) || static_cast<int>(u1) != i ||
@@ -852,11 +852,9 @@ bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, ContactQuery* resul
   return true;
 }
 
-bool BodyMapCollider::ClearlyFree(Float3 p0, Float3 p1) const {
-  const float u0 = (p0.x - origin_x_) * inv_texel_size_, v0 = (p0.y - origin_y_) * inv_texel_size_;
-  const float u1 = (p1.x - origin_x_) * inv_texel_size_, v1 = (p1.y - origin_y_) * inv_texel_size_;
-  const float u_lo = std::min(u0, u1), u_hi = std::max(u0, u1);
-  const float v_lo = std::min(v0, v1), v_hi = std::max(v0, v1);
+bool BodyMapCollider::ClearlyFree(Float3 p0, Float3 p1, const TexelCoords& t) const {
+  const float u_lo = std::min(t.u0, t.u1), u_hi = std::max(t.u0, t.u1);
+  const float v_lo = std::min(t.v0, t.v1), v_hi = std::max(t.v0, t.v1);
   if (!(u_lo >= 0.f && v_lo >= 0.f && u_hi < width_f_ && v_hi < height_f_)) return false;
   // The walk's cells lie between the texels of its clipped ends, and the clipped ends lie
   // between p0 and p1 (float rounding is monotone): the texel box of p0 and p1 holds every
@@ -909,8 +907,11 @@ ContactQuery NoContact(Float3 p0, Float3 p1) {
 ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
   ContactQuery result = NoContact(p0, p1);
   if (result.flags == kCollisionInvalidInput || stats_.valid_texels == 0) return result;
-  if (sampling_ == DepthSampling::kNearest && QuerySingleTexel(p0, p1, &result)) return result;
-  if (ClearlyFree(p0, p1)) return result;
+  const TexelCoords texels = ToTexels(p0, p1);
+  if (sampling_ == DepthSampling::kNearest && QuerySingleTexel(p0, p1, texels, &result)) {
+    return result;
+  }
+  if (ClearlyFree(p0, p1, texels)) return result;
   WalkInto(p0, p1, &result);
   return result;  // one named result on every path: built in place, never copied
 }

@@ -28,10 +28,11 @@ struct BodyMapColliderTestAccess {
   // Whether each quick path answers this motion (nearest sampling for the first).
   static bool SingleTexelAnswers(const BodyMapCollider& c, Float3 p0, Float3 p1) {
     ContactQuery unused;
-    return c.sampling() == DepthSampling::kNearest && c.QuerySingleTexel(p0, p1, &unused);
+    return c.sampling() == DepthSampling::kNearest &&
+           c.QuerySingleTexel(p0, p1, c.ToTexels(p0, p1), &unused);
   }
   static bool ClearlyFree(const BodyMapCollider& c, Float3 p0, Float3 p1) {
-    return c.ClearlyFree(p0, p1);
+    return c.ClearlyFree(p0, p1, c.ToTexels(p0, p1));
   }
 };
 

@@ -208,10 +208,19 @@ class BodyMapCollider {
   static constexpr uint32_t kBlockShift = 3;  // 8x8 texels per min/max block
   static constexpr uint32_t kBlockTexels = 1u << kBlockShift;
 
+  // A motion's ends in texel units, computed once for the quick paths (the same expressions the
+  // walk and IsInside use).
+  struct TexelCoords {
+    float u0, v0, u1, v1;
+  };
+  TexelCoords ToTexels(Float3 p0, Float3 p1) const {
+    return {(p0.x - origin_x_) * inv_texel_size_, (p0.y - origin_y_) * inv_texel_size_,
+            (p1.x - origin_x_) * inv_texel_size_, (p1.y - origin_y_) * inv_texel_size_};
+  }
   // The quick answer for motions through air: true when every texel (or min/max block) the
   // walk from p0 to p1 could visit holds no z of the segment, so Query has no contact and p1 is
   // outside. Conservative: false whenever unsure (ends off the grid, long motions).
-  bool ClearlyFree(Float3 p0, Float3 p1) const;
+  bool ClearlyFree(Float3 p0, Float3 p1, const TexelCoords& t) const;
   // Query without its quick paths: clip, walk, answer. Query gives the same bits.
   ContactQuery QueryWalk(Float3 p0, Float3 p1) const;
   // QueryWalk's clip, walk and answer into *out, which holds the defaults of a miss (finite
@@ -220,7 +229,7 @@ class BodyMapCollider {
   // Query for a motion that stays in one texel of the grid (kNearest): fills *result and
   // returns true, bit for bit what the general path gives; false when the general path must
   // answer (ends in different texels, off the grid, or outside the clip box in z).
-  bool QuerySingleTexel(Float3 p0, Float3 p1, ContactQuery* result) const;
+  bool QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& t, ContactQuery* result) const;
   static constexpr int kFreeTestMaxTexels = 9;  // texels (or blocks) ClearlyFree reads at most
   bool IsInsideBilinear(Float3 p) const;
   void InsideRange(const Float3* points, uint8_t* inside, size_t count) const;  // kNearest
