@@ -6,6 +6,7 @@
 #include "drape/bake/mesh_reference.h"
 
 #include <gtest/gtest.h>
+#include <Eigen/Dense>
 
 #include <algorithm>
 #include <array>
@@ -41,38 +42,28 @@ struct Mesh {
   std::vector<uint32_t> triangles;
 };
 
-struct V3 {
-  double x = 0, y = 0, z = 0;
-};
-V3 Sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 Add(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-V3 Scale(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-double Dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 Cross(V3 a, V3 b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-double Norm(V3 a) { return std::sqrt(Dot(a, a)); }
+using V3 = Eigen::Vector3d;  // metres, double: the brute-force references' arithmetic
 V3 ToV3(Float3 f) { return {f.x, f.y, f.z}; }
 V3 Corner(const Mesh& m, size_t t, int c) { return ToV3(m.positions[m.triangles[3 * t + c]]); }
 
 // Icosphere of radius `radius` about `centre`, outward counter-clockwise; `subdivisions` splits
 // every triangle in four, vertices pushed to the sphere (in float: the stored precision).
-Mesh MakeIcosphere(int subdivisions, double radius, V3 centre = {}) {
+Mesh MakeIcosphere(int subdivisions, double radius, V3 centre = V3::Zero()) {
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<V3> v = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
                        {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
   std::vector<uint32_t> f = {0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
                              4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
                              6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
-  for (V3& p : v) p = Scale(p, 1.0 / Norm(p));
+  for (V3& p : v) p = p * (1.0 / p.norm());
   for (int s = 0; s < subdivisions; ++s) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoint;
     auto mid = [&](uint32_t a, uint32_t b) {
       const auto key = std::minmax(a, b);
       auto it = midpoint.find(key);
       if (it != midpoint.end()) return it->second;
-      const V3 m = Scale(Add(v[a], v[b]), 0.5);
-      v.push_back(Scale(m, 1.0 / Norm(m)));
+      const V3 m = (v[a] + v[b]) * 0.5;
+      v.push_back(m * (1.0 / m.norm()));
       const uint32_t index = static_cast<uint32_t>(v.size() - 1);
       midpoint.emplace(key, index);
       return index;
@@ -87,9 +78,9 @@ Mesh MakeIcosphere(int subdivisions, double radius, V3 centre = {}) {
   }
   Mesh mesh;
   for (const V3& p : v) {
-    const V3 q = Add(centre, Scale(p, radius));
+    const V3 q = centre + (p * radius);
     mesh.positions.push_back(
-        {static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)});
+        {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z())});
   }
   mesh.triangles = std::move(f);
   return mesh;
@@ -111,25 +102,25 @@ bool LoadRestPose(const std::string& path, Mesh* mesh) {
 
 // Moller-Trumbore in double: the segment parameter where p0 + t d crosses triangle abc, or -1.
 double SegmentTriangle(V3 p0, V3 d, V3 a, V3 b, V3 c) {
-  const V3 e1 = Sub(b, a), e2 = Sub(c, a);
-  const V3 p = Cross(d, e2);
-  const double det = Dot(e1, p);
+  const V3 e1 = b - a, e2 = c - a;
+  const V3 p = d.cross(e2);
+  const double det = e1.dot(p);
   if (det == 0.0) return -1.0;
   const double inverse = 1.0 / det;
-  const V3 s = Sub(p0, a);
-  const double u = Dot(s, p) * inverse;
+  const V3 s = p0 - a;
+  const double u = s.dot(p) * inverse;
   if (u < 0.0 || u > 1.0) return -1.0;
-  const V3 qv = Cross(s, e1);
-  const double v = Dot(d, qv) * inverse;
+  const V3 qv = s.cross(e1);
+  const double v = d.dot(qv) * inverse;
   if (v < 0.0 || u + v > 1.0) return -1.0;
-  const double t = Dot(e2, qv) * inverse;
+  const double t = e2.dot(qv) * inverse;
   return (t >= 0.0 && t <= 1.0) ? t : -1.0;
 }
 
 // Every (t, triangle) crossing of the segment, by brute force, sorted by t.
 std::vector<std::pair<double, uint32_t>> BruteCrossings(const Mesh& m, V3 p0, V3 p1) {
   std::vector<std::pair<double, uint32_t>> hits;
-  const V3 d = Sub(p1, p0);
+  const V3 d = p1 - p0;
   for (size_t t = 0; t < m.triangles.size() / 3; ++t) {
     const double s = SegmentTriangle(p0, d, Corner(m, t, 0), Corner(m, t, 1), Corner(m, t, 2));
     if (s >= 0.0) hits.emplace_back(s, static_cast<uint32_t>(t));
@@ -144,10 +135,8 @@ struct Bounds {
 Bounds BoundsOf(const Mesh& m) {
   Bounds b;
   for (const Float3& f : m.positions) {
-    b.lo = {std::min(b.lo.x, double{f.x}), std::min(b.lo.y, double{f.y}),
-            std::min(b.lo.z, double{f.z})};
-    b.hi = {std::max(b.hi.x, double{f.x}), std::max(b.hi.y, double{f.y}),
-            std::max(b.hi.z, double{f.z})};
+    b.lo = b.lo.cwiseMin(ToV3(f));
+    b.hi = b.hi.cwiseMax(ToV3(f));
   }
   return b;
 }
@@ -155,10 +144,10 @@ Bounds BoundsOf(const Mesh& m) {
 // `count` points uniform in the bounding box inflated by 10 % of its extent on every side.
 std::vector<V3> BoxPoints(const Mesh& m, size_t count, uint64_t seed) {
   const Bounds b = BoundsOf(m);
-  const V3 margin = Scale(Sub(b.hi, b.lo), 0.1);
-  const V3 lo = Sub(b.lo, margin), hi = Add(b.hi, margin);
+  const V3 margin = (b.hi - b.lo) * 0.1;
+  const V3 lo = b.lo - margin, hi = b.hi + margin;
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> x(lo.x, hi.x), y(lo.y, hi.y), z(lo.z, hi.z);
+  std::uniform_real_distribution<double> x(lo.x(), hi.x()), y(lo.y(), hi.y()), z(lo.z(), hi.z());
   std::vector<V3> points(count);
   for (V3& p : points) p = {x(rng), y(rng), z(rng)};
   return points;
@@ -174,17 +163,17 @@ std::vector<V3> NearSurfacePoints(const Mesh& m, size_t count, double offset, ui
   while (points.size() < count) {
     const size_t t = pick(rng);
     const V3 a = Corner(m, t, 0), b = Corner(m, t, 1), c = Corner(m, t, 2);
-    const V3 n = Cross(Sub(b, a), Sub(c, a));
-    if (Norm(n) == 0.0) continue;
+    const V3 n = (b - a).cross(c - a);
+    if (n.norm() == 0.0) continue;
     double u = unit(rng), v = unit(rng);
     if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
-    const V3 on = Add(a, Add(Scale(Sub(b, a), u), Scale(Sub(c, a), v)));
-    points.push_back(Add(on, Scale(n, along(rng) / Norm(n))));
+    const V3 on = a + ((b - a) * u + (c - a) * v);
+    points.push_back(on + n * (along(rng) / n.norm()));
   }
   return points;
 }
 
-const double* Ptr(const V3& v) { return &v.x; }
+const double* Ptr(const V3& v) { return v.data(); }
 
 struct WindingComparison {
   double max_error = 0.0;
@@ -277,7 +266,7 @@ Mesh MakeBumpyPatch() {
 TEST(MeshReference, ExpansionErrorFallsWithTheExpectedPower) {
   const Mesh patch = MakeBumpyPatch();
   const ExactMesh brute(patch.positions, patch.triangles);
-  const V3 direction = Scale(V3{0.3, 0.8, -0.5}, 1.0 / Norm(V3{0.3, 0.8, -0.5}));
+  const V3 direction = V3{0.3, 0.8, -0.5}.normalized();
   double error_at_2m[3] = {0, 0, 0};
   for (int order = 0; order <= 2; ++order) {
     WindingNumberOptions options;
@@ -286,7 +275,7 @@ TEST(MeshReference, ExpansionErrorFallsWithTheExpectedPower) {
     const MeshReference fast(patch.positions, patch.triangles, options);
     double previous_error = 0.0;
     for (double distance : {1.0, 2.0, 4.0, 8.0}) {  // metres; the patch radius is about 0.2 m
-      const V3 q = Add(V3{0.15, 0.1, 0.0}, Scale(direction, distance));
+      const V3 q = V3{0.15, 0.1, 0.0} + (direction * distance);
       const double error = std::fabs(fast.WindingNumber(Ptr(q)) - brute.WindingNumber(Ptr(q)));
       if (distance == 2.0) error_at_2m[order] = error;
       if (previous_error > 0.0) {
@@ -438,11 +427,11 @@ void CheckDistances(const Mesh& mesh, const std::vector<V3>& points) {
     const double off = bake::PointTriangleDistance(point, Ptr(a), Ptr(b), Ptr(c));
     EXPECT_LT(off, 1e-9);
     max_off_triangle = std::max(max_off_triangle, off);
-    const V3 face = Cross(Sub(b, a), Sub(c, a));
+    const V3 face = (b - a).cross(c - a);
     const V3 n{normal[0], normal[1], normal[2]};
-    EXPECT_NEAR(Norm(n), 1.0, 1e-12);
-    EXPECT_NEAR(Dot(n, face) / Norm(face), 1.0, 1e-12) << "the face normal, winding order";
-    EXPECT_NEAR(Norm(Sub(V3{point[0], point[1], point[2]}, p)), reference, 1e-9);
+    EXPECT_NEAR(n.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(n.dot(face) / face.norm(), 1.0, 1e-12) << "the face normal, winding order";
+    EXPECT_NEAR((V3{point[0], point[1], point[2]} - p).norm(), reference, 1e-9);
   }
   std::printf(
       "%zu points: max |distance - brute| %.3g m, max closest point off its triangle %.3g m\n",
@@ -479,16 +468,16 @@ TEST(MeshReference, FirstCrossingMatchesMollerTrumbore) {
   std::mt19937_64 rng(61);
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  auto random_direction = [&] {
+  auto random_direction = [&]() -> V3 {  // a vector, not an expression of the local d
     V3 d{gauss(rng), gauss(rng), gauss(rng)};
-    return Scale(d, 1.0 / Norm(d));
+    return d * (1.0 / d.norm());
   };
   int entries = 0, exits = 0, misses = 0;
   std::vector<double> ts;
   for (int i = 0; i < 300; ++i) {
     // Start outside, inside or far; end anywhere: entries, exits, two crossings and misses.
-    const V3 p0 = Add(centre, Scale(random_direction(), radius * (0.2 + 1.8 * unit(rng))));
-    const V3 p1 = Add(centre, Scale(random_direction(), radius * (0.2 + 1.8 * unit(rng))));
+    const V3 p0 = centre + (random_direction() * (radius * (0.2 + 1.8 * unit(rng))));
+    const V3 p1 = centre + (random_direction() * (radius * (0.2 + 1.8 * unit(rng))));
     const auto expected = BruteCrossings(sphere, p0, p1);
     const SurfaceHit hit = reference.FirstCrossing(Ptr(p0), Ptr(p1));
     reference.Crossings(Ptr(p0), Ptr(p1), &ts);
@@ -504,18 +493,18 @@ TEST(MeshReference, FirstCrossingMatchesMollerTrumbore) {
     }
     EXPECT_NEAR(hit.t, expected.front().first, 1e-9) << "segment " << i;
     EXPECT_EQ(hit.triangle, expected.front().second) << "segment " << i;
-    const V3 d = Sub(p1, p0);
-    const V3 at = Add(p0, Scale(d, hit.t));
-    EXPECT_NEAR(Norm(Sub(V3{hit.point[0], hit.point[1], hit.point[2]}, at)), 0.0, 1e-9);
+    const V3 d = p1 - p0;
+    const V3 at = p0 + (d * hit.t);
+    EXPECT_NEAR((V3{hit.point[0], hit.point[1], hit.point[2]} - at).norm(), 0.0, 1e-9);
     const V3 n{hit.normal[0], hit.normal[1], hit.normal[2]};
-    EXPECT_NEAR(Norm(n), 1.0, 1e-12);
-    const bool starts_inside = Norm(Sub(p0, centre)) < radius * 0.9;
+    EXPECT_NEAR(n.norm(), 1.0, 1e-12);
+    const bool starts_inside = (p0 - centre).norm() < radius * 0.9;
     if (starts_inside) {
       ++exits;
-      EXPECT_GT(Dot(n, d), 0.0) << "leaving an outward-wound surface";
-    } else if (Norm(Sub(p0, centre)) > radius) {
+      EXPECT_GT(n.dot(d), 0.0) << "leaving an outward-wound surface";
+    } else if ((p0 - centre).norm() > radius) {
       ++entries;
-      EXPECT_LT(Dot(n, d), 0.0) << "entering an outward-wound surface";
+      EXPECT_LT(n.dot(d), 0.0) << "entering an outward-wound surface";
     }
   }
   std::printf("first crossing: %d entries, %d exits, %d misses\n", entries, exits, misses);
@@ -530,8 +519,8 @@ TEST(MeshReference, SegmentThroughTheSphereCrossesTwiceEvenThroughVertices) {
   const MeshReference reference(sphere.positions, sphere.triangles);
   std::vector<double> ts;
   // A generic diameter.
-  const V3 d = Scale(V3{0.31, 0.52, 0.79}, 1.0 / Norm(V3{0.31, 0.52, 0.79}));
-  const V3 p0 = Add(centre, Scale(d, -0.5)), p1 = Add(centre, Scale(d, 0.5));
+  const V3 d = V3{0.31, 0.52, 0.79}.normalized();
+  const V3 p0 = centre + (d * -0.5), p1 = centre + (d * 0.5);
   reference.Crossings(Ptr(p0), Ptr(p1), &ts);
   ASSERT_EQ(ts.size(), 2u);
   EXPECT_LT(ts[0], ts[1]);
@@ -539,8 +528,8 @@ TEST(MeshReference, SegmentThroughTheSphereCrossesTwiceEvenThroughVertices) {
   EXPECT_NEAR(ts[1], 0.8, 0.01);
   // Through two antipodal vertices: five or six triangles meet at each, one crossing each side.
   const V3 vertex = ToV3(sphere.positions[0]);
-  const V3 through = Sub(vertex, centre);
-  const V3 q0 = Add(centre, Scale(through, 1.5)), q1 = Add(centre, Scale(through, -1.5));
+  const V3 through = vertex - centre;
+  const V3 q0 = centre + (through * 1.5), q1 = centre + (through * -1.5);
   reference.Crossings(Ptr(q0), Ptr(q1), &ts);
   ASSERT_EQ(ts.size(), 2u) << "one crossing per vertex, however many triangles meet there";
   EXPECT_NEAR(ts[0], 1.0 / 6.0, 1e-6);
