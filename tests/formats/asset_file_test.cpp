@@ -495,27 +495,27 @@ void ExpectMannequinContent(const CharacterAsset& a) {
   EXPECT_FLOAT_EQ(a.info.unit_scale, 1.f);
 }
 
-TEST(GoldenFile, MannequinVersion1LoadsWithExpectedContent) {
-  const std::string path = test::GoldenDir() + "/mannequin_v1.drape";
+// Reads tests/golden/<name>, checking the format version its header declares.
+void ReadGoldenFile(const std::string& name, uint8_t format_version, CharacterAsset* asset) {
+  const std::string path = test::GoldenDir() + "/" + name;
   const std::vector<uint8_t> bytes = ReadBytes(path);
   ASSERT_GT(bytes.size(), kAssetHeaderSize);
-  EXPECT_EQ(bytes[8], 1) << "format version 1";
-  CharacterAsset a;
-  const Status s = ReadAssetFile(path, &a);
+  EXPECT_EQ(bytes[8], format_version) << "format version of " << name;
+  const Status s = ReadAssetFile(path, asset);
   ASSERT_TRUE(s.ok()) << s.message();
+}
+
+TEST(GoldenFile, MannequinVersion1LoadsWithExpectedContent) {
+  CharacterAsset a;
+  ASSERT_NO_FATAL_FAILURE(ReadGoldenFile("mannequin_v1.drape", 1, &a));
   ExpectMannequinContent(a);
 }
 
 // tests/golden/mannequin_v2.json: N = 64, no hulls. Written once by the format version 2 writer;
 // never regenerated (a later format gets a file of its own beside it).
 TEST(GoldenFile, MannequinVersion2LoadsWithExpectedContent) {
-  const std::string path = test::GoldenDir() + "/mannequin_v2.drape";
-  const std::vector<uint8_t> bytes = ReadBytes(path);
-  ASSERT_GT(bytes.size(), kAssetHeaderSize);
-  EXPECT_EQ(bytes[8], 2) << "format version 2";
   CharacterAsset a;
-  const Status s = ReadAssetFile(path, &a);
-  ASSERT_TRUE(s.ok()) << s.message();
+  ASSERT_NO_FATAL_FAILURE(ReadGoldenFile("mannequin_v2.drape", 2, &a));
   ExpectMannequinContent(a);
   ASSERT_EQ(a.body_maps.poses.size(), 1u);
   EXPECT_EQ(a.body_maps.resolution, 64u);
