@@ -55,7 +55,7 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
   }
   *regions = Regions{};
   regions->rigid_threshold = rigid_threshold;
-  regions->shape_threshold = std::min(shape_threshold, rigid_threshold);
+  const float shaping = std::min(shape_threshold, rigid_threshold);  // the effective threshold
   const SkeletonData& skeleton = character.skeleton;
   const MeshData& mesh = character.mesh;
   const uint32_t joints = skeleton.joint_count();
@@ -91,7 +91,7 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
       regions->rigid_vertices[first].push_back(v);
       continue;
     }
-    if (w_first >= regions->shape_threshold) regions->shaping_vertices[first].push_back(v);
+    if (w_first >= shaping) regions->shaping_vertices[first].push_back(v);
     // The joint between the two bones: the descendant carries it.
     int32_t child = first, parent = second;
     if (IsAncestor(skeleton, first, second)) child = second, parent = first;

@@ -20,7 +20,6 @@ struct JointRegion {
 
 struct Regions {
   float rigid_threshold = 0.99f;
-  float shape_threshold = 0.99f;       // effective: min(the config's, rigid_threshold)
   std::vector<Float3> rest_positions;  // the rest-pose skinned mesh
   std::vector<Mat34> rest_skinning;    // per joint: bind -> rest
   std::vector<Mat34> collider_frames;  // per joint: rigid rest-pose joint frame -> asset
