@@ -149,6 +149,7 @@ struct BodyMapWalk {
   float hit_s = 0.f;
   int hit_ci = 0, hit_cj = 0;  // cell of the entry (texel, or half-texel in kBilinear)
   float hit_z = 0.f;           // the surface z (front/back) or the segment's z (side wall)
+  int hit_slot = 0;            // the entered surface (BodyMapCollider::Interval slots)
 
   // Interpolation that is exact at s = 0 and s = 1 and constant when both ends are equal (a
   // segment lying on a texel edge or on a surface stays on it); monotone up to one rounding
@@ -169,6 +170,12 @@ struct BodyMapWalk {
     hit_ci = ci;
     hit_cj = cj;
     hit_z = z;
+    hit_slot = side == kEntryBack ? BodyMapCollider::kBackSlot : BodyMapCollider::kFrontSlot;
+    return true;
+  }
+  bool HitSurface(float s, EntrySide side, int ci, int cj, float z, int slot) {
+    Hit(s, side, ci, cj, z);
+    hit_slot = slot;
     return true;
   }
 
@@ -189,7 +196,11 @@ struct BodyMapWalk {
       inside_prev = false;
       return false;
     }
-    const BodyMapCollider::Slab slab = c.slabs_[static_cast<size_t>(j) * c.width_ + i];
+    const size_t texel = static_cast<size_t>(j) * c.width_ + i;
+    if (c.gap_layers_ != 0 && c.HasGap(texel)) {
+      return VisitTexelWithGaps(texel, ci, cj, s_enter, s_exit);
+    }
+    const BodyMapCollider::Slab slab = c.slabs_[texel];
     const float z_enter = Z(s_enter);
     const float z_exit = Z(s_exit);
     if (z_enter <= slab.top && z_enter >= slab.bottom) {
@@ -209,6 +220,50 @@ struct BodyMapWalk {
       const float r = (slab.bottom - z_enter) / (z_exit - z_enter);
       const float s = std::min(std::max(s_enter + r * (s_exit - s_enter), s_enter), s_exit);
       return Hit(s, kEntryBack, ci, cj, slab.bottom);
+    }
+    inside_prev = false;
+    return false;
+  }
+
+  // A texel with air gaps: its inside set is up to kMaxBodyMapLayers disjoint z intervals, sorted
+  // from the top, and z is linear (monotone) along the piece, so the first entry is into the
+  // next interval in the direction of motion, if the piece reaches it.
+  bool VisitTexelWithGaps(size_t texel, int ci, int cj, float s_enter, float s_exit) {
+    BodyMapCollider::Interval in[kMaxBodyMapLayers];
+    const int count = c.TexelIntervals(texel, in);
+    const float z_enter = Z(s_enter);
+    const float z_exit = Z(s_exit);
+    int at = -1;  // the interval holding z_enter
+    for (int k = 0; k < count; ++k) {
+      if (z_enter <= in[k].top && z_enter >= in[k].bottom) at = k;
+    }
+    if (at >= 0 && !inside_prev) {
+      if (s_enter == 0.f && start_on_z_face) {
+        return z1 < z0 ? HitSurface(s_enter, kEntryFront, ci, cj, in[at].top, in[at].top_slot)
+                       : HitSurface(s_enter, kEntryBack, ci, cj, in[at].bottom, in[at].bottom_slot);
+      }
+      return Hit(s_enter, kEntrySideWall, ci, cj, Z(s_enter));
+    }
+    if (at >= 0 && z_exit <= in[at].top && z_exit >= in[at].bottom) return false;  // stays in
+    // The next interval below (moving down) or above (moving up) the entry point.
+    const auto solve = [&](float surface) {
+      const float r = (surface - z_enter) / (z_exit - z_enter);
+      return std::min(std::max(s_enter + r * (s_exit - s_enter), s_enter), s_exit);
+    };
+    if (z_exit < z_enter) {
+      int next = 0;
+      while (next < count && !(in[next].top < z_enter)) ++next;
+      if (next < count && z_exit <= in[next].top) {
+        return HitSurface(solve(in[next].top), kEntryFront, ci, cj, in[next].top,
+                          in[next].top_slot);
+      }
+    } else if (z_exit > z_enter) {
+      int next = count - 1;
+      while (next >= 0 && !(in[next].bottom > z_enter)) --next;
+      if (next >= 0 && z_exit >= in[next].bottom) {
+        return HitSurface(solve(in[next].bottom), kEntryBack, ci, cj, in[next].bottom,
+                          in[next].bottom_slot);
+      }
     }
     inside_prev = false;
     return false;
@@ -449,6 +504,9 @@ void BodyMapCollider::Clear() {
   normals_.clear();
   bilinear_ok_.clear();
   blocks_.clear();
+  gap_layers_ = 0;
+  gaps_.clear();
+  gap_normals_.clear();
 }
 
 Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
@@ -474,6 +532,10 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   if (sampling != DepthSampling::kNearest && sampling != DepthSampling::kBilinear) {
     return fail("unknown depth sampling");
   }
+  if (pose.layers < 1 || pose.layers > kMaxBodyMapLayers) {
+    return fail("layers = " + std::to_string(pose.layers) + " is outside [1, " +
+                std::to_string(kMaxBodyMapLayers) + "]");
+  }
   if (const std::string problem = CheckBodyMapLayout(pose); !problem.empty()) return fail(problem);
   if (pose.layout != BodyMapLayout::kDense) {
     // Row spans: expand into the dense rectangle (background outside the spans) and build from
@@ -490,6 +552,8 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
     }
   }
   const size_t n = static_cast<size_t>(pose.width) * pose.height;
+  const size_t layers = pose.layers;
+  const size_t values = n * layers;  // per array: every layer's texels, layer-major
   const char* view_name[2] = {"front", "back"};
 
   // Exactly the arrays of the chosen encodings are filled (body_map_data.h).
@@ -498,10 +562,10 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
     size_t depth_f32 = 0, depth_u16 = 0;
     switch (pose.depth_encoding) {
       case DepthEncoding::kFloat32:
-        depth_f32 = n;
+        depth_f32 = values;
         break;
       case DepthEncoding::kUnorm16:
-        depth_u16 = n;
+        depth_u16 = values;
         break;
       default:
         return fail("unknown depth encoding");
@@ -510,18 +574,19 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
       return fail(name + " depth arrays hold " + std::to_string(pose.depth_f32[view].size()) +
                   " float32 / " + std::to_string(pose.depth_u16[view].size()) +
                   " unorm16 values, expected " + std::to_string(depth_f32) + " / " +
-                  std::to_string(depth_u16) + " for width*height=" + std::to_string(n));
+                  std::to_string(depth_u16) + " for width*height=" + std::to_string(n) + " and " +
+                  std::to_string(layers) + " layer(s)");
     }
     size_t normal_f32 = 0, normal_oct16 = 0, normal_rgb8 = 0;
     switch (pose.normal_encoding) {
       case NormalEncoding::kFloat32:
-        normal_f32 = 3 * n;
+        normal_f32 = 3 * values;
         break;
       case NormalEncoding::kOct16:
-        normal_oct16 = 2 * n;
+        normal_oct16 = 2 * values;
         break;
       case NormalEncoding::kRgb8:
-        normal_rgb8 = 3 * n;
+        normal_rgb8 = 3 * values;
         break;
       default:
         return fail("unknown normal encoding");
@@ -541,23 +606,64 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   normals_.resize(n);
   const float depth_range = pose.depth_range;
   const float back_plane_z = pose.front_z - pose.depth_range;
+  // Depth of array entry `index` of one view: false (and a failure message) for a corrupt value.
+  std::string problem;
+  const auto where = [&](int view, size_t index) {
+    const size_t layer = index / n, k = index % n;
+    return std::string(view_name[view]) +
+           (layer == 0 ? "" : " gap layer " + std::to_string(layer)) + " at texel " +
+           std::to_string(k);
+  };
+  const auto read_depth = [&](int view, size_t index, float* depth, bool* valid) {
+    if (pose.depth_encoding == DepthEncoding::kFloat32) {
+      const float d = pose.depth_f32[view][index];
+      if (std::isnan(d) || d < 0.f) {
+        problem = where(view, index) + ": depth is NaN or negative";
+        return false;
+      }
+      *valid = d < depth_range;  // +inf and >= depth_range are background
+      *depth = d;
+    } else {
+      const uint16_t q = pose.depth_u16[view][index];
+      *valid = q != 65535;
+      *depth = static_cast<float>(q) / 65535.f * depth_range;
+    }
+    return true;
+  };
+  // Normals are kept as oct16 whatever the input encoding.
+  const auto read_normal = [&](int view, size_t index, uint16_t oct[2]) {
+    const Float3 view_fallback{0.f, 0.f, view == 0 ? 1.f : -1.f};
+    if (pose.normal_encoding == NormalEncoding::kOct16) {
+      oct[0] = pose.normal_oct16[view][2 * index];
+      oct[1] = pose.normal_oct16[view][2 * index + 1];
+      return true;
+    }
+    Float3 normal;
+    if (pose.normal_encoding == NormalEncoding::kFloat32) {
+      const float* f = &pose.normal_f32[view][3 * index];
+      normal = {f[0], f[1], f[2]};
+      if (!IsFinite(normal)) {
+        problem = where(view, index) + ": normal is not finite";
+        return false;
+      }
+      normal = NormalizeOr(normal, view_fallback);
+    } else {
+      const uint8_t* c = &pose.normal_rgb8[view][3 * index];
+      const Float3 raw{static_cast<float>(c[0]) / 255.f * 2.f - 1.f,
+                       static_cast<float>(c[1]) / 255.f * 2.f - 1.f,
+                       static_cast<float>(c[2]) / 255.f * 2.f - 1.f};
+      normal = NormalizeOr(raw, view_fallback);
+    }
+    const std::array<uint16_t, 2> q = EncodeOct16(normal);
+    oct[0] = q[0];
+    oct[1] = q[1];
+    return true;
+  };
   for (size_t k = 0; k < n; ++k) {
     float depth[2];
     bool valid[2];
     for (int view = 0; view < 2; ++view) {
-      if (pose.depth_encoding == DepthEncoding::kFloat32) {
-        const float d = pose.depth_f32[view][k];
-        if (std::isnan(d) || d < 0.f) {
-          return fail(std::string(view_name[view]) + " depth at texel " + std::to_string(k) +
-                      " is NaN or negative");
-        }
-        valid[view] = d < depth_range;  // +inf and >= depth_range are background
-        depth[view] = d;
-      } else {
-        const uint16_t q = pose.depth_u16[view][k];
-        valid[view] = q != 65535;
-        depth[view] = static_cast<float>(q) / 65535.f * depth_range;
-      }
+      if (!read_depth(view, k, &depth[view], &valid[view])) return fail(problem);
     }
     Slab slab{-kInf, kInf};
     if (valid[0] && valid[1]) {
@@ -572,35 +678,52 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
       ++stats_.one_sided_texels;  // notes/algorithms.md §5.1 step 5b: treated as background
     }
     slabs_[k] = slab;
+    if (!read_normal(0, k, normals_[k].front) || !read_normal(1, k, normals_[k].back)) {
+      return fail(problem);
+    }
+  }
 
-    TexelNormals& out = normals_[k];
-    for (int view = 0; view < 2; ++view) {
-      uint16_t* oct = view == 0 ? out.front : out.back;
-      const Float3 view_fallback{0.f, 0.f, view == 0 ? 1.f : -1.f};
-      if (pose.normal_encoding == NormalEncoding::kOct16) {
-        oct[0] = pose.normal_oct16[view][2 * k];
-        oct[1] = pose.normal_oct16[view][2 * k + 1];
+  // Gap layers: each gap must sit strictly inside the interval above it, so that the texel's
+  // inside set is a sorted list of disjoint intervals (the walk relies on it).
+  gap_layers_ = static_cast<uint32_t>(layers - 1);
+  if (gap_layers_ > 0) {
+    gaps_.assign(n * gap_layers_, Slab{-kInf, kInf});
+    gap_normals_.assign(n * gap_layers_, TexelNormals{});
+  }
+  for (size_t k = 0; k < n && gap_layers_ > 0; ++k) {
+    float floor_z = slabs_[k].top;  // the gap must lie below this (the previous interval's top)
+    bool absent_before = false;
+    for (size_t g = 0; g < gap_layers_; ++g) {
+      const size_t index = (g + 1) * n + k;
+      float depth[2];
+      bool valid[2];
+      for (int view = 0; view < 2; ++view) {
+        if (!read_depth(view, index, &depth[view], &valid[view])) return fail(problem);
+      }
+      if (!valid[0] && !valid[1]) {
+        absent_before = true;
         continue;
       }
-      Float3 normal;
-      if (pose.normal_encoding == NormalEncoding::kFloat32) {
-        const float* f = &pose.normal_f32[view][3 * k];
-        normal = {f[0], f[1], f[2]};
-        if (!IsFinite(normal)) {
-          return fail(std::string(view_name[view]) + " normal at texel " + std::to_string(k) +
-                      " is not finite");
-        }
-        normal = NormalizeOr(normal, view_fallback);
-      } else {
-        const uint8_t* c = &pose.normal_rgb8[view][3 * k];
-        const Float3 raw{static_cast<float>(c[0]) / 255.f * 2.f - 1.f,
-                         static_cast<float>(c[1]) / 255.f * 2.f - 1.f,
-                         static_cast<float>(c[2]) / 255.f * 2.f - 1.f};
-        normal = NormalizeOr(raw, view_fallback);
+      const float upper = pose.front_z - depth[0];
+      const float lower = back_plane_z + depth[1];
+      const Slab& slab = slabs_[k];
+      const char* reason = nullptr;
+      if (valid[0] != valid[1]) {
+        reason = "has only one of its two boundaries";
+      } else if (!(slab.top >= slab.bottom)) {
+        reason = "lies on a background texel";
+      } else if (absent_before) {
+        reason = "follows an absent gap (gaps are filled in order)";
+      } else if (!(floor_z > upper && upper > lower && lower > slab.bottom)) {
+        reason = "is not strictly inside the slab below the previous gap";
       }
-      const std::array<uint16_t, 2> q = EncodeOct16(normal);
-      oct[0] = q[0];
-      oct[1] = q[1];
+      if (reason != nullptr) return fail(where(0, index) + ": the gap " + reason);
+      gaps_[k * gap_layers_ + g] = {upper, lower};
+      floor_z = lower;
+      TexelNormals& normals = gap_normals_[k * gap_layers_ + g];
+      if (!read_normal(0, index, normals.front) || !read_normal(1, index, normals.back)) {
+        return fail(problem);
+      }
     }
   }
 
@@ -638,6 +761,8 @@ void BodyMapCollider::Finish() {
     }
   }
   stats_.valid_texels = valid;
+  stats_.gap_texels = 0;
+  for (size_t k = 0; k < w * h && gap_layers_ > 0; ++k) stats_.gap_texels += HasGap(k) ? 1u : 0u;
   const double s = texel_size_;
   if (valid == 0) {
     bounds_min_ = {1.f, 1.f, 1.f};
@@ -671,7 +796,10 @@ void BodyMapCollider::Finish() {
         const Slab q[4] = {slabs_[j * w + i], slabs_[j * w + i + 1], slabs_[(j + 1) * w + i],
                            slabs_[(j + 1) * w + i + 1]};
         float top_lo = kInf, top_hi = -kInf, bottom_lo = kInf, bottom_hi = -kInf;
-        bool all_valid = true;
+        // Texels with air gaps stay nearest: their inside set is not one slab to interpolate.
+        bool all_valid =
+            gap_layers_ == 0 || !(HasGap(j * w + i) || HasGap(j * w + i + 1) ||
+                                  HasGap((j + 1) * w + i) || HasGap((j + 1) * w + i + 1));
         for (const Slab& c : q) {
           all_valid = all_valid && c.top >= c.bottom;
           top_lo = std::min(top_lo, c.top);
@@ -719,9 +847,58 @@ void BodyMapCollider::Finish() {
 }
 
 size_t BodyMapCollider::memory_bytes() const {
-  return sizeof(*this) + slabs_.capacity() * sizeof(Slab) +
-         normals_.capacity() * sizeof(TexelNormals) + bilinear_ok_.capacity() +
-         blocks_.capacity() * sizeof(BlockBounds);
+  return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
+         (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
+         bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds);
+}
+
+uint32_t BodyMapCollider::TexelGaps(uint32_t i, uint32_t j, float* upper, float* lower) const {
+  if (i >= width_ || j >= height_ || gap_layers_ == 0) return 0;
+  const Slab* gaps = gaps_.data() + (static_cast<size_t>(j) * width_ + i) * gap_layers_;
+  uint32_t count = 0;
+  for (; count < gap_layers_ && gaps[count].top > gaps[count].bottom; ++count) {
+    upper[count] = gaps[count].top;
+    lower[count] = gaps[count].bottom;
+  }
+  return count;
+}
+
+int BodyMapCollider::TexelIntervals(size_t texel, Interval* intervals) const {
+  const Slab& slab = slabs_[texel];
+  if (!(slab.top >= slab.bottom)) return 0;
+  int count = 0;
+  intervals[0] = {slab.top, slab.bottom, kFrontSlot, kBackSlot};
+  const Slab* gaps = gaps_.data() + texel * gap_layers_;
+  for (uint32_t g = 0; g < gap_layers_ && gaps[g].top > gaps[g].bottom; ++g) {
+    // Gap g splits the last interval: its upper boundary ends it, its lower one starts the next.
+    const int slot = 2 + 2 * static_cast<int>(g);
+    intervals[count].bottom = gaps[g].top;
+    intervals[count].bottom_slot = slot;
+    ++count;
+    intervals[count] = {gaps[g].bottom, slab.bottom, slot + 1, kBackSlot};
+  }
+  return count + 1;
+}
+
+BodyMapCollider::Interval BodyMapCollider::IntervalAt(size_t texel, float z) const {
+  const Slab& slab = slabs_[texel];
+  if (gap_layers_ == 0 || !HasGap(texel)) return {slab.top, slab.bottom, kFrontSlot, kBackSlot};
+  Interval intervals[kMaxBodyMapLayers];
+  const int count = TexelIntervals(texel, intervals);
+  for (int k = 0; k < count; ++k) {
+    if (z <= intervals[k].top && z >= intervals[k].bottom) return intervals[k];
+  }
+  return {slab.top, slab.bottom, kFrontSlot, kBackSlot};
+}
+
+Float3 BodyMapCollider::SlotNormal(size_t texel, int slot) const {
+  if (slot < 2) {
+    const uint16_t* q = slot == kBackSlot ? normals_[texel].back : normals_[texel].front;
+    return DecodeOct16(q[0], q[1]);
+  }
+  const TexelNormals& n = gap_normals_[texel * gap_layers_ + static_cast<size_t>((slot - 2) / 2)];
+  const uint16_t* q = slot % 2 == 1 ? n.back : n.front;
+  return DecodeOct16(q[0], q[1]);
 }
 
 bool BodyMapCollider::TexelSlab(uint32_t i, uint32_t j, float* top, float* bottom) const {
@@ -797,7 +974,10 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
   const int ci = static_cast<int>(u * 2.f), cj = static_cast<int>(v * 2.f);
   float top, bottom;
   SampleSlab(ci, cj, u, v, &top, &bottom);
-  return p.z <= top && p.z >= bottom;
+  // A texel with gaps is never part of a bilinear block: its nearest slab minus its gaps.
+  return p.z <= top && p.z >= bottom &&
+         !(gap_layers_ != 0 &&
+           InGap(static_cast<size_t>(cj >> 1) * width_ + static_cast<size_t>(ci >> 1), p.z));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -822,6 +1002,7 @@ bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& 
   // On a valid texel x and y lie in the clip box; the general path clips nothing only when z
   // does too, and then its walk is one visit of this texel over s in [0, 1], which is below.
   if (!(slab.top >= slab.bottom)) return true;
+  if (gap_layers_ != 0 && HasGap(texel)) return false;  // the walk solves the intervals
   if (!(z0 >= clip_lo_[2] && z0 <= clip_hi_[2] && z1 >= clip_lo_[2] && z1 <= clip_hi_[2])) {
     return false;
   }
@@ -992,31 +1173,41 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
     walk.Run<2>();
   }
 
-  // Penetration of p1 along z (the start-inside push-out uses the same numbers).
-  float p1_top = 0.f, p1_bottom = 0.f;
-  int p1_ci = 0, p1_cj = 0;
-  if (result.inside_end) {
-    const float u = (p1.x - origin_x_) * inv_texel_size_;
-    const float v = (p1.y - origin_y_) * inv_texel_size_;
+  // The z interval of the inside set around z in walk cell (ci, cj), with its surfaces: the
+  // bilinear patch in an eligible block, else the texel's interval (gaps split the slab).
+  const auto interval_at = [&](int ci, int cj, float u, float v, float z) {
     if (sampling_ == DepthSampling::kNearest) {
-      p1_ci = static_cast<int>(u);
-      p1_cj = static_cast<int>(v);
-      const Slab& s = slabs_[static_cast<size_t>(p1_cj) * width_ + static_cast<size_t>(p1_ci)];
-      p1_top = s.top;
-      p1_bottom = s.bottom;
-    } else {
-      p1_ci = static_cast<int>(u * 2.f);
-      p1_cj = static_cast<int>(v * 2.f);
-      SampleSlab(p1_ci, p1_cj, u, v, &p1_top, &p1_bottom);
+      return IntervalAt(static_cast<size_t>(cj) * width_ + static_cast<size_t>(ci), z);
     }
-    result.depth = std::min(p1_top - p1.z, p1.z - p1_bottom);
-  }
-  const auto normal_at = [&](int ci, int cj, float u, float v, bool back) {
-    if (sampling_ == DepthSampling::kNearest) {
-      return TexelNormal(static_cast<uint32_t>(ci), static_cast<uint32_t>(cj), back);
+    if (!BilinearBlock((ci - 1) >> 1, (cj - 1) >> 1)) {
+      return IntervalAt(static_cast<size_t>(cj >> 1) * width_ + static_cast<size_t>(ci >> 1), z);
     }
-    return SampleNormal(ci, cj, u, v, back);
+    Interval patch{0.f, 0.f, kFrontSlot, kBackSlot};
+    SampleSlab(ci, cj, u, v, &patch.top, &patch.bottom);
+    return patch;
   };
+  const auto normal_at = [&](int ci, int cj, float u, float v, int slot) {
+    if (sampling_ == DepthSampling::kNearest) {
+      return SlotNormal(static_cast<size_t>(cj) * width_ + static_cast<size_t>(ci), slot);
+    }
+    if (slot >= 2) {  // a gap's boundary: its texel has no bilinear block
+      return SlotNormal(static_cast<size_t>(cj >> 1) * width_ + static_cast<size_t>(ci >> 1), slot);
+    }
+    return SampleNormal(ci, cj, u, v, slot == kBackSlot);
+  };
+
+  // Penetration of p1 along z (the start-inside push-out uses the same numbers).
+  Interval p1_interval{0.f, 0.f, kFrontSlot, kBackSlot};
+  int p1_ci = 0, p1_cj = 0;
+  const float p1_u = (p1.x - origin_x_) * inv_texel_size_;
+  const float p1_v = (p1.y - origin_y_) * inv_texel_size_;
+  if (result.inside_end) {
+    const float cells = sampling_ == DepthSampling::kNearest ? 1.f : 2.f;
+    p1_ci = static_cast<int>(p1_u * cells);
+    p1_cj = static_cast<int>(p1_v * cells);
+    p1_interval = interval_at(p1_ci, p1_cj, p1_u, p1_v, p1.z);
+    result.depth = std::min(p1_interval.top - p1.z, p1.z - p1_interval.bottom);
+  }
 
   if (walk.hit) {
     const float s = walk.hit_s;
@@ -1026,21 +1217,13 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
     result.point =
         Float3{BodyMapWalk::Along(q0.x, q1.x, s), BodyMapWalk::Along(q0.y, q1.y, s), walk.hit_z};
     const float u = walk.U(s), v = walk.V(s);
-    bool back = walk.hit_side == kEntryBack;
+    int slot = walk.hit_slot;
     if (walk.hit_side == kEntrySideWall) {
       result.flags = kCollisionSideWall;
       // The wall's own normal would be horizontal; the texel's surface normal from the map
       // whose surface is nearer in z describes the body better (notes/algorithms.md §5.1 step 3).
-      float top, bottom;
-      if (sampling_ == DepthSampling::kNearest) {
-        const Slab& c =
-            slabs_[static_cast<size_t>(walk.hit_cj) * width_ + static_cast<size_t>(walk.hit_ci)];
-        top = c.top;
-        bottom = c.bottom;
-      } else {
-        SampleSlab(walk.hit_ci, walk.hit_cj, u, v, &top, &bottom);
-      }
-      back = walk.hit_z - bottom < top - walk.hit_z;
+      const Interval wall = interval_at(walk.hit_ci, walk.hit_cj, u, v, walk.hit_z);
+      slot = walk.hit_z - wall.bottom < wall.top - walk.hit_z ? wall.bottom_slot : wall.top_slot;
       // The wall point belongs to the entered texel, whose slab contains it: a particle put there
       // (plus separation along the mostly-z map normal) would still test inside. Step back across
       // the wall by a thousandth of a texel, into the texel the segment came from.
@@ -1052,20 +1235,19 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
         result.point.y -= dy * back_off;
       }
     }
-    result.normal = normal_at(walk.hit_ci, walk.hit_cj, u, v, back);
+    result.normal = normal_at(walk.hit_ci, walk.hit_cj, u, v, slot);
     return;
   }
   if (result.inside_end) {
     // Started inside and never left (or, defensively, any inside end the walk did not explain):
-    // push p1 out along z to the nearer surface.
-    const bool back = p1.z - p1_bottom < p1_top - p1.z;
+    // push p1 out along z to the nearer surface of its interval.
+    const bool back = p1.z - p1_interval.bottom < p1_interval.top - p1.z;
     result.contact = true;
     result.t = 0.f;
     result.flags = start_inside ? kCollisionStartedInside : kCollisionNone;
-    result.point = Float3{p1.x, p1.y, back ? p1_bottom : p1_top};
-    const float u = (p1.x - origin_x_) * inv_texel_size_;
-    const float v = (p1.y - origin_y_) * inv_texel_size_;
-    result.normal = normal_at(p1_ci, p1_cj, u, v, back);
+    result.point = Float3{p1.x, p1.y, back ? p1_interval.bottom : p1_interval.top};
+    result.normal =
+        normal_at(p1_ci, p1_cj, p1_u, p1_v, back ? p1_interval.bottom_slot : p1_interval.top_slot);
   }
 }
 
@@ -1141,7 +1323,7 @@ Status BodyMapCollider::InsideBatch(std::span<const Float3> points,
                       " points but " + std::to_string(inside.size()) + " result slots");
   }
   const int64_t count = static_cast<int64_t>(points.size());
-  if (sampling_ != DepthSampling::kNearest) {
+  if (sampling_ != DepthSampling::kNearest || gap_layers_ != 0) {
 #pragma omp parallel for schedule(static) if (count > 16384)
     for (int64_t k = 0; k < count; ++k) inside[k] = IsInside(points[k]) ? 1 : 0;
     return Status::Ok();
@@ -1168,7 +1350,7 @@ namespace {
 bool SameGrid(const BodyMapCollider& a, const BodyMapCollider& b) {
   return a.width() == b.width() && a.height() == b.height() && a.origin_x() == b.origin_x() &&
          a.origin_y() == b.origin_y() && a.texel_size() == b.texel_size() &&
-         a.sampling() == b.sampling();
+         a.sampling() == b.sampling() && a.layers() == b.layers();
 }
 
 }  // namespace
@@ -1244,6 +1426,10 @@ const BodyMapCollider& BodyMapSequence::At(float time, BodyMapCollider* scratch)
   out.stats_ = nearer.stats_;
   out.slabs_.resize(n);  // allocates only when the scratch has never held this grid size
   out.normals_.resize(n);
+  const size_t gap_layers = a.gap_layers_;
+  out.gap_layers_ = a.gap_layers_;
+  out.gaps_.resize(n * gap_layers);
+  out.gap_normals_.resize(n * gap_layers);
   const int64_t count = static_cast<int64_t>(n);
 #pragma omp parallel for schedule(static) if (count > 65536)
   for (int64_t k = 0; k < count; ++k) {
@@ -1259,6 +1445,25 @@ const BodyMapCollider& BodyMapSequence::At(float time, BodyMapCollider* scratch)
     }
     out.slabs_[k] = slab;
     out.normals_[k] = nearer.normals_[k];
+    // Gaps: blended where both poses have them (a convex combination keeps the strict order
+    // top > upper > lower > ... > bottom), else taken with the slab from the one pose it came
+    // from. The first gap one pose lacks ends the list: fewer gaps only means more inside.
+    const size_t first = static_cast<size_t>(k) * gap_layers;
+    bool more = slab.top >= slab.bottom;  // background has no gaps
+    for (size_t g = 0; g < gap_layers; ++g) {
+      const BodyMapCollider::Slab ga = a.gaps_[first + g], gb = b.gaps_[first + g];
+      BodyMapCollider::Slab gap{-kInf, kInf};
+      if (more && valid_a && valid_b) {
+        if (ga.top > ga.bottom && gb.top > gb.bottom) {
+          gap = {(1.f - w) * ga.top + w * gb.top, (1.f - w) * ga.bottom + w * gb.bottom};
+        }
+      } else if (more) {
+        gap = a_nearer ? ga : gb;
+      }
+      more = more && gap.top > gap.bottom;
+      out.gaps_[first + g] = more ? gap : BodyMapCollider::Slab{-kInf, kInf};
+      out.gap_normals_[first + g] = nearer.gap_normals_[first + g];
+    }
   }
   out.Finish();
   return out;

@@ -59,10 +59,9 @@ struct GridSpec {
   float depth_range = 1.f;
 };
 
-// Fills a pose by evaluating the surface at every texel centre, in the requested encodings.
-BodyMapPose MakePose(const GridSpec& g, const SurfaceFn& surface,
-                     DepthEncoding depth_encoding = DepthEncoding::kFloat32,
-                     NormalEncoding normal_encoding = NormalEncoding::kFloat32) {
+// An empty pose of the grid with its arrays sized for `layers` layers in the given encodings.
+BodyMapPose EmptyPose(const GridSpec& g, DepthEncoding depth_encoding,
+                      NormalEncoding normal_encoding, uint8_t layers = 1) {
   BodyMapPose pose;
   pose.width = g.width;
   pose.height = g.height;
@@ -73,7 +72,8 @@ BodyMapPose MakePose(const GridSpec& g, const SurfaceFn& surface,
   pose.depth_range = g.depth_range;
   pose.depth_encoding = depth_encoding;
   pose.normal_encoding = normal_encoding;
-  const size_t n = static_cast<size_t>(g.width) * g.height;
+  pose.layers = layers;
+  const size_t n = static_cast<size_t>(g.width) * g.height * layers;
   for (int view = 0; view < 2; ++view) {
     if (depth_encoding == DepthEncoding::kFloat32) pose.depth_f32[view].resize(n);
     if (depth_encoding == DepthEncoding::kUnorm16) pose.depth_u16[view].resize(n);
@@ -81,6 +81,43 @@ BodyMapPose MakePose(const GridSpec& g, const SurfaceFn& surface,
     if (normal_encoding == NormalEncoding::kOct16) pose.normal_oct16[view].resize(2 * n);
     if (normal_encoding == NormalEncoding::kRgb8) pose.normal_rgb8[view].resize(3 * n);
   }
+  return pose;
+}
+
+// Writes array entry `index` of one view: the depth (metres from that view's plane) and normal
+// of a surface, or background when !valid.
+void PutSurface(BodyMapPose& pose, size_t index, int view, bool valid, double depth,
+                Float3 normal) {
+  if (pose.depth_encoding == DepthEncoding::kFloat32) {
+    pose.depth_f32[view][index] = valid ? static_cast<float>(depth) : pose.depth_range;
+  } else {
+    const double q = std::round(depth / pose.depth_range * 65535.0);
+    pose.depth_u16[view][index] =
+        valid ? static_cast<uint16_t>(std::clamp(q, 0.0, 65534.0)) : uint16_t{65535};
+  }
+  const Float3 nv = valid ? normal : Float3{};
+  if (pose.normal_encoding == NormalEncoding::kFloat32) {
+    pose.normal_f32[view][3 * index] = nv.x;
+    pose.normal_f32[view][3 * index + 1] = nv.y;
+    pose.normal_f32[view][3 * index + 2] = nv.z;
+  } else if (pose.normal_encoding == NormalEncoding::kOct16) {
+    const std::array<uint16_t, 2> q = EncodeOct16(nv);
+    pose.normal_oct16[view][2 * index] = q[0];
+    pose.normal_oct16[view][2 * index + 1] = q[1];
+  } else {
+    const float c[3] = {nv.x, nv.y, nv.z};
+    for (int a = 0; a < 3; ++a) {
+      pose.normal_rgb8[view][3 * index + a] =
+          static_cast<uint8_t>(std::lround((c[a] * 0.5f + 0.5f) * 255.f));
+    }
+  }
+}
+
+// Fills a pose by evaluating the surface at every texel centre, in the requested encodings.
+BodyMapPose MakePose(const GridSpec& g, const SurfaceFn& surface,
+                     DepthEncoding depth_encoding = DepthEncoding::kFloat32,
+                     NormalEncoding normal_encoding = NormalEncoding::kFloat32) {
+  BodyMapPose pose = EmptyPose(g, depth_encoding, normal_encoding);
   const double back_plane = static_cast<double>(g.front_z) - g.depth_range;
   for (uint32_t j = 0; j < g.height; ++j) {
     for (uint32_t i = 0; i < g.width; ++i) {
@@ -88,33 +125,8 @@ BodyMapPose MakePose(const GridSpec& g, const SurfaceFn& surface,
       const double x = g.origin_x + (i + 0.5) * g.texel;
       const double y = g.origin_y + (j + 0.5) * g.texel;
       const SurfaceSample s = surface(x, y);
-      const double depth[2] = {g.front_z - s.top, s.bottom - back_plane};
-      const Float3 normal[2] = {s.front_normal, s.back_normal};
-      for (int view = 0; view < 2; ++view) {
-        if (depth_encoding == DepthEncoding::kFloat32) {
-          pose.depth_f32[view][k] = s.valid ? static_cast<float>(depth[view]) : g.depth_range;
-        } else {
-          const double q = std::round(depth[view] / g.depth_range * 65535.0);
-          pose.depth_u16[view][k] =
-              s.valid ? static_cast<uint16_t>(std::clamp(q, 0.0, 65534.0)) : uint16_t{65535};
-        }
-        const Float3 nv = s.valid ? normal[view] : Float3{};
-        if (normal_encoding == NormalEncoding::kFloat32) {
-          pose.normal_f32[view][3 * k] = nv.x;
-          pose.normal_f32[view][3 * k + 1] = nv.y;
-          pose.normal_f32[view][3 * k + 2] = nv.z;
-        } else if (normal_encoding == NormalEncoding::kOct16) {
-          const std::array<uint16_t, 2> q = EncodeOct16(nv);
-          pose.normal_oct16[view][2 * k] = q[0];
-          pose.normal_oct16[view][2 * k + 1] = q[1];
-        } else {
-          const float c[3] = {nv.x, nv.y, nv.z};
-          for (int a = 0; a < 3; ++a) {
-            pose.normal_rgb8[view][3 * k + a] =
-                static_cast<uint8_t>(std::lround((c[a] * 0.5f + 0.5f) * 255.f));
-          }
-        }
-      }
+      PutSurface(pose, k, 0, s.valid, g.front_z - s.top, s.front_normal);
+      PutSurface(pose, k, 1, s.valid, s.bottom - back_plane, s.back_normal);
     }
   }
   return pose;
@@ -195,34 +207,41 @@ double AngleDegrees(Float3 a, Float3 b) {
 }
 
 // Exact first entry of p0 -> p1 into the union of the collider's texel columns
-// [x_i, x_i + s] x [y_j, y_j + s] x [bottom, top] (nearest sampling), by brute force in double
-// over every texel. Returns -1 when the segment misses all of them.
+// [x_i, x_i + s] x [y_j, y_j + s] x [bottom, top] (nearest sampling; one column per interval
+// when the texel has air gaps), by brute force in double over every texel. Returns -1 when the
+// segment misses all of them.
 double ReferenceFirstEntry(const BodyMapCollider& c, Float3 p0, Float3 p1) {
   double best = -1.0;
   const double s = c.texel_size();
   for (uint32_t j = 0; j < c.height(); ++j) {
     for (uint32_t i = 0; i < c.width(); ++i) {
-      float top, bottom;
+      float top, bottom, upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
       if (!c.TexelSlab(i, j, &top, &bottom)) continue;
-      const double lo[3] = {c.origin_x() + i * s, c.origin_y() + j * s, bottom};
-      const double hi[3] = {c.origin_x() + (i + 1) * s, c.origin_y() + (j + 1) * s, top};
-      const double a[3] = {p0.x, p0.y, p0.z};
-      const double d[3] = {static_cast<double>(p1.x) - p0.x, static_cast<double>(p1.y) - p0.y,
-                           static_cast<double>(p1.z) - p0.z};
-      double t0 = 0.0, t1 = 1.0;
-      bool miss = false;
-      for (int k = 0; k < 3 && !miss; ++k) {
-        if (d[k] == 0.0) {
-          miss = a[k] < lo[k] || a[k] > hi[k];
-          continue;
+      // The texel's inside intervals: the slab split by its air gaps.
+      const uint32_t gaps = c.TexelGaps(i, j, upper, lower);
+      for (uint32_t interval = 0; interval <= gaps; ++interval) {
+        const double lo[3] = {c.origin_x() + i * s, c.origin_y() + j * s,
+                              interval == gaps ? bottom : upper[interval]};
+        const double hi[3] = {c.origin_x() + (i + 1) * s, c.origin_y() + (j + 1) * s,
+                              interval == 0 ? top : lower[interval - 1]};
+        const double a[3] = {p0.x, p0.y, p0.z};
+        const double d[3] = {static_cast<double>(p1.x) - p0.x, static_cast<double>(p1.y) - p0.y,
+                             static_cast<double>(p1.z) - p0.z};
+        double t0 = 0.0, t1 = 1.0;
+        bool miss = false;
+        for (int k = 0; k < 3 && !miss; ++k) {
+          if (d[k] == 0.0) {
+            miss = a[k] < lo[k] || a[k] > hi[k];
+            continue;
+          }
+          double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
+          if (ta > tb) std::swap(ta, tb);
+          t0 = std::max(t0, ta);
+          t1 = std::min(t1, tb);
+          miss = t0 > t1;
         }
-        double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-        miss = t0 > t1;
+        if (!miss && (best < 0.0 || t0 < best)) best = t0;
       }
-      if (!miss && (best < 0.0 || t0 < best)) best = t0;
     }
   }
   return best;
@@ -1100,4 +1119,332 @@ TEST(BodyMapSequence, NearestAndBracketingPoses) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Air gaps (BodyMapPose::layers > 1): a plate held in front of a block, and a second, smaller
+// plate between them on one side, so texels have zero, one or two gaps.
+
+namespace {
+
+struct ZBox {
+  float x_lo, x_hi, y_lo, y_hi, z_lo, z_hi;  // metres
+};
+// Edges on texel boundaries (multiples of 1/128 m), so every texel centre is clearly in or out.
+constexpr ZBox kBlock{-30 * kTexel, 30 * kTexel, -30 * kTexel, 30 * kTexel, -0.10f, 0.05f};
+constexpr ZBox kPlate{-20 * kTexel, 20 * kTexel, -20 * kTexel, 20 * kTexel, 0.10f, 0.12f};
+constexpr ZBox kMidPlate{0.f, 10 * kTexel, -10 * kTexel, 10 * kTexel, 0.065f, 0.075f};
+// Distinct gap-boundary normals, so a test can tell which array an answer read.
+const Float3 kGapUpperNormal = NormalizeOr(Float3{0.3f, 0.f, -1.f}, Float3{});
+const Float3 kGapLowerNormal = NormalizeOr(Float3{0.f, 0.3f, 1.f}, Float3{});
+
+// The boxes' z intervals at every texel centre: slab = their hull, gaps = the air between them;
+// at most layers - 1 gaps are kept, the widest (as the bake keeps them), in order from the top.
+BodyMapPose LayeredPose(uint8_t layers, const std::vector<ZBox>& boxes,
+                        DepthEncoding depth_encoding = DepthEncoding::kFloat32,
+                        NormalEncoding normal_encoding = NormalEncoding::kFloat32) {
+  const GridSpec g = SphereGrid();
+  BodyMapPose pose = EmptyPose(g, depth_encoding, normal_encoding, layers);
+  const size_t n = static_cast<size_t>(g.width) * g.height;
+  const double back_plane = static_cast<double>(g.front_z) - g.depth_range;
+  for (uint32_t j = 0; j < g.height; ++j) {
+    for (uint32_t i = 0; i < g.width; ++i) {
+      const size_t k = static_cast<size_t>(j) * g.width + i;
+      const double x = g.origin_x + (i + 0.5) * g.texel;
+      const double y = g.origin_y + (j + 0.5) * g.texel;
+      std::vector<std::pair<float, float>> spans;  // (top, bottom), disjoint by construction
+      for (const ZBox& b : boxes) {
+        if (x > b.x_lo && x < b.x_hi && y > b.y_lo && y < b.y_hi) spans.push_back({b.z_hi, b.z_lo});
+      }
+      std::sort(spans.begin(), spans.end(), std::greater<>());
+      std::vector<std::pair<float, float>> gaps;  // (upper, lower)
+      for (size_t s = 1; s < spans.size(); ++s)
+        gaps.push_back({spans[s - 1].second, spans[s].first});
+      std::stable_sort(gaps.begin(), gaps.end(), [](const auto& a, const auto& b) {
+        return a.first - a.second > b.first - b.second;
+      });
+      if (gaps.size() > layers - 1u) gaps.resize(layers - 1u);
+      std::sort(gaps.begin(), gaps.end(), std::greater<>());
+      const bool valid = !spans.empty();
+      const double top = valid ? spans.front().first : 0.0;
+      const double bottom = valid ? spans.back().second : 0.0;
+      PutSurface(pose, k, 0, valid, g.front_z - top, Float3{0.f, 0.f, 1.f});
+      PutSurface(pose, k, 1, valid, bottom - back_plane, Float3{0.f, 0.f, -1.f});
+      for (size_t layer = 1; layer < layers; ++layer) {
+        const bool has = layer <= gaps.size();
+        const double upper = has ? gaps[layer - 1].first : 0.0;
+        const double lower = has ? gaps[layer - 1].second : 0.0;
+        PutSurface(pose, layer * n + k, 0, has, g.front_z - upper, kGapUpperNormal);
+        PutSurface(pose, layer * n + k, 1, has, lower - back_plane, kGapLowerNormal);
+      }
+    }
+  }
+  return pose;
+}
+
+const std::vector<ZBox> kStack = {kBlock, kPlate, kMidPlate};
+
+}  // namespace
+
+TEST(BodyMapGaps, InsideSetIsTheSlabMinusItsGaps) {
+  const BodyMapCollider paper = BuildOrDie(LayeredPose(1, kStack));
+  const BodyMapCollider two = BuildOrDie(LayeredPose(2, kStack));
+  const BodyMapCollider three = BuildOrDie(LayeredPose(3, kStack));
+  EXPECT_EQ(paper.layers(), 1u);
+  EXPECT_EQ(three.layers(), 3u);
+  EXPECT_EQ(paper.stats().gap_texels, 0u);
+  EXPECT_EQ(three.stats().gap_texels, 40u * 40u);  // the plate's texels
+  EXPECT_EQ(two.stats().gap_texels, 40u * 40u);
+  // Under the plate only (x < 0): one gap (0.05, 0.10).
+  const Float3 plate_only{-0.05f, 0.01f, 0.f}, both_plates{0.03f, 0.01f, 0.f};
+  const auto at = [](Float3 p, float z) { return Float3{p.x, p.y, z}; };
+  for (const BodyMapCollider* c : {&two, &three}) {
+    EXPECT_TRUE(c->IsInside(at(plate_only, 0.11f)));
+    EXPECT_FALSE(c->IsInside(at(plate_only, 0.075f)));
+    EXPECT_TRUE(c->IsInside(at(plate_only, 0.0f)));
+    EXPECT_FALSE(c->IsInside(at(plate_only, 0.13f)));
+    EXPECT_TRUE(c->IsInside(at(plate_only, 0.10f)));  // gap boundaries are inside
+    EXPECT_TRUE(c->IsInside(at(plate_only, 0.05f)));
+  }
+  EXPECT_TRUE(paper.IsInside(at(plate_only, 0.075f)));  // paper A: the air counts as inside
+  // Under both plates: gaps (0.075, 0.10) and (0.05, 0.065); with two layers only the wider,
+  // upper one.
+  EXPECT_TRUE(three.IsInside(at(both_plates, 0.07f)));
+  EXPECT_FALSE(three.IsInside(at(both_plates, 0.09f)));
+  EXPECT_FALSE(three.IsInside(at(both_plates, 0.06f)));
+  EXPECT_FALSE(two.IsInside(at(both_plates, 0.09f)));
+  EXPECT_TRUE(two.IsInside(at(both_plates, 0.06f)));
+  float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+  const uint32_t i = static_cast<uint32_t>((both_plates.x + 44 * kTexel) / kTexel);
+  const uint32_t j = static_cast<uint32_t>((both_plates.y + 44 * kTexel) / kTexel);
+  ASSERT_EQ(three.TexelGaps(i, j, upper, lower), 2u);
+  EXPECT_NEAR(upper[0], 0.10f, 1e-6);
+  EXPECT_NEAR(lower[0], 0.075f, 1e-6);
+  EXPECT_NEAR(upper[1], 0.065f, 1e-6);
+  EXPECT_NEAR(lower[1], 0.05f, 1e-6);
+  EXPECT_EQ(paper.TexelGaps(i, j, upper, lower), 0u);
+  // The batch and the bilinear sampling classify the same way (the gap texels stay nearest).
+  const BodyMapCollider bilinear = BuildOrDie(LayeredPose(3, kStack), DepthSampling::kBilinear);
+  std::mt19937 rng(31);
+  std::vector<Float3> points(20000);
+  for (Float3& p : points) p = RandomPoint(rng, -0.3f, 0.3f, -0.15f, 0.15f);
+  std::vector<uint8_t> inside(points.size());
+  ASSERT_TRUE(three.InsideBatch(points, inside).ok());
+  int gap_points = 0;
+  for (size_t k = 0; k < points.size(); ++k) {
+    EXPECT_EQ(inside[k] != 0, three.IsInside(points[k])) << k;
+    EXPECT_EQ(bilinear.IsInside(points[k]), three.IsInside(points[k])) << k;
+    gap_points += paper.IsInside(points[k]) && !three.IsInside(points[k]);
+  }
+  EXPECT_GT(gap_points, 500);
+}
+
+TEST(BodyMapGaps, EntriesAcrossAGapUseTheGapsSurfaces) {
+  const BodyMapCollider paper = BuildOrDie(LayeredPose(1, kStack));
+  // Oct16 normals (the runtime's storage) are within 0.004 degrees.
+  for (NormalEncoding ne : {NormalEncoding::kFloat32, NormalEncoding::kOct16}) {
+    SCOPED_TRACE(::testing::Message() << "normal encoding " << int(ne));
+    const BodyMapCollider c = BuildOrDie(LayeredPose(3, kStack, DepthEncoding::kFloat32, ne));
+    const float x = -0.05f, y = 0.01f;  // under the plate only: one gap (0.05, 0.10)
+    // From the gap down into the block: a front entry on the gap's lower boundary.
+    ContactQuery q = c.Query({x, y, 0.09f}, {x, y, 0.03f});
+    ASSERT_TRUE(q.contact);
+    EXPECT_EQ(q.flags, kCollisionNone);
+    EXPECT_NEAR(q.t, (0.09f - 0.05f) / 0.06f, 1e-5);
+    EXPECT_NEAR(q.point.z, 0.05f, 1e-6);
+    EXPECT_LT(AngleDegrees(q.normal, kGapLowerNormal), 0.01);
+    EXPECT_NEAR(q.depth, 0.02f, 1e-6);  // below the block's top, in the block's interval
+    // From the gap up into the plate: a back entry on the gap's upper boundary.
+    q = c.Query({x, y, 0.06f}, {x, y, 0.105f});
+    ASSERT_TRUE(q.contact);
+    EXPECT_NEAR(q.point.z, 0.10f, 1e-6);
+    EXPECT_LT(AngleDegrees(q.normal, kGapUpperNormal), 0.01);
+    // Moving inside the gap: air, no contact. Paper A's slab calls it inside.
+    q = c.Query({x, y, 0.06f}, {x + 0.01f, y, 0.09f});
+    EXPECT_FALSE(q.contact);
+    EXPECT_FALSE(q.inside_end);
+    EXPECT_TRUE(paper.Query({x, y, 0.06f}, {x + 0.01f, y, 0.09f}).contact);
+    // From inside the plate through the gap into the block: a swept entry into the block.
+    q = c.Query({x, y, 0.11f}, {x, y, 0.04f});
+    ASSERT_TRUE(q.contact);
+    EXPECT_EQ(q.flags & kCollisionStartedInside, 0);
+    EXPECT_NEAR(q.point.z, 0.05f, 1e-6);
+    EXPECT_LT(AngleDegrees(q.normal, kGapLowerNormal), 0.01);
+    // Deep in the plate and staying: pushed out to the plate's nearer surface, its lower one.
+    q = c.Query({x, y, 0.105f}, {x, y, 0.102f});
+    ASSERT_TRUE(q.contact);
+    EXPECT_EQ(q.flags, kCollisionStartedInside);
+    EXPECT_NEAR(q.point.z, 0.10f, 1e-6);
+    EXPECT_NEAR(q.depth, 0.002f, 1e-6);
+    EXPECT_LT(AngleDegrees(q.normal, kGapUpperNormal), 0.01);
+    // From above through everything: the plate's front surface.
+    q = c.Query({x, y, 0.2f}, {x, y, -0.2f});
+    ASSERT_TRUE(q.contact);
+    EXPECT_NEAR(q.point.z, 0.12f, 1e-6);
+    EXPECT_LT(AngleDegrees(q.normal, Float3{0.f, 0.f, 1.f}), 0.01);
+    // Sideways at gap height from beyond the plate (slab = the block only) in under it: air.
+    // Paper A's slab grows there and reports a side wall.
+    q = c.Query({-0.2f, y, 0.075f}, {-0.1f, y, 0.075f});
+    EXPECT_FALSE(q.contact);
+    q = paper.Query({-0.2f, y, 0.075f}, {-0.1f, y, 0.075f});
+    ASSERT_TRUE(q.contact);
+    EXPECT_NE(q.flags & kCollisionSideWall, 0);
+    // Sideways in the gap into the edge of the mid plate (x = 0): a side wall, with the normal of
+    // the nearer surface of the mid plate's interval, its top (gap 0's lower boundary).
+    q = c.Query({-0.02f, y, 0.073f}, {0.02f, y, 0.073f});
+    ASSERT_TRUE(q.contact);
+    EXPECT_NE(q.flags & kCollisionSideWall, 0);
+    EXPECT_NEAR(q.point.x, 0.f, kWallTolerance);
+    EXPECT_LT(AngleDegrees(q.normal, kGapLowerNormal), 0.01);
+  }
+}
+
+TEST(BodyMapGaps, WalkMatchesExactReferenceOnRandomSegments) {
+  for (uint8_t layers : {uint8_t{2}, uint8_t{3}}) {
+    const BodyMapCollider c = BuildOrDie(LayeredPose(layers, kStack));
+    std::mt19937 rng(17 + layers);
+    int hits = 0, misses = 0, from_gap = 0;
+    const BodyMapCollider paper = BuildOrDie(LayeredPose(1, kStack));
+    for (int k = 0; k < 3000; ++k) {
+      Float3 p0, p1;
+      RandomSegment(rng, k, &p0, &p1);
+      if (c.IsInside(p0)) continue;
+      from_gap += paper.IsInside(p0);
+      const ContactQuery q = c.Query(p0, p1);
+      const double reference = ReferenceFirstEntry(c, p0, p1);
+      EXPECT_EQ(q.inside_end, c.IsInside(p1));
+      EXPECT_TRUE(!q.inside_end || q.contact);
+      ASSERT_EQ(q.contact, reference >= 0.0) << "segment " << k << " ref " << reference;
+      if (!q.contact) {
+        ++misses;
+        continue;
+      }
+      ++hits;
+      EXPECT_NEAR(q.t, reference, 2e-6 + 2e-7 / Length(p1 - p0)) << "segment " << k;
+      const Float3 on_segment = Lerp(p0, p1, q.t);
+      EXPECT_NEAR(q.point.z, on_segment.z, 1e-5) << "segment " << k;
+      EXPECT_NEAR(Length(q.normal), 1.f, 1e-5);
+    }
+    std::printf("layers %d: %d hits, %d misses, %d starts in a gap\n", layers, hits, misses,
+                from_gap);
+    EXPECT_GT(hits, 300);
+    EXPECT_GT(misses, 100);
+    EXPECT_GT(from_gap, 50);  // starts that paper A's slab would call inside
+  }
+}
+
+TEST(BodyMapGaps, QuickPathsAndBatchAnswerAsTheWalkAtAnyThreadCount) {
+  for (DepthSampling sampling : {DepthSampling::kNearest, DepthSampling::kBilinear}) {
+    SCOPED_TRACE(::testing::Message() << "sampling " << int(sampling));
+    const BodyMapCollider c = BuildOrDie(LayeredPose(3, kStack), sampling);
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<float> unit(0.f, 1.f);
+    constexpr size_t kCount = 30000;
+    std::vector<Float3> previous(kCount), positions(kCount), velocities(kCount);
+    for (size_t k = 0; k < kCount; ++k) {
+      previous[k] = RandomPoint(rng, -0.3f, 0.3f, -0.15f, 0.15f);
+      const float reach = k % 3 == 0 ? 0.3f * kTexel : (k % 3 == 1 ? 3.f * kTexel : 0.1f);
+      positions[k] = previous[k] + RandomPoint(rng, -reach, reach, -0.03f, 0.03f);
+      velocities[k] = RandomPoint(rng, -1.f, 1.f, -1.f, 1.f);
+    }
+    int contacts = 0;
+    for (size_t k = 0; k < kCount; ++k) {
+      const ContactQuery walk = BodyMapColliderTestAccess::QueryWalk(c, previous[k], positions[k]);
+      ExpectSameAnswer(c.Query(previous[k], positions[k]), walk, static_cast<int>(k));
+      contacts += walk.contact;
+    }
+    EXPECT_GT(contacts, 3000);
+    std::vector<Float3> out_positions[2], out_velocities[2];
+    std::vector<uint8_t> flags[2];
+    const int saved_threads = omp_get_max_threads();
+    for (int run = 0; run < 2; ++run) {
+      omp_set_num_threads(run + 1);
+      out_positions[run] = positions;
+      out_velocities[run] = velocities;
+      flags[run].assign(kCount, 0);
+      ASSERT_TRUE(c.CollideBatch(previous, out_positions[run], out_velocities[run], flags[run],
+                                 ResponseParams{})
+                      .ok());
+    }
+    omp_set_num_threads(saved_threads);
+    EXPECT_EQ(
+        0, std::memcmp(out_positions[0].data(), out_positions[1].data(), kCount * sizeof(Float3)));
+    EXPECT_EQ(flags[0], flags[1]);
+  }
+}
+
+TEST(BodyMapGaps, BuildRejectsGapsThatDoNotNest) {
+  const GridSpec g = SphereGrid();
+  const size_t n = static_cast<size_t>(g.width) * g.height;
+  const uint32_t i = 30, j = 44;  // under the plate only (x = -0.11 m)
+  const size_t k = static_cast<size_t>(j) * g.width + i;
+  const double back_plane = static_cast<double>(g.front_z) - g.depth_range;
+  const auto expect_rejected = [](const BodyMapPose& pose, const std::string& words) {
+    BodyMapCollider c;
+    const Status status = c.Build(pose);
+    EXPECT_FALSE(status.ok()) << words;
+    EXPECT_NE(status.message().find(words), std::string::npos) << status.message();
+    EXPECT_TRUE(c.empty());
+  };
+  const auto with_gap = [&](size_t layer, size_t texel, bool front_valid, double upper,
+                            bool back_valid, double lower) {
+    BodyMapPose pose = LayeredPose(3, kStack);
+    PutSurface(pose, layer * n + texel, 0, front_valid, g.front_z - upper, kGapUpperNormal);
+    PutSurface(pose, layer * n + texel, 1, back_valid, lower - back_plane, kGapLowerNormal);
+    return pose;
+  };
+  ASSERT_TRUE(BodyMapCollider().Build(with_gap(1, k, true, 0.09, true, 0.06)).ok());
+  for (uint8_t layers : {uint8_t{0}, uint8_t{5}}) {
+    BodyMapPose pose = LayeredPose(3, kStack);
+    pose.layers = layers;
+    expect_rejected(pose, "layers = " + std::to_string(layers));
+  }
+  {  // arrays sized for three layers, pose says two
+    BodyMapPose pose = LayeredPose(3, kStack);
+    pose.layers = 2;
+    expect_rejected(pose, "2 layer(s)");
+  }
+  expect_rejected(with_gap(1, k, true, 0.09, false, 0.0), "only one of its two boundaries");
+  expect_rejected(with_gap(1, k, true, 0.13, true, 0.06), "not strictly inside");  // above top
+  expect_rejected(with_gap(1, k, true, 0.07, true, 0.09), "not strictly inside");  // inverted
+  expect_rejected(with_gap(1, k, true, 0.09, true, -0.2), "not strictly inside");  // below bottom
+  const size_t block_only = static_cast<size_t>(j) * g.width + 16;  // x = -0.215 m: no gap
+  expect_rejected(with_gap(2, block_only, true, 0.0, true, -0.05), "follows an absent gap");
+  expect_rejected(with_gap(1, 0, true, 0.09, true, 0.06), "background texel");
+  {                                             // gap 2 overlapping gap 1
+    BodyMapPose pose = LayeredPose(3, kStack);  // gap 1 of texel k: (0.10, 0.05)
+    PutSurface(pose, 2 * n + k, 0, true, g.front_z - 0.07, kGapUpperNormal);
+    PutSurface(pose, 2 * n + k, 1, true, 0.03 - back_plane, kGapLowerNormal);
+    expect_rejected(pose, "gap layer 2");
+  }
+}
+
+TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
+  // The plate rises by 0.04 m from t = 0 to t = 1; at t = 1 the mid plate is gone.
+  ZBox raised = kPlate;
+  raised.z_lo += 0.04f;
+  raised.z_hi += 0.04f;
+  std::vector<BodyMapPose> poses = {LayeredPose(3, kStack), LayeredPose(3, {kBlock, raised})};
+  poses[0].time = 0.f;
+  poses[1].time = 1.f;
+  BodyMapSequence sequence;
+  ASSERT_TRUE(sequence.Build(poses, DepthSampling::kNearest, PoseBlend::kBracket).ok());
+  BodyMapCollider scratch;
+  const BodyMapCollider& blended = sequence.At(0.25f, &scratch);
+  ASSERT_EQ(&blended, &scratch);
+  EXPECT_EQ(blended.layers(), 3u);
+  float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+  // Under the plate only: one gap in both poses, blended.
+  ASSERT_EQ(blended.TexelGaps(30, 44, upper, lower), 1u);
+  EXPECT_NEAR(upper[0], 0.11f, 1e-6);
+  EXPECT_NEAR(lower[0], 0.05f, 1e-6);
+  // Under both plates at t = 0, the raised plate only at t = 1: the first gap is blended (the
+  // mid plate's top at t = 0 with the block's top at t = 1), the second, which pose 1 lacks,
+  // ends the list.
+  ASSERT_EQ(blended.TexelGaps(48, 44, upper, lower), 1u);
+  EXPECT_NEAR(upper[0], 0.11f, 1e-6);
+  EXPECT_NEAR(lower[0], 0.75f * 0.075f + 0.25f * 0.05f, 1e-6);
+  EXPECT_FALSE(blended.IsInside({-0.05f, 0.01f, 0.08f}));
+  EXPECT_TRUE(blended.IsInside({-0.05f, 0.01f, 0.115f}));
+}
+
 }  // namespace drape

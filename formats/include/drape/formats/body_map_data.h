@@ -35,6 +35,8 @@ enum class BodyMapLayout : uint8_t {
 // exists; everything outside it is background. Inside it, `layout` says which texels the
 // per-texel arrays hold: all of them row-major (j * width + i), or only those in the row spans
 // (everything outside the spans is background).
+inline constexpr uint8_t kMaxBodyMapLayers = 4;  // the slab and up to three air gaps
+
 struct BodyMapPose {
   int32_t clip = -1;   // clip index, or -1 for the rest pose as authored (see docs/FORMAT.md)
   float time = 0.f;    // seconds into the clip
@@ -47,6 +49,17 @@ struct BodyMapPose {
   DepthEncoding depth_encoding = DepthEncoding::kFloat32;
   NormalEncoding normal_encoding = NormalEncoding::kFloat32;
   BodyMapLayout layout = BodyMapLayout::kDense;
+  // Depth layers per texel, 1 to kMaxBodyMapLayers (class version 3; older poses have 1).
+  // Layer 0 is paper A's slab: each view's nearest surface. Layer k >= 1 is the k-th air gap
+  // inside that slab, counted from the front (an arm held before the chest leaves air between the
+  // two; paper A's slab counts it as inside): the front arrays hold the depth from the front
+  // camera of the gap's upper boundary (where the body is left going along -z), the back arrays
+  // the depth from the back camera of its lower boundary (where the body is entered again).
+  // Normals are the body's outward normals at those surfaces, so a gap's upper normal points
+  // into the gap (-z side). A texel without that gap holds background in every array of the
+  // layer. At one texel the gaps are filled in order and nested strictly inside the slab without
+  // touching: top > upper_1 > lower_1 > upper_2 > lower_2 > ... > bottom (asset-frame z).
+  uint8_t layers = 1;
   // kRowSpans only (empty when dense), compressed rows: row j's spans are the entries
   // [row_span_offsets[j], row_span_offsets[j + 1]) of the span arrays (height + 1 entries, from
   // 0, non-decreasing). Span s covers texels i in [span_begin[s], span_begin[s] + length) of its
@@ -61,7 +74,8 @@ struct BodyMapPose {
   // Index 0 is the front view (looking along -z), 1 the back view (looking along +z). The back
   // map is not mirrored: the same texel covers the same (x, y) in both. Depth is measured from
   // each view's own camera plane. Exactly the arrays of the chosen encodings are filled, each
-  // with one value (or 2 or 3 per texel, as noted) per stored texel.
+  // with one value (or 2 or 3 per texel, as noted) per stored texel and layer, layer-major: the
+  // value of layer k at stored texel n is entry k * stored_texels + n (times 2 or 3).
   std::vector<float> depth_f32[2];
   std::vector<uint16_t> depth_u16[2];
   std::vector<float> normal_f32[2];       // 3 per texel
@@ -77,8 +91,10 @@ struct BodyMapSet {
   std::vector<BodyMapPose> poses;
 };
 
-// Texels the per-texel arrays hold: width * height (dense) or the spans' total (row spans;
-// 0 when the span table is empty). Assumes a span table that CheckBodyMapLayout accepts.
+// Texels each layer of the per-texel arrays holds: width * height (dense) or the spans' total
+// (row spans; 0 when the span table is empty). Every layer stores the same texels, so an array
+// holds layers times this many values (times 2 or 3 for normals). Assumes a span table that
+// CheckBodyMapLayout accepts.
 size_t BodyMapStoredTexels(const BodyMapPose& pose);
 
 // Checks the layout and the span table against width and height, without trusting any count:
@@ -86,16 +102,20 @@ size_t BodyMapStoredTexels(const BodyMapPose& pose);
 // "span_begin[7] = 3 overlaps the previous span of row 2 (ends at 5)".
 std::string CheckBodyMapLayout(const BodyMapPose& pose);
 
-// Position of texel (i, j) in the per-texel arrays, or -1 when it is outside the rectangle or
-// (row spans) outside every span, i.e. background. O(log spans in row j). Assumes a span table
-// that CheckBodyMapLayout accepts.
+// Position n of texel (i, j) within one layer of the per-texel arrays (layer k's value is entry
+// k * BodyMapStoredTexels(pose) + n), or -1 when it is outside the rectangle or (row spans)
+// outside every span, i.e. background in every layer. O(log spans in row j). Assumes a span
+// table that CheckBodyMapLayout accepts.
 int64_t BodyMapTexelIndex(const BodyMapPose& pose, uint32_t i, uint32_t j);
 
-// Copies `in` into `out` in `layout`. To row spans: keeps every texel that is valid (depth not
-// background) in either view, in maximal runs. To dense: texels outside the spans get the
-// background values (depth: depth_range or 65535; normals: zeros). Dense -> spans -> dense gives
-// back the same arrays when every background texel holds those values (as the bake writes).
-// kInvalidArgument (and `out` untouched) when `in`'s layout or array sizes are inconsistent.
+// Copies `in` into `out` in `layout`, every layer. To row spans: keeps every texel whose slab
+// (layer 0) is valid (depth not background) in either view, in maximal runs, with its values in
+// every layer (a gap lies inside its texel's slab, so no gap is lost). To dense: texels outside
+// the spans get the background values in every layer (depth: depth_range or 65535; normals:
+// zeros). Dense -> spans -> dense gives back the same arrays when every texel without a slab
+// holds those values in every layer (as the bake writes). kInvalidArgument (and `out`
+// untouched) when `in`'s layers, layout or array sizes are inconsistent, or a gap lies outside
+// the slab or out of order (the presence checks of ValidateAsset; not the depth order).
 Status ConvertBodyMapLayout(const BodyMapPose& in, BodyMapLayout layout, BodyMapPose* out);
 
 }  // namespace drape

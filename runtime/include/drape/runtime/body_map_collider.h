@@ -9,8 +9,10 @@
 // point has u = (x - origin_x) / s, v = (y - origin_y) / s and lies in texel (floor u, floor v).
 // The point is inside at that texel iff both maps are valid there and
 //   front_z - D_front >= z >= (front_z - depth_range) + D_back,
-// i.e. bottom <= z <= top with top/bottom the asset-frame z of the front/back surfaces. Points
-// outside the stored rectangle are outside.
+// i.e. bottom <= z <= top with top/bottom the asset-frame z of the front/back surfaces, and z is
+// in none of the texel's air gaps (poses with layers > 1: lower < z < upper for a gap's lower and
+// upper boundary; the boundaries themselves are inside). Points outside the stored rectangle are
+// outside.
 
 #include <array>
 #include <cmath>
@@ -101,6 +103,7 @@ struct BodyMapStats {
   uint32_t one_sided_texels = 0;  // exactly one map valid (silhouette disagreement): background
   uint32_t inverted_texels = 0;   // both valid but front surface below back surface: background
   uint32_t bilinear_blocks = 0;   // 2x2 blocks eligible for bilinear depth (kBilinear only)
+  uint32_t gap_texels = 0;        // valid texels with at least one air gap (layers > 1)
 };
 
 class BodyMapSequence;
@@ -112,7 +115,15 @@ class BodyMapSequence;
 // (top, bottom z as float) + 8 bytes of normals (front and back, re-encoded as oct16 whatever the
 // input encoding: float32 input loses < 0.004 degrees) + 1 byte of bilinear eligibility in
 // kBilinear mode, plus 8 bytes per 8x8 block for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB
-// (17.1 MiB bilinear). memory_bytes() reports the exact figure.
+// (17.1 MiB bilinear). A pose with gap layers adds 16 bytes per texel and gap layer (the gap's
+// upper and lower z, their normals). memory_bytes() reports the exact figure.
+//
+// Air gaps (BodyMapPose::layers > 1): a texel's inside set is its slab minus its gaps, i.e. up to
+// `layers` disjoint z intervals. Every query honours them: an entry into the body below a gap is
+// a front entry with the normal of the gap's lower boundary, one from below into the body above
+// it a back entry with the normal of the gap's upper boundary; depth and the started-inside
+// push-out use the interval that holds the point. Texels with gaps are answered by the general
+// walk (no single-texel quick path) and take no part in bilinear blocks (nearest there).
 class BodyMapCollider {
  public:
   // Validates the pose and decodes it into the internal layout (allocates). A row-span pose is
@@ -132,8 +143,11 @@ class BodyMapCollider {
     const float u = (p.x - origin_x_) * inv_texel_size_;
     const float v = (p.y - origin_y_) * inv_texel_size_;
     if (!(u >= 0.f && v >= 0.f && u < width_f_ && v < height_f_)) return false;  // also NaN
-    const Slab& s = slabs_[static_cast<size_t>(v) * width_ + static_cast<size_t>(u)];
-    return (p.z <= s.top) & (p.z >= s.bottom);  // no branch: near a surface it is a coin toss
+    const size_t texel = static_cast<size_t>(v) * width_ + static_cast<size_t>(u);
+    const Slab& s = slabs_[texel];
+    const bool in_slab = (p.z <= s.top) & (p.z >= s.bottom);  // no branch: near a surface it is
+                                                              // a coin toss
+    return gap_layers_ == 0 ? in_slab : in_slab && !InGap(texel, p.z);
   }
 
   // Continuous test of the motion p0 -> p1 (a point query is p0 == p1).
@@ -175,6 +189,7 @@ class BodyMapCollider {
   float origin_x() const { return origin_x_; }
   float origin_y() const { return origin_y_; }
   DepthSampling sampling() const { return sampling_; }
+  uint32_t layers() const { return gap_layers_ + 1; }  // the slab and its gap layers
   int32_t clip() const { return clip_; }
   float time() const { return time_; }
   // Asset-frame box of the valid texels (x, y: texel edges; z: lowest back / highest front
@@ -187,6 +202,9 @@ class BodyMapCollider {
   // Per-texel access (tests, tools): false for background; top/bottom are asset-frame z.
   bool TexelSlab(uint32_t i, uint32_t j, float* top, float* bottom) const;
   Float3 TexelNormal(uint32_t i, uint32_t j, bool back) const;
+  // The air gaps of texel (i, j), from the front: writes upper[g], lower[g] (asset-frame z) for
+  // each and returns their number (0 for background and gap-free texels; arrays of layers() - 1).
+  uint32_t TexelGaps(uint32_t i, uint32_t j, float* upper, float* lower) const;
 
  private:
   friend class BodyMapSequence;
@@ -205,6 +223,32 @@ class BodyMapCollider {
     float max_top;      // padded up; -inf when no valid texel
     float min_bottom;   // padded down; +inf when no valid texel
   };
+  // The z interval of a texel's inside set that holds a point, with the surfaces bounding it:
+  // slot 0/1 = the slab's front/back surface, 2 + 2g / 3 + 2g = gap g's upper/lower boundary.
+  struct Interval {
+    float top, bottom;
+    int top_slot, bottom_slot;
+  };
+  static constexpr int kFrontSlot = 0, kBackSlot = 1;
+  // Gap g of texel k: gaps_[k * gap_layers_ + g] (upper in `top`, lower in `bottom`); an absent
+  // gap holds top = -inf, bottom = +inf, which no z lies strictly between.
+  bool HasGap(size_t texel) const {
+    const Slab& g = gaps_[texel * gap_layers_];
+    return g.top > g.bottom;
+  }
+  bool InGap(size_t texel, float z) const {
+    const Slab* g = gaps_.data() + texel * gap_layers_;
+    bool in = false;
+    for (uint32_t k = 0; k < gap_layers_; ++k) in |= (z < g[k].top) & (z > g[k].bottom);
+    return in;
+  }
+  // Up to kMaxBodyMapLayers intervals of texel k, from the top; returns their number (0 for
+  // background).
+  int TexelIntervals(size_t texel, Interval* intervals) const;
+  // The interval holding z at texel k; the slab itself when no interval does (z in a gap or out).
+  Interval IntervalAt(size_t texel, float z) const;
+  Float3 SlotNormal(size_t texel, int slot) const;
+
   static constexpr uint32_t kBlockShift = 3;  // 8x8 texels per min/max block
   static constexpr uint32_t kBlockTexels = 1u << kBlockShift;
 
@@ -258,6 +302,9 @@ class BodyMapCollider {
   std::vector<TexelNormals> normals_;  // width*height
   std::vector<uint8_t> bilinear_ok_;   // width*height (kBilinear only): block (i, j)..(i+1, j+1)
   std::vector<BlockBounds> blocks_;    // blocks_w_ * blocks_h_
+  uint32_t gap_layers_ = 0;            // BodyMapPose::layers - 1
+  std::vector<Slab> gaps_;             // width*height*gap_layers_, texel-major (see HasGap)
+  std::vector<TexelNormals> gap_normals_;  // same index: front = upper, back = lower boundary
 };
 
 // How a sequence answers times between its baked poses.
@@ -266,8 +313,10 @@ class BodyMapCollider {
 //    collider when they share the same grid (width, height, origin, texel size): top and bottom
 //    z are interpolated linearly where both poses are valid; a texel valid in one pose only keeps
 //    that pose's slab while that pose is the nearer one in time (the silhouette switches halfway);
-//    normals come from the nearer pose. Different grids, a time on or outside the baked keys, or
-//    no scratch: nearest.
+//    normals come from the nearer pose. Air gaps are blended where both poses have them and
+//    taken from the nearer pose with its slab; a texel's gaps end at the first one a blended
+//    pose lacks. Different grids or layer counts, a time on or outside the baked keys, or no
+//    scratch: nearest.
 enum class PoseBlend : uint8_t { kNearest = 0, kBracket = 1 };
 
 // The baked poses of one clip (or the bind pose alone).
