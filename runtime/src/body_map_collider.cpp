@@ -197,8 +197,9 @@ struct BodyMapWalk {
       return false;
     }
     const size_t texel = static_cast<size_t>(j) * c.width_ + i;
-    if (c.gap_layers_ != 0 && c.HasGap(texel)) {
-      return VisitTexelWithGaps(texel, ci, cj, s_enter, s_exit);
+    if (c.gap_layers_ != 0 && c.GapBase(static_cast<uint32_t>(i), static_cast<uint32_t>(j)) >= 0) {
+      return VisitTexelWithGaps(static_cast<uint32_t>(i), static_cast<uint32_t>(j), ci, cj, s_enter,
+                                s_exit);
     }
     const BodyMapCollider::Slab slab = c.slabs_[texel];
     const float z_enter = Z(s_enter);
@@ -228,9 +229,9 @@ struct BodyMapWalk {
   // A texel with air gaps: its inside set is up to kMaxBodyMapLayers disjoint z intervals, sorted
   // from the top, and z is linear (monotone) along the piece, so the first entry is into the
   // next interval in the direction of motion, if the piece reaches it.
-  bool VisitTexelWithGaps(size_t texel, int ci, int cj, float s_enter, float s_exit) {
+  bool VisitTexelWithGaps(uint32_t i, uint32_t j, int ci, int cj, float s_enter, float s_exit) {
     BodyMapCollider::Interval in[kMaxBodyMapLayers];
-    const int count = c.TexelIntervals(texel, in);
+    const int count = c.TexelIntervals(i, j, in);
     const float z_enter = Z(s_enter);
     const float z_exit = Z(s_exit);
     int at = -1;  // the interval holding z_enter
@@ -505,6 +506,8 @@ void BodyMapCollider::Clear() {
   bilinear_ok_.clear();
   blocks_.clear();
   gap_layers_ = 0;
+  gap_masks_.clear();
+  gap_block_first_.clear();
   gaps_.clear();
   gap_normals_.clear();
 }
@@ -685,11 +688,10 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
 
   // Gap layers: each gap must sit strictly inside the interval above it, so that the texel's
   // inside set is a sorted list of disjoint intervals (the walk relies on it).
+  // Decoded densely (setup time), stored compactly by PackGaps below.
   gap_layers_ = static_cast<uint32_t>(layers - 1);
-  if (gap_layers_ > 0) {
-    gaps_.assign(n * gap_layers_, Slab{-kInf, kInf});
-    gap_normals_.assign(n * gap_layers_, TexelNormals{});
-  }
+  std::vector<Slab> dense_gaps(n * gap_layers_, Slab{-kInf, kInf});
+  std::vector<TexelNormals> dense_gap_normals(n * gap_layers_, TexelNormals{});
   for (size_t k = 0; k < n && gap_layers_ > 0; ++k) {
     float floor_z = slabs_[k].top;  // the gap must lie below this (the previous interval's top)
     bool absent_before = false;
@@ -718,9 +720,9 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
         reason = "is not strictly inside the slab below the previous gap";
       }
       if (reason != nullptr) return fail(where(0, index) + ": the gap " + reason);
-      gaps_[k * gap_layers_ + g] = {upper, lower};
+      dense_gaps[k * gap_layers_ + g] = {upper, lower};
       floor_z = lower;
-      TexelNormals& normals = gap_normals_[k * gap_layers_ + g];
+      TexelNormals& normals = dense_gap_normals[k * gap_layers_ + g];
       if (!read_normal(0, index, normals.front) || !read_normal(1, index, normals.back)) {
         return fail(problem);
       }
@@ -738,8 +740,43 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   sampling_ = sampling;
   clip_ = pose.clip;
   time_ = pose.time;
+  PackGaps(dense_gaps, dense_gap_normals);
   Finish();
   return Status::Ok();
+}
+
+void BodyMapCollider::PackGaps(const std::vector<Slab>& gaps,
+                               const std::vector<TexelNormals>& normals) {
+  const size_t w = width_, h = height_, layers = gap_layers_;
+  blocks_w_ = static_cast<uint32_t>((w + kBlockTexels - 1) >> kBlockShift);
+  blocks_h_ = static_cast<uint32_t>((h + kBlockTexels - 1) >> kBlockShift);
+  gap_masks_.clear();
+  gap_block_first_.clear();
+  gaps_.clear();
+  gap_normals_.clear();
+  if (layers == 0) return;
+  gap_masks_.assign(static_cast<size_t>(blocks_w_) * blocks_h_, 0);
+  gap_block_first_.assign(gap_masks_.size(), 0);
+  uint32_t gap_texels = 0;
+  for (size_t bj = 0; bj < blocks_h_; ++bj) {
+    for (size_t bi = 0; bi < blocks_w_; ++bi) {
+      const size_t block = bj * blocks_w_ + bi;
+      gap_block_first_[block] = gap_texels;
+      for (size_t b = 0; b < kBlockTexels * kBlockTexels; ++b) {  // bit order: (j % 8) * 8 + i % 8
+        const size_t i = (bi << kBlockShift) + (b & (kBlockTexels - 1));
+        const size_t j = (bj << kBlockShift) + (b >> kBlockShift);
+        if (i >= w || j >= h) continue;
+        const size_t first = (j * w + i) * layers;
+        if (!(gaps[first].top > gaps[first].bottom)) continue;
+        gap_masks_[block] |= uint64_t{1} << b;
+        ++gap_texels;
+        gaps_.insert(gaps_.end(), gaps.begin() + static_cast<ptrdiff_t>(first),
+                     gaps.begin() + static_cast<ptrdiff_t>(first + layers));
+        gap_normals_.insert(gap_normals_.end(), normals.begin() + static_cast<ptrdiff_t>(first),
+                            normals.begin() + static_cast<ptrdiff_t>(first + layers));
+      }
+    }
+  }
 }
 
 void BodyMapCollider::Finish() {
@@ -762,7 +799,7 @@ void BodyMapCollider::Finish() {
   }
   stats_.valid_texels = valid;
   stats_.gap_texels = 0;
-  for (size_t k = 0; k < w * h && gap_layers_ > 0; ++k) stats_.gap_texels += HasGap(k) ? 1u : 0u;
+  stats_.gap_texels = gap_layers_ == 0 ? 0u : static_cast<uint32_t>(gaps_.size() / gap_layers_);
   const double s = texel_size_;
   if (valid == 0) {
     bounds_min_ = {1.f, 1.f, 1.f};
@@ -797,9 +834,10 @@ void BodyMapCollider::Finish() {
                            slabs_[(j + 1) * w + i + 1]};
         float top_lo = kInf, top_hi = -kInf, bottom_lo = kInf, bottom_hi = -kInf;
         // Texels with air gaps stay nearest: their inside set is not one slab to interpolate.
+        const uint32_t i0 = static_cast<uint32_t>(i), j0 = static_cast<uint32_t>(j);
         bool all_valid =
-            gap_layers_ == 0 || !(HasGap(j * w + i) || HasGap(j * w + i + 1) ||
-                                  HasGap((j + 1) * w + i) || HasGap((j + 1) * w + i + 1));
+            gap_layers_ == 0 || (GapBase(i0, j0) < 0 && GapBase(i0 + 1, j0) < 0 &&
+                                 GapBase(i0, j0 + 1) < 0 && GapBase(i0 + 1, j0 + 1) < 0);
         for (const Slab& c : q) {
           all_valid = all_valid && c.top >= c.bottom;
           top_lo = std::min(top_lo, c.top);
@@ -849,56 +887,8 @@ void BodyMapCollider::Finish() {
 size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
+         gap_masks_.capacity() * sizeof(uint64_t) + gap_block_first_.capacity() * sizeof(uint32_t) +
          bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds);
-}
-
-uint32_t BodyMapCollider::TexelGaps(uint32_t i, uint32_t j, float* upper, float* lower) const {
-  if (i >= width_ || j >= height_ || gap_layers_ == 0) return 0;
-  const Slab* gaps = gaps_.data() + (static_cast<size_t>(j) * width_ + i) * gap_layers_;
-  uint32_t count = 0;
-  for (; count < gap_layers_ && gaps[count].top > gaps[count].bottom; ++count) {
-    upper[count] = gaps[count].top;
-    lower[count] = gaps[count].bottom;
-  }
-  return count;
-}
-
-int BodyMapCollider::TexelIntervals(size_t texel, Interval* intervals) const {
-  const Slab& slab = slabs_[texel];
-  if (!(slab.top >= slab.bottom)) return 0;
-  int count = 0;
-  intervals[0] = {slab.top, slab.bottom, kFrontSlot, kBackSlot};
-  const Slab* gaps = gaps_.data() + texel * gap_layers_;
-  for (uint32_t g = 0; g < gap_layers_ && gaps[g].top > gaps[g].bottom; ++g) {
-    // Gap g splits the last interval: its upper boundary ends it, its lower one starts the next.
-    const int slot = 2 + 2 * static_cast<int>(g);
-    intervals[count].bottom = gaps[g].top;
-    intervals[count].bottom_slot = slot;
-    ++count;
-    intervals[count] = {gaps[g].bottom, slab.bottom, slot + 1, kBackSlot};
-  }
-  return count + 1;
-}
-
-BodyMapCollider::Interval BodyMapCollider::IntervalAt(size_t texel, float z) const {
-  const Slab& slab = slabs_[texel];
-  if (gap_layers_ == 0 || !HasGap(texel)) return {slab.top, slab.bottom, kFrontSlot, kBackSlot};
-  Interval intervals[kMaxBodyMapLayers];
-  const int count = TexelIntervals(texel, intervals);
-  for (int k = 0; k < count; ++k) {
-    if (z <= intervals[k].top && z >= intervals[k].bottom) return intervals[k];
-  }
-  return {slab.top, slab.bottom, kFrontSlot, kBackSlot};
-}
-
-Float3 BodyMapCollider::SlotNormal(size_t texel, int slot) const {
-  if (slot < 2) {
-    const uint16_t* q = slot == kBackSlot ? normals_[texel].back : normals_[texel].front;
-    return DecodeOct16(q[0], q[1]);
-  }
-  const TexelNormals& n = gap_normals_[texel * gap_layers_ + static_cast<size_t>((slot - 2) / 2)];
-  const uint16_t* q = slot % 2 == 1 ? n.back : n.front;
-  return DecodeOct16(q[0], q[1]);
 }
 
 bool BodyMapCollider::TexelSlab(uint32_t i, uint32_t j, float* top, float* bottom) const {
@@ -914,6 +904,55 @@ Float3 BodyMapCollider::TexelNormal(uint32_t i, uint32_t j, bool back) const {
   if (i >= width_ || j >= height_) return Float3{0.f, 0.f, back ? -1.f : 1.f};
   const TexelNormals& n = normals_[static_cast<size_t>(j) * width_ + i];
   const uint16_t* q = back ? n.back : n.front;
+  return DecodeOct16(q[0], q[1]);
+}
+
+uint32_t BodyMapCollider::TexelGaps(uint32_t i, uint32_t j, float* upper, float* lower) const {
+  if (i >= width_ || j >= height_ || gap_layers_ == 0) return 0;
+  const int64_t base = GapBase(i, j);
+  if (base < 0) return 0;
+  const Slab* gaps = gaps_.data() + base;
+  uint32_t count = 0;
+  for (; count < gap_layers_ && gaps[count].top > gaps[count].bottom; ++count) {
+    upper[count] = gaps[count].top;
+    lower[count] = gaps[count].bottom;
+  }
+  return count;
+}
+
+int BodyMapCollider::TexelIntervals(uint32_t i, uint32_t j, Interval* intervals) const {
+  const Slab& slab = slabs_[static_cast<size_t>(j) * width_ + i];
+  if (!(slab.top >= slab.bottom)) return 0;
+  int count = 0;
+  intervals[0] = {slab.top, slab.bottom, kFrontSlot, kBackSlot};
+  const int64_t base = gap_layers_ == 0 ? -1 : GapBase(i, j);
+  if (base < 0) return 1;
+  const Slab* gaps = gaps_.data() + base;
+  for (uint32_t g = 0; g < gap_layers_ && gaps[g].top > gaps[g].bottom; ++g) {
+    // Gap g splits the last interval: its upper boundary ends it, its lower one starts the next.
+    const int slot = 2 + 2 * static_cast<int>(g);
+    intervals[count].bottom = gaps[g].top;
+    intervals[count].bottom_slot = slot;
+    ++count;
+    intervals[count] = {gaps[g].bottom, slab.bottom, slot + 1, kBackSlot};
+  }
+  return count + 1;
+}
+
+BodyMapCollider::Interval BodyMapCollider::IntervalAt(uint32_t i, uint32_t j, float z) const {
+  Interval intervals[kMaxBodyMapLayers];
+  const int count = TexelIntervals(i, j, intervals);
+  for (int k = 0; k < count; ++k) {
+    if (z <= intervals[k].top && z >= intervals[k].bottom) return intervals[k];
+  }
+  const Slab& slab = slabs_[static_cast<size_t>(j) * width_ + i];
+  return {slab.top, slab.bottom, kFrontSlot, kBackSlot};
+}
+
+Float3 BodyMapCollider::SlotNormal(uint32_t i, uint32_t j, int slot) const {
+  if (slot < 2) return TexelNormal(i, j, slot == kBackSlot);
+  const TexelNormals& n = gap_normals_[static_cast<size_t>(GapBase(i, j)) + (slot - 2) / 2];
+  const uint16_t* q = slot % 2 == 1 ? n.back : n.front;
   return DecodeOct16(q[0], q[1]);
 }
 
@@ -977,7 +1016,7 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
   // A texel with gaps is never part of a bilinear block: its nearest slab minus its gaps.
   return p.z <= top && p.z >= bottom &&
          !(gap_layers_ != 0 &&
-           InGap(static_cast<size_t>(cj >> 1) * width_ + static_cast<size_t>(ci >> 1), p.z));
+           InGap(GapBase(static_cast<uint32_t>(ci >> 1), static_cast<uint32_t>(cj >> 1)), p.z));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1002,7 +1041,9 @@ bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& 
   // On a valid texel x and y lie in the clip box; the general path clips nothing only when z
   // does too, and then its walk is one visit of this texel over s in [0, 1], which is below.
   if (!(slab.top >= slab.bottom)) return true;
-  if (gap_layers_ != 0 && HasGap(texel)) return false;  // the walk solves the intervals
+  if (gap_layers_ != 0 && GapBase(static_cast<uint32_t>(i), static_cast<uint32_t>(j)) >= 0) {
+    return false;  // the walk solves the intervals
+  }
   if (!(z0 >= clip_lo_[2] && z0 <= clip_hi_[2] && z1 >= clip_lo_[2] && z1 <= clip_hi_[2])) {
     return false;
   }
@@ -1177,10 +1218,10 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
   // bilinear patch in an eligible block, else the texel's interval (gaps split the slab).
   const auto interval_at = [&](int ci, int cj, float u, float v, float z) {
     if (sampling_ == DepthSampling::kNearest) {
-      return IntervalAt(static_cast<size_t>(cj) * width_ + static_cast<size_t>(ci), z);
+      return IntervalAt(static_cast<uint32_t>(ci), static_cast<uint32_t>(cj), z);
     }
     if (!BilinearBlock((ci - 1) >> 1, (cj - 1) >> 1)) {
-      return IntervalAt(static_cast<size_t>(cj >> 1) * width_ + static_cast<size_t>(ci >> 1), z);
+      return IntervalAt(static_cast<uint32_t>(ci >> 1), static_cast<uint32_t>(cj >> 1), z);
     }
     Interval patch{0.f, 0.f, kFrontSlot, kBackSlot};
     SampleSlab(ci, cj, u, v, &patch.top, &patch.bottom);
@@ -1188,10 +1229,10 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
   };
   const auto normal_at = [&](int ci, int cj, float u, float v, int slot) {
     if (sampling_ == DepthSampling::kNearest) {
-      return SlotNormal(static_cast<size_t>(cj) * width_ + static_cast<size_t>(ci), slot);
+      return SlotNormal(static_cast<uint32_t>(ci), static_cast<uint32_t>(cj), slot);
     }
     if (slot >= 2) {  // a gap's boundary: its texel has no bilinear block
-      return SlotNormal(static_cast<size_t>(cj >> 1) * width_ + static_cast<size_t>(ci >> 1), slot);
+      return SlotNormal(static_cast<uint32_t>(ci >> 1), static_cast<uint32_t>(cj >> 1), slot);
     }
     return SampleNormal(ci, cj, u, v, slot == kBackSlot);
   };
@@ -1426,10 +1467,6 @@ const BodyMapCollider& BodyMapSequence::At(float time, BodyMapCollider* scratch)
   out.stats_ = nearer.stats_;
   out.slabs_.resize(n);  // allocates only when the scratch has never held this grid size
   out.normals_.resize(n);
-  const size_t gap_layers = a.gap_layers_;
-  out.gap_layers_ = a.gap_layers_;
-  out.gaps_.resize(n * gap_layers);
-  out.gap_normals_.resize(n * gap_layers);
   const int64_t count = static_cast<int64_t>(n);
 #pragma omp parallel for schedule(static) if (count > 65536)
   for (int64_t k = 0; k < count; ++k) {
@@ -1445,28 +1482,80 @@ const BodyMapCollider& BodyMapSequence::At(float time, BodyMapCollider* scratch)
     }
     out.slabs_[k] = slab;
     out.normals_[k] = nearer.normals_[k];
-    // Gaps: blended where both poses have them (a convex combination keeps the strict order
-    // top > upper > lower > ... > bottom), else taken with the slab from the one pose it came
-    // from. The first gap one pose lacks ends the list: fewer gaps only means more inside.
-    const size_t first = static_cast<size_t>(k) * gap_layers;
-    bool more = slab.top >= slab.bottom;  // background has no gaps
-    for (size_t g = 0; g < gap_layers; ++g) {
-      const BodyMapCollider::Slab ga = a.gaps_[first + g], gb = b.gaps_[first + g];
-      BodyMapCollider::Slab gap{-kInf, kInf};
-      if (more && valid_a && valid_b) {
-        if (ga.top > ga.bottom && gb.top > gb.bottom) {
-          gap = {(1.f - w) * ga.top + w * gb.top, (1.f - w) * ga.bottom + w * gb.bottom};
-        }
-      } else if (more) {
-        gap = a_nearer ? ga : gb;
-      }
-      more = more && gap.top > gap.bottom;
-      out.gaps_[first + g] = more ? gap : BodyMapCollider::Slab{-kInf, kInf};
-      out.gap_normals_[first + g] = nearer.gap_normals_[first + g];
-    }
   }
+  BlendGaps(a, b, w, &out);
   out.Finish();
   return out;
+}
+
+void BodyMapSequence::BlendGaps(const BodyMapCollider& a, const BodyMapCollider& b, float w,
+                                BodyMapCollider* out) {
+  using Slab = BodyMapCollider::Slab;
+  const uint32_t layers = a.gap_layers_;
+  out->gap_layers_ = layers;
+  out->blocks_w_ = a.blocks_w_;
+  out->blocks_h_ = a.blocks_h_;
+  out->gaps_.clear();
+  out->gap_normals_.clear();
+  if (layers == 0) {
+    out->gap_masks_.clear();
+    out->gap_block_first_.clear();
+    return;
+  }
+  const size_t blocks = a.gap_masks_.size();
+  out->gap_masks_.assign(blocks, 0);  // no allocation once the scratch held this grid
+  out->gap_block_first_.assign(blocks, 0);
+  // Room for both poses' gaps: a blend never keeps more gap texels than the two have together.
+  out->gaps_.reserve(a.gaps_.size() + b.gaps_.size());
+  out->gap_normals_.reserve(a.gap_normals_.size() + b.gap_normals_.size());
+  const BodyMapCollider& nearer = w <= 0.5f ? a : b;
+  uint32_t gap_texels = 0;
+  for (size_t block = 0; block < blocks; ++block) {
+    out->gap_block_first_[block] = gap_texels;
+    uint64_t candidates = a.gap_masks_[block] | b.gap_masks_[block];
+    while (candidates != 0) {
+      const int bit = std::countr_zero(candidates);
+      candidates &= candidates - 1;
+      const uint32_t i =
+          static_cast<uint32_t>((block % a.blocks_w_) << BodyMapCollider::kBlockShift) +
+          static_cast<uint32_t>(bit & (BodyMapCollider::kBlockTexels - 1));
+      const uint32_t j =
+          static_cast<uint32_t>((block / a.blocks_w_) << BodyMapCollider::kBlockShift) +
+          static_cast<uint32_t>(bit >> BodyMapCollider::kBlockShift);
+      const size_t k = static_cast<size_t>(j) * a.width_ + i;
+      const Slab slab = out->slabs_[k];
+      if (!(slab.top >= slab.bottom)) continue;  // background has no gaps
+      const bool both =
+          a.slabs_[k].top >= a.slabs_[k].bottom && b.slabs_[k].top >= b.slabs_[k].bottom;
+      const int64_t base_a = a.GapBase(i, j), base_b = b.GapBase(i, j);
+      const int64_t base_nearer = nearer.GapBase(i, j);
+      Slab gaps[kMaxBodyMapLayers];
+      bool more = true;
+      for (uint32_t g = 0; g < layers; ++g) {
+        Slab gap{-kInf, kInf};
+        if (both) {
+          // A convex combination keeps the strict order top > upper > lower > ... > bottom.
+          if (base_a >= 0 && base_b >= 0) {
+            const Slab ga = a.gaps_[base_a + g], gb = b.gaps_[base_b + g];
+            if (ga.top > ga.bottom && gb.top > gb.bottom) {
+              gap = {(1.f - w) * ga.top + w * gb.top, (1.f - w) * ga.bottom + w * gb.bottom};
+            }
+          }
+        } else if (base_nearer >= 0) {  // the slab is the nearer pose's: so are its gaps
+          gap = nearer.gaps_[base_nearer + g];
+        }
+        more = more && gap.top > gap.bottom;  // the first gap one pose lacks ends the list
+        gaps[g] = more ? gap : Slab{-kInf, kInf};
+      }
+      if (!(gaps[0].top > gaps[0].bottom)) continue;
+      // Kept gaps exist in the nearer pose (blended ones in both), so its normals are there.
+      out->gap_masks_[block] |= uint64_t{1} << bit;
+      ++gap_texels;
+      out->gaps_.insert(out->gaps_.end(), gaps, gaps + layers);
+      out->gap_normals_.insert(out->gap_normals_.end(), nearer.gap_normals_.begin() + base_nearer,
+                               nearer.gap_normals_.begin() + base_nearer + layers);
+    }
+  }
 }
 
 size_t BodyMapSequence::memory_bytes() const {

@@ -103,7 +103,7 @@ std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path)
       << ", \"width\": " << pose.width << ", \"height\": " << pose.height
       << ", \"texel_size_mm\": " << pose.texel_size * 1000.f << ", \"depth\": \""
       << DepthName(pose.depth_encoding) << "\", \"normal\": \"" << NormalName(pose.normal_encoding)
-      << "\", \"bytes\": " << PoseBytes(pose) << "}";
+      << "\", \"layers\": " << int(pose.layers) << ", \"bytes\": " << PoseBytes(pose) << "}";
   }
   o << "]},\n  \"hulls\": [";
   for (size_t h = 0; h < a.hulls.size(); ++h) {
@@ -144,9 +144,12 @@ void PrintText(const drape::CharacterAsset& a, const std::string& path) {
   std::printf("  body maps: %zu poses (epsilon %.1f mm)\n", a.body_maps.poses.size(),
               a.body_maps.epsilon * 1000.f);
   for (const auto& pose : a.body_maps.poses) {
-    std::printf("    clip %d t=%.3f s: %ux%u texels of %.2f mm, depth %s, normals %s, %zu bytes\n",
-                pose.clip, pose.time, pose.width, pose.height, pose.texel_size * 1000.f,
-                DepthName(pose.depth_encoding), NormalName(pose.normal_encoding), PoseBytes(pose));
+    std::printf(
+        "    clip %d t=%.3f s: %ux%u texels of %.2f mm, depth %s, normals %s, %d layer(s), %zu "
+        "bytes\n",
+        pose.clip, pose.time, pose.width, pose.height, pose.texel_size * 1000.f,
+        DepthName(pose.depth_encoding), NormalName(pose.normal_encoding), int(pose.layers),
+        PoseBytes(pose));
   }
   std::printf("  hulls: %zu\n", a.hulls.size());
   for (const auto& hull : a.hulls) {

@@ -1194,6 +1194,9 @@ TEST(BodyMapGaps, InsideSetIsTheSlabMinusItsGaps) {
   EXPECT_EQ(paper.stats().gap_texels, 0u);
   EXPECT_EQ(three.stats().gap_texels, 40u * 40u);  // the plate's texels
   EXPECT_EQ(two.stats().gap_texels, 40u * 40u);
+  // Stored compactly: two gap slots of 16 bytes per gap texel, 12 bytes per 8x8 block.
+  const size_t blocks = 11 * 11;
+  EXPECT_LE(three.memory_bytes() - paper.memory_bytes(), 40u * 40u * 2 * 16 + blocks * 12 + 64);
   // Under the plate only (x < 0): one gap (0.05, 0.10).
   const Float3 plate_only{-0.05f, 0.01f, 0.f}, both_plates{0.03f, 0.01f, 0.f};
   const auto at = [](Float3 p, float z) { return Float3{p.x, p.y, z}; };

@@ -15,6 +15,7 @@
 // outside.
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -143,11 +144,11 @@ class BodyMapCollider {
     const float u = (p.x - origin_x_) * inv_texel_size_;
     const float v = (p.y - origin_y_) * inv_texel_size_;
     if (!(u >= 0.f && v >= 0.f && u < width_f_ && v < height_f_)) return false;  // also NaN
-    const size_t texel = static_cast<size_t>(v) * width_ + static_cast<size_t>(u);
-    const Slab& s = slabs_[texel];
+    const uint32_t i = static_cast<uint32_t>(u), j = static_cast<uint32_t>(v);
+    const Slab& s = slabs_[static_cast<size_t>(j) * width_ + i];
     const bool in_slab = (p.z <= s.top) & (p.z >= s.bottom);  // no branch: near a surface it is
                                                               // a coin toss
-    return gap_layers_ == 0 ? in_slab : in_slab && !InGap(texel, p.z);
+    return gap_layers_ == 0 ? in_slab : in_slab && !InGap(GapBase(i, j), p.z);
   }
 
   // Continuous test of the motion p0 -> p1 (a point query is p0 == p1).
@@ -230,24 +231,36 @@ class BodyMapCollider {
     int top_slot, bottom_slot;
   };
   static constexpr int kFrontSlot = 0, kBackSlot = 1;
-  // Gap g of texel k: gaps_[k * gap_layers_ + g] (upper in `top`, lower in `bottom`); an absent
-  // gap holds top = -inf, bottom = +inf, which no z lies strictly between.
-  bool HasGap(size_t texel) const {
-    const Slab& g = gaps_[texel * gap_layers_];
-    return g.top > g.bottom;
+  // Gaps are stored compactly (on a character a few percent of the texels have one): per 8x8
+  // block a bit mask of its texels with gaps (bit (j % 8) * 8 + i % 8) and the number of gap
+  // texels in the blocks before it; gap texel t holds gap g at gaps_[t * gap_layers_ + g]
+  // (upper in `top`, lower in `bottom`; an absent gap holds top = -inf, bottom = +inf, which no z
+  // lies strictly between). GapBase: the index of texel (i, j)'s first gap, or -1 for none.
+  int64_t GapBase(uint32_t i, uint32_t j) const {
+    const size_t block = static_cast<size_t>(j >> kBlockShift) * blocks_w_ + (i >> kBlockShift);
+    const uint64_t bit = uint64_t{1}
+                         << (((j & (kBlockTexels - 1)) << kBlockShift) | (i & (kBlockTexels - 1)));
+    const uint64_t mask = gap_masks_[block];
+    if (!(mask & bit)) return -1;
+    return (static_cast<int64_t>(gap_block_first_[block]) + std::popcount(mask & (bit - 1))) *
+           gap_layers_;
   }
-  bool InGap(size_t texel, float z) const {
-    const Slab* g = gaps_.data() + texel * gap_layers_;
+  bool InGap(int64_t base, float z) const {
+    if (base < 0) return false;
+    const Slab* g = gaps_.data() + base;
     bool in = false;
     for (uint32_t k = 0; k < gap_layers_; ++k) in |= (z < g[k].top) & (z > g[k].bottom);
     return in;
   }
-  // Up to kMaxBodyMapLayers intervals of texel k, from the top; returns their number (0 for
+  // Up to kMaxBodyMapLayers intervals of texel (i, j), from the top; returns their number (0 for
   // background).
-  int TexelIntervals(size_t texel, Interval* intervals) const;
-  // The interval holding z at texel k; the slab itself when no interval does (z in a gap or out).
-  Interval IntervalAt(size_t texel, float z) const;
-  Float3 SlotNormal(size_t texel, int slot) const;
+  int TexelIntervals(uint32_t i, uint32_t j, Interval* intervals) const;
+  // The interval holding z at texel (i, j); the slab itself when no interval does.
+  Interval IntervalAt(uint32_t i, uint32_t j, float z) const;
+  Float3 SlotNormal(uint32_t i, uint32_t j, int slot) const;
+  // Stores dense per-texel gaps (gap_layers_ per texel, texel-major) compactly. Needs width_,
+  // height_ and gap_layers_; sets blocks_w_ and blocks_h_ as Finish does.
+  void PackGaps(const std::vector<Slab>& gaps, const std::vector<TexelNormals>& normals);
 
   static constexpr uint32_t kBlockShift = 3;  // 8x8 texels per min/max block
   static constexpr uint32_t kBlockTexels = 1u << kBlockShift;
@@ -303,7 +316,9 @@ class BodyMapCollider {
   std::vector<uint8_t> bilinear_ok_;   // width*height (kBilinear only): block (i, j)..(i+1, j+1)
   std::vector<BlockBounds> blocks_;    // blocks_w_ * blocks_h_
   uint32_t gap_layers_ = 0;            // BodyMapPose::layers - 1
-  std::vector<Slab> gaps_;             // width*height*gap_layers_, texel-major (see HasGap)
+  std::vector<uint64_t> gap_masks_;    // per 8x8 block (see GapBase); empty without gaps
+  std::vector<uint32_t> gap_block_first_;  // per block: gap texels in the blocks before it
+  std::vector<Slab> gaps_;                 // gap_layers_ per gap texel (see GapBase)
   std::vector<TexelNormals> gap_normals_;  // same index: front = upper, back = lower boundary
 };
 
@@ -340,6 +355,11 @@ class BodyMapSequence {
   size_t memory_bytes() const;
 
  private:
+  // The gaps of the blend of a and b at weight w (of b) into *out, whose slabs are already
+  // blended: see PoseBlend.
+  static void BlendGaps(const BodyMapCollider& a, const BodyMapCollider& b, float w,
+                        BodyMapCollider* out);
+
   std::vector<BodyMapCollider> poses_;
   PoseBlend blend_ = PoseBlend::kNearest;
   BodyMapCollider empty_;
