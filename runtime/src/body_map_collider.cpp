@@ -757,6 +757,10 @@ void BodyMapCollider::PackGaps(const std::vector<Slab>& gaps,
   if (layers == 0) return;
   gap_masks_.assign(static_cast<size_t>(blocks_w_) * blocks_h_, 0);
   gap_block_first_.assign(gap_masks_.size(), 0);
+  size_t with_gaps = 0;  // exact capacity: memory_bytes() reports what the gaps need
+  for (size_t k = 0; k < gaps.size(); k += layers) with_gaps += gaps[k].top > gaps[k].bottom;
+  gaps_.reserve(with_gaps * layers);
+  gap_normals_.reserve(with_gaps * layers);
   uint32_t gap_texels = 0;
   for (size_t bj = 0; bj < blocks_h_; ++bj) {
     for (size_t bi = 0; bi < blocks_w_; ++bi) {
