@@ -33,6 +33,16 @@ bool IsSane(const Float3& v) {
          std::fabs(v.z) <= kMaxCoordinate;
 }
 
+constexpr uint16_t kUnorm16Background = 65535;
+
+// Entry `entry` of a view's depth array holds a surface, not background (a float32 NaN counts
+// as a surface, so that the validator, which refuses NaN, sees it).
+bool HasDepth(const BodyMapPose& p, int view, size_t entry) {
+  if (p.depth_encoding == DepthEncoding::kFloat32)
+    return !(p.depth_f32[view][entry] >= p.depth_range);
+  return p.depth_u16[view][entry] != kUnorm16Background;
+}
+
 class Checker {
  public:
   bool failed() const { return !message_.empty(); }
@@ -176,6 +186,42 @@ void CheckMesh(const MeshData& m, size_t joints, Checker& c) {
   }
 }
 
+// Gap layers (k >= 1, body_map_data.h) where they hold a surface: a gap has both boundaries or
+// neither, and gap k exists only where gap k - 1 does (the slab, in either view, for k = 1). So
+// the row-span layout, whose spans follow the slab alone, keeps every gap. The depth order of the
+// boundaries within a texel is left to the runtime's Build, which reads them decoded. `texels`
+// per layer; `prefix` starts the field names ("body_maps.poses[2]." or "").
+bool CheckGapLayers(const BodyMapPose& p, size_t texels, const std::string& prefix, Checker& c) {
+  const std::string depth =
+      prefix + (p.depth_encoding == DepthEncoding::kFloat32 ? "depth_f32_" : "depth_u16_");
+  for (size_t k = 1; k < p.layers; ++k) {
+    for (size_t n = 0; n < texels; ++n) {
+      const size_t entry = k * texels + n;
+      const bool upper = HasDepth(p, 0, entry);
+      const bool lower = HasDepth(p, 1, entry);
+      const std::string where =
+          "layer " + std::to_string(k) + ", stored texel " + std::to_string(n);
+      if (upper != lower) {
+        return c.Fail(depth + (upper ? "back[" : "front[") + std::to_string(entry) +
+                      "] is background where the other view is not (" + where +
+                      ": a gap has both boundaries or neither)");
+      }
+      if (!upper) continue;
+      const size_t outer = entry - texels;  // the same texel, one layer out
+      const bool enclosed =
+          k == 1 ? HasDepth(p, 0, outer) || HasDepth(p, 1, outer) : HasDepth(p, 0, outer);
+      if (!enclosed) {
+        return c.Fail(depth + "front[" + std::to_string(entry) + "] holds a gap (" + where +
+                      ") where " +
+                      (k == 1 ? std::string("the slab (layer 0) is background")
+                              : "layer " + std::to_string(k - 1) + " holds none") +
+                      " (gaps are nested and filled in order)");
+      }
+    }
+  }
+  return true;
+}
+
 void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
   if (!c.Require(std::isfinite(set.epsilon) && set.epsilon >= 0.f, "body_maps.epsilon",
                  "is negative or not finite"))
@@ -198,27 +244,31 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
         !c.Require(static_cast<uint8_t>(pose.depth_encoding) <= 1, at + ".depth_encoding",
                    "is unknown") ||
         !c.Require(static_cast<uint8_t>(pose.normal_encoding) <= 2, at + ".normal_encoding",
-                   "is unknown"))
+                   "is unknown") ||
+        !c.Require(pose.layers >= 1 && pose.layers <= kMaxBodyMapLayers, at + ".layers",
+                   "= " + std::to_string(pose.layers) + " is not in [1, " +
+                       std::to_string(kMaxBodyMapLayers) + "]"))
       return;
     // The span table before any array size that depends on it (row spans: the spans' total).
     if (const std::string problem = CheckBodyMapLayout(pose); !problem.empty()) {
       c.Fail(at + "." + problem);
       return;
     }
-    const size_t texels = BodyMapStoredTexels(pose);
+    const size_t texels = BodyMapStoredTexels(pose);  // of one layer
+    const size_t entries = texels * pose.layers;      // values of one component, all layers
     const bool f32 = pose.depth_encoding == DepthEncoding::kFloat32;
     for (int view = 0; view < 2; ++view) {
       const std::string v = view == 0 ? "front" : "back";
-      if (!c.Size(pose.depth_f32[view].size(), f32 ? texels : 0, at + ".depth_f32_" + v) ||
-          !c.Size(pose.depth_u16[view].size(), f32 ? 0 : texels, at + ".depth_u16_" + v) ||
+      if (!c.Size(pose.depth_f32[view].size(), f32 ? entries : 0, at + ".depth_f32_" + v) ||
+          !c.Size(pose.depth_u16[view].size(), f32 ? 0 : entries, at + ".depth_u16_" + v) ||
           !c.Size(pose.normal_f32[view].size(),
-                  pose.normal_encoding == NormalEncoding::kFloat32 ? 3 * texels : 0,
+                  pose.normal_encoding == NormalEncoding::kFloat32 ? 3 * entries : 0,
                   at + ".normal_f32_" + v) ||
           !c.Size(pose.normal_oct16[view].size(),
-                  pose.normal_encoding == NormalEncoding::kOct16 ? 2 * texels : 0,
+                  pose.normal_encoding == NormalEncoding::kOct16 ? 2 * entries : 0,
                   at + ".normal_oct16_" + v) ||
           !c.Size(pose.normal_rgb8[view].size(),
-                  pose.normal_encoding == NormalEncoding::kRgb8 ? 3 * texels : 0,
+                  pose.normal_encoding == NormalEncoding::kRgb8 ? 3 * entries : 0,
                   at + ".normal_rgb8_" + v))
         return;
       for (size_t i = 0; i < pose.depth_f32[view].size(); ++i)
@@ -232,6 +282,7 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
                       at + ".normal_f32_" + v + "[" + std::to_string(i) + "]"))
           return;
     }
+    if (!CheckGapLayers(pose, texels, at + ".", c)) return;
   }
 }
 
@@ -366,16 +417,16 @@ Status ValidateAsset(const CharacterAsset& asset) {
 namespace drape {
 namespace {
 
-constexpr uint16_t kUnorm16Background = 65535;
-
 std::string Count(size_t actual, size_t expected, const std::string& field,
                   const std::string& what) {
   return field + " has " + std::to_string(actual) + " elements, expected " + what + " = " +
          std::to_string(expected);
 }
 
-// "" or a message when the arrays of the chosen encodings do not hold `texels` texels each.
-std::string CheckArraySizes(const BodyMapPose& p, size_t texels) {
+// "" or a message when the arrays of the chosen encodings do not hold `texels` texels of each of
+// the pose's layers.
+std::string CheckArraySizes(const BodyMapPose& p, size_t texels_per_layer) {
+  const size_t texels = texels_per_layer * p.layers;
   const bool f32 = p.depth_encoding == DepthEncoding::kFloat32;
   for (int view = 0; view < 2; ++view) {
     const std::string v = view == 0 ? "front" : "back";
@@ -413,11 +464,14 @@ BodyMapPose CopyHeader(const BodyMapPose& in, BodyMapLayout layout) {
   out.depth_encoding = in.depth_encoding;
   out.normal_encoding = in.normal_encoding;
   out.layout = layout;
+  out.layers = in.layers;
   return out;
 }
 
-// Sizes the arrays of the pose's encodings for `texels` texels, all background.
-void AssignBackground(BodyMapPose& p, size_t texels) {
+// Sizes the arrays of the pose's encodings for `texels_per_layer` texels in each of its layers,
+// all background.
+void AssignBackground(BodyMapPose& p, size_t texels_per_layer) {
+  const size_t texels = texels_per_layer * p.layers;
   for (int view = 0; view < 2; ++view) {
     if (p.depth_encoding == DepthEncoding::kFloat32) {
       p.depth_f32[view].assign(texels, p.depth_range);
@@ -438,7 +492,8 @@ void AssignBackground(BodyMapPose& p, size_t texels) {
   }
 }
 
-void CopyTexel(const BodyMapPose& src, size_t from, BodyMapPose& dst, size_t to) {
+// Copies entry `from` of every array of `src` (one texel of one layer) to entry `to` of `dst`.
+void CopyEntry(const BodyMapPose& src, size_t from, BodyMapPose& dst, size_t to) {
   for (int view = 0; view < 2; ++view) {
     if (src.depth_encoding == DepthEncoding::kFloat32) {
       dst.depth_f32[view][to] = src.depth_f32[view][from];
@@ -462,27 +517,36 @@ void CopyTexel(const BodyMapPose& src, size_t from, BodyMapPose& dst, size_t to)
   }
 }
 
-// Depth is not background in either view (NaN counts as valid, so the validator sees it).
+// Stored texels per layer of the source and the destination of a copy: layer k of stored texel
+// n is entry k * texels + n (layer-major).
+struct LayerStrides {
+  size_t src = 0;
+  size_t dst = 0;
+};
+
+// Copies stored texel `from` of `src` to stored texel `to` of `dst`, every layer.
+void CopyTexel(const BodyMapPose& src, size_t from, BodyMapPose& dst, size_t to,
+               LayerStrides texels) {
+  for (size_t k = 0; k < src.layers; ++k)
+    CopyEntry(src, k * texels.src + from, dst, k * texels.dst + to);
+}
+
+// The slab (layer 0, the first `texels` entries) is not background in either view. Gaps lie
+// inside the slab (the validator checks it), so this decides for every layer.
 bool ValidInEitherView(const BodyMapPose& p, size_t index) {
-  for (int view = 0; view < 2; ++view) {
-    if (p.depth_encoding == DepthEncoding::kFloat32) {
-      if (!(p.depth_f32[view][index] >= p.depth_range)) return true;
-    } else if (p.depth_u16[view][index] != kUnorm16Background) {
-      return true;
-    }
-  }
-  return false;
+  return HasDepth(p, 0, index) || HasDepth(p, 1, index);
 }
 
 BodyMapPose ExpandToDense(const BodyMapPose& in) {
   BodyMapPose out = CopyHeader(in, BodyMapLayout::kDense);
-  AssignBackground(out, static_cast<size_t>(in.width) * in.height);
+  const LayerStrides texels{BodyMapStoredTexels(in), static_cast<size_t>(in.width) * in.height};
+  AssignBackground(out, texels.dst);
   for (uint32_t j = 0; j < in.height; ++j) {
     for (uint32_t s = in.row_span_offsets[j]; s < in.row_span_offsets[j + 1]; ++s) {
       const uint32_t length = in.span_texel_offsets[s + 1] - in.span_texel_offsets[s];
       const size_t to = static_cast<size_t>(j) * in.width + in.span_begin[s];
       for (uint32_t t = 0; t < length; ++t)
-        CopyTexel(in, in.span_texel_offsets[s] + t, out, to + t);
+        CopyTexel(in, in.span_texel_offsets[s] + t, out, to + t, texels);
     }
   }
   return out;
@@ -510,13 +574,14 @@ BodyMapPose PackRowSpans(const BodyMapPose& dense) {
     }
     out.row_span_offsets.push_back(static_cast<uint32_t>(out.span_begin.size()));
   }
-  AssignBackground(out, stored);
+  const LayerStrides texels{width * dense.height, stored};
+  AssignBackground(out, texels.dst);
   for (size_t j = 0; j < dense.height; ++j) {
     for (uint32_t s = out.row_span_offsets[j]; s < out.row_span_offsets[j + 1]; ++s) {
       const uint32_t length = out.span_texel_offsets[s + 1] - out.span_texel_offsets[s];
       const size_t from = j * width + out.span_begin[s];
       for (uint32_t t = 0; t < length; ++t)
-        CopyTexel(dense, from + t, out, out.span_texel_offsets[s] + t);
+        CopyTexel(dense, from + t, out, out.span_texel_offsets[s] + t, texels);
     }
   }
   return out;
@@ -613,9 +678,15 @@ Status ConvertBodyMapLayout(const BodyMapPose& in, BodyMapLayout layout, BodyMap
     return invalid("unknown normal encoding");
   if (layout == BodyMapLayout::kRowSpans && in.width > 65536)
     return invalid("width " + std::to_string(in.width) + " exceeds the 65536 of span_begin");
+  if (in.layers < 1 || in.layers > kMaxBodyMapLayers)
+    return invalid("layers = " + std::to_string(in.layers) + " is not in [1, " +
+                   std::to_string(kMaxBodyMapLayers) + "]");
   if (std::string problem = CheckBodyMapLayout(in); !problem.empty()) return invalid(problem);
   if (std::string problem = CheckArraySizes(in, BodyMapStoredTexels(in)); !problem.empty())
     return invalid(problem);
+  // Spans follow the slab alone: a gap outside it would be dropped without a word.
+  if (Checker gaps; !CheckGapLayers(in, BodyMapStoredTexels(in), "", gaps))
+    return invalid(gaps.message());
   if (layout == in.layout) {
     *out = in;
   } else if (layout == BodyMapLayout::kDense) {

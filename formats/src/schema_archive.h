@@ -230,14 +230,20 @@ void serialize(Archive& ar, MeshData& m, const uint32_t version) {
 }
 
 // Version 1 (format version 1): always dense, no layout field and no span table. Version 2
-// (format version 2): `layout` and the span table follow normal_encoding. Writing is always
-// version 2; a version-1 pose loads as dense with an empty span table.
+// (format version 2): `layout` and the span table follow normal_encoding. Version 3 (format
+// version 3): `layers` (uint8) follows `layout`, before the span table. Writing is always
+// version 3; a version-1 pose loads as dense with an empty span table, and versions 1 and 2
+// load with one layer. Format version N holds exactly class version N (what its writer wrote):
+// a newer class in an older format is impossible, an older one in a newer format is a forgery
+// that would not re-encode to the same bytes. A format version that changes another type only
+// must map its own BodyMapPose version here.
 template <class Archive>
 void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
-  detail::CheckVersionRange(version, 1, 2, "BodyMapPose");
+  detail::CheckVersionRange(version, 1, 3, "BodyMapPose");
   if constexpr (Archive::is_loading::value) {
-    if (version == 2 && detail::g_format_version == 1) {
-      throw DecodeError("BodyMapPose version 2 in a format version 1 file");
+    if (detail::g_format_version != 0 && version != detail::g_format_version) {
+      throw DecodeError("BodyMapPose version " + std::to_string(version) + " in a format version " +
+                        std::to_string(detail::g_format_version) + " file");
     }
   }
   ar(cereal::make_nvp("clip", p.clip), cereal::make_nvp("time", p.time),
@@ -249,11 +255,17 @@ void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
      cereal::make_nvp("normal_encoding", p.normal_encoding));
   if (version >= 2) {
     ar(cereal::make_nvp("layout", p.layout));
+    if (version >= 3) {
+      ar(cereal::make_nvp("layers", p.layers));
+    } else {
+      p.layers = 1;
+    }
     Array(ar, "row_span_offsets", p.row_span_offsets);
     Array(ar, "span_begin", p.span_begin);
     Array(ar, "span_texel_offsets", p.span_texel_offsets);
   } else {
     p.layout = BodyMapLayout::kDense;
+    p.layers = 1;
     p.row_span_offsets.clear();
     p.span_begin.clear();
     p.span_texel_offsets.clear();
@@ -336,7 +348,7 @@ CEREAL_CLASS_VERSION(drape::AssetInfo, 1)
 CEREAL_CLASS_VERSION(drape::SkeletonData, 1)
 CEREAL_CLASS_VERSION(drape::ClipData, 1)
 CEREAL_CLASS_VERSION(drape::MeshData, 1)
-CEREAL_CLASS_VERSION(drape::BodyMapPose, 2)  // 2: layout and span table (format 2)
+CEREAL_CLASS_VERSION(drape::BodyMapPose, 3)  // 2: layout, spans (format 2); 3: layers (format 3)
 CEREAL_CLASS_VERSION(drape::BodyMapSet, 1)
 CEREAL_CLASS_VERSION(drape::KirkpatrickHierarchy, 1)
 CEREAL_CLASS_VERSION(drape::MapTableData, 1)

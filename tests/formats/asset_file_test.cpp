@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -341,9 +343,10 @@ TEST(BodyMapLayout, RoundTripKeepsBothLayouts) {
   EXPECT_EQ(spans.depth_f32[0], a.body_maps.poses[1].depth_f32[0]);
   EXPECT_EQ(spans.normal_rgb8[1], a.body_maps.poses[1].normal_rgb8[1]);
   EXPECT_EQ(Encode(b), bytes);
-  // The writer writes format version 2.
-  EXPECT_EQ(bytes[8], 2);
-  EXPECT_EQ(kAssetFormatVersion, 2u);
+  // The writer writes format version 3 (BodyMapPose class version 3, one layer here).
+  EXPECT_EQ(bytes[8], 3);
+  EXPECT_EQ(kAssetFormatVersion, 3u);
+  EXPECT_EQ(spans.layers, 1);
 }
 
 TEST(BodyMapLayout, EveryTruncationAndByteFlipOfASpansFileFailsCleanly) {
@@ -453,17 +456,28 @@ TEST(BodyMapLayout, CorruptSpanTableInAFileIsACorruptError) {
   EXPECT_TRUE(out.body_maps.poses.empty());
 }
 
-// A format version 1 file holds only class version 1: a version 2 pose under a version 1 header
-// is refused, and an older class version of BodyMapPose is read as dense (the golden files).
+// A format version 1 file holds only class version 1: a version 2 or 3 pose under a version 1
+// header is refused, and an older class version of BodyMapPose is read as dense with one layer
+// (the golden files).
 TEST(BodyMapLayout, FormatVersion1HoldsOnlyDensePoses) {
-  std::vector<uint8_t> bytes = Encode(SmallAsset());
+  std::vector<uint8_t> bytes = Encode(SmallAsset());  // BodyMapPose version 3
   bytes[8] = 1;
   FixChecksums(bytes);
   CharacterAsset out;
-  const Status s = DecodeAsset(bytes, "v1.drape", &out);
+  Status s = DecodeAsset(bytes, "v1.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("BodyMapPose version 3 in a format version 1 file"), std::string::npos)
+      << s.message();
+  // mannequin_v2.drape holds a BodyMapPose version 2: under a version 1 header it is refused too.
+  bytes = ReadBytes(test::GoldenDir() + "/mannequin_v2.drape");
+  ASSERT_GT(bytes.size(), kAssetHeaderSize);
+  bytes[8] = 1;
+  FixChecksums(bytes);
+  s = DecodeAsset(bytes, "v1.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
   EXPECT_NE(s.message().find("BodyMapPose version 2 in a format version 1 file"), std::string::npos)
       << s.message();
+  EXPECT_TRUE(out.body_maps.poses.empty());
   // mannequin_colliders_v1.drape was written by the format version 1 writer with a body-map pose.
   CharacterAsset golden;
   const Status g = ReadAssetFile(test::GoldenDir() + "/mannequin_colliders_v1.drape", &golden);
@@ -471,15 +485,393 @@ TEST(BodyMapLayout, FormatVersion1HoldsOnlyDensePoses) {
   ASSERT_EQ(golden.body_maps.poses.size(), 1u);
   const BodyMapPose& pose = golden.body_maps.poses[0];
   EXPECT_EQ(pose.layout, BodyMapLayout::kDense);
+  EXPECT_EQ(pose.layers, 1);
   EXPECT_TRUE(pose.row_span_offsets.empty() && pose.span_begin.empty());
   EXPECT_EQ(BodyMapStoredTexels(pose), static_cast<size_t>(pose.width) * pose.height);
   EXPECT_EQ(pose.depth_u16[0].size(), static_cast<size_t>(pose.width) * pose.height);
 }
 
+// --- Depth layers (BodyMapPose class version 3, format version 3) ----------------------------
+
+// The slab and the gaps of LayeredDensePose, a 5 x 3 rectangle (row 0 first): 'X' slab only,
+// '1' slab and gap 1, '2' slab and gaps 1 and 2, '.' background in every layer.
+constexpr const char* kLayeredTexels =
+    "X21.X"
+    ".X12."
+    "2X...";
+
+// Depth of `view` in layer k at dense texel n, in metres from that view's camera: boundaries in
+// the order top > upper_1 > lower_1 > upper_2 > lower_2 > bottom (depth_range 1, so the back
+// depth d is at z = front_z - 1 + d). Distinct per texel, so a misplaced value shows.
+float LayerDepth(int view, size_t k, size_t n) {
+  static const float kFront[3] = {0.10f, 0.30f, 0.50f};
+  static const float kBack[3] = {0.10f, 0.60f, 0.40f};
+  return (view == 0 ? kFront[k] : kBack[k]) + 0.001f * static_cast<float>(n);
+}
+
+// Layer k holds a surface at dense texel n.
+bool HasLayer(size_t k, size_t n) {
+  const char c = kLayeredTexels[n];
+  return k == 0 ? c != '.' : (c == '2' || (c == '1' && k == 1));
+}
+
+// A dense pose with `layers` layers (1 to 3) of the texels above, in the given encodings;
+// background values everywhere a layer has no surface (as the bake writes).
+BodyMapPose LayeredDensePose(DepthEncoding depth, NormalEncoding normal, uint8_t layers) {
+  BodyMapPose p;
+  p.clip = 0;
+  p.time = 0.05f;
+  p.width = 5;
+  p.height = 3;
+  p.origin_x = -0.3f;
+  p.origin_y = 0.25f;
+  p.texel_size = 0.125f;
+  p.front_z = 0.5f;
+  p.depth_range = 1.f;
+  p.depth_encoding = depth;
+  p.normal_encoding = normal;
+  p.layers = layers;
+  const size_t texels = 15;
+  const size_t entries = texels * layers;
+  for (int v = 0; v < 2; ++v) {
+    if (depth == DepthEncoding::kFloat32) {
+      p.depth_f32[v].assign(entries, p.depth_range);
+    } else {
+      p.depth_u16[v].assign(entries, 65535);
+    }
+    p.normal_f32[v].assign(normal == NormalEncoding::kFloat32 ? 3 * entries : 0, 0.f);
+    p.normal_oct16[v].assign(normal == NormalEncoding::kOct16 ? 2 * entries : 0, 0);
+    p.normal_rgb8[v].assign(normal == NormalEncoding::kRgb8 ? 3 * entries : 0, 0);
+    for (size_t k = 0; k < layers; ++k) {
+      for (size_t n = 0; n < texels; ++n) {
+        if (!HasLayer(k, n)) continue;
+        const size_t e = k * texels + n;
+        const float d = LayerDepth(v, k, n);
+        if (depth == DepthEncoding::kFloat32) {
+          p.depth_f32[v][e] = d;
+        } else {
+          p.depth_u16[v][e] = static_cast<uint16_t>(std::lround(d * 65535.f));
+        }
+        const size_t code = 40 * k + 2 * n + static_cast<size_t>(v);  // < 256, distinct
+        for (size_t c = 0; c < 3; ++c) {
+          if (normal == NormalEncoding::kFloat32)
+            p.normal_f32[v][3 * e + c] = 0.001f * static_cast<float>(code + c);
+          if (normal == NormalEncoding::kRgb8)
+            p.normal_rgb8[v][3 * e + c] = static_cast<uint8_t>(code + c);
+          if (normal == NormalEncoding::kOct16 && c < 2)
+            p.normal_oct16[v][2 * e + c] = static_cast<uint16_t>(500 * code + c);
+        }
+      }
+    }
+  }
+  return p;
+}
+
+// Every per-texel array and the span table of two poses are equal.
+void ExpectSameMaps(const BodyMapPose& a, const BodyMapPose& b) {
+  EXPECT_EQ(a.layout, b.layout);
+  EXPECT_EQ(a.layers, b.layers);
+  EXPECT_EQ(a.row_span_offsets, b.row_span_offsets);
+  EXPECT_EQ(a.span_begin, b.span_begin);
+  EXPECT_EQ(a.span_texel_offsets, b.span_texel_offsets);
+  for (int v = 0; v < 2; ++v) {
+    EXPECT_EQ(a.depth_f32[v], b.depth_f32[v]) << "view " << v;
+    EXPECT_EQ(a.depth_u16[v], b.depth_u16[v]) << "view " << v;
+    EXPECT_EQ(a.normal_f32[v], b.normal_f32[v]) << "view " << v;
+    EXPECT_EQ(a.normal_oct16[v], b.normal_oct16[v]) << "view " << v;
+    EXPECT_EQ(a.normal_rgb8[v], b.normal_rgb8[v]) << "view " << v;
+  }
+}
+
+// SmallAsset plus a three-layer pose of the texels above, in row spans, float32 depth and oct16
+// normals.
+CharacterAsset LayeredAsset() {
+  CharacterAsset a = SmallAsset();
+  BodyMapPose spans;
+  const Status s =
+      ConvertBodyMapLayout(LayeredDensePose(DepthEncoding::kFloat32, NormalEncoding::kOct16, 3),
+                           BodyMapLayout::kRowSpans, &spans);
+  EXPECT_TRUE(s.ok()) << s.message();
+  a.body_maps.poses.push_back(spans);
+  return a;
+}
+
+TEST(BodyMapLayers, ThreeLayersRoundTripInEveryEncodingAndBothLayouts) {
+  const DepthEncoding depths[2] = {DepthEncoding::kFloat32, DepthEncoding::kUnorm16};
+  const NormalEncoding normals[3] = {NormalEncoding::kFloat32, NormalEncoding::kOct16,
+                                     NormalEncoding::kRgb8};
+  for (DepthEncoding depth : depths) {
+    for (NormalEncoding normal : normals) {
+      for (BodyMapLayout layout : {BodyMapLayout::kDense, BodyMapLayout::kRowSpans}) {
+        SCOPED_TRACE(testing::Message() << "depth " << int(depth) << ", normal " << int(normal)
+                                        << ", layout " << int(layout));
+        BodyMapPose pose;
+        ASSERT_TRUE(ConvertBodyMapLayout(LayeredDensePose(depth, normal, 3), layout, &pose).ok());
+        CharacterAsset a = SmallAsset();
+        a.body_maps.poses.push_back(pose);
+        const std::vector<uint8_t> bytes = Encode(a);
+        CharacterAsset b;
+        const Status s = DecodeAsset(bytes, "layers.drape", &b);
+        ASSERT_TRUE(s.ok()) << s.message();
+        EXPECT_EQ(AssetToJson(a), AssetToJson(b));
+        ASSERT_EQ(b.body_maps.poses.size(), 2u);
+        EXPECT_EQ(b.body_maps.poses[0].layers, 1);
+        const BodyMapPose& back = b.body_maps.poses[1];
+        EXPECT_EQ(back.layers, 3);
+        ExpectSameMaps(back, pose);
+        // Gap 2 at texel (0, 2) (dense texel 10), front view: entry 2 * stored + index.
+        const size_t stored = BodyMapStoredTexels(back);
+        EXPECT_EQ(stored, layout == BodyMapLayout::kDense ? 15u : 9u);
+        const int64_t index = BodyMapTexelIndex(back, 0, 2);
+        ASSERT_GE(index, 0);
+        const size_t entry = 2 * stored + static_cast<size_t>(index);
+        if (depth == DepthEncoding::kFloat32) {
+          EXPECT_EQ(back.depth_f32[0].size(), 3 * stored);
+          EXPECT_EQ(back.depth_f32[0][entry], LayerDepth(0, 2, 10));
+        } else {
+          EXPECT_EQ(back.depth_u16[1].size(), 3 * stored);
+          EXPECT_EQ(back.depth_u16[1][entry], std::lround(LayerDepth(1, 2, 10) * 65535.f));
+        }
+        EXPECT_EQ(Encode(b), bytes) << "the writer is deterministic";
+      }
+    }
+  }
+}
+
+// docs/FORMAT.md: `layers` is one byte right after `layout`, before the span table.
+TEST(BodyMapLayers, LayersFollowLayoutBeforeTheSpanTable) {
+  const std::vector<uint8_t> bytes = Encode(LayeredAsset());
+  // texel_size, front_z, depth_range (float32), the encodings, layout (row spans), layers, then
+  // row_span_offsets' uint64 count (height + 1 = 4).
+  const std::vector<uint8_t> pattern = {
+      0, 0, 0, 0x3E, 0, 0, 0, 0x3F, 0, 0, 0x80, 0x3F,  // 0.125f, 0.5f, 1.f, little-endian
+      0, 1, 1, 3,    4, 0, 0, 0,    0, 0, 0,    0};
+  const auto found = std::search(bytes.begin(), bytes.end(), pattern.begin(), pattern.end());
+  ASSERT_NE(found, bytes.end());
+  // The byte is the field: 3 -> 2 with the arrays left at three layers is refused by size.
+  std::vector<uint8_t> bad = bytes;
+  bad[static_cast<size_t>(found - bytes.begin()) + 15] = 2;
+  FixChecksums(bad);
+  CharacterAsset out;
+  const Status s = DecodeAsset(bad, "layers.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("body_maps.poses[1].depth_f32_front has 27 elements, expected 18"),
+            std::string::npos)
+      << s.message();
+}
+
+TEST(BodyMapLayers, LayerCountOutsideOneToFourIsRefusedNamingTheField) {
+  const CharacterAsset good = LayeredAsset();
+  ASSERT_TRUE(ValidateAsset(good).ok()) << ValidateAsset(good).message();
+  for (uint8_t layers : {uint8_t{0}, uint8_t{5}}) {
+    CharacterAsset a = good;
+    a.body_maps.poses[1].layers = layers;
+    const std::string expected =
+        "body_maps.poses[1].layers = " + std::to_string(layers) + " is not in [1, 4]";
+    const Status v = ValidateAsset(a);
+    EXPECT_EQ(v.message(), expected);
+    std::vector<uint8_t> refused;
+    EXPECT_FALSE(EncodeAsset(a, &refused).ok()) << "the writer must refuse layers " << int(layers);
+    BodyMapPose converted;
+    const Status c = ConvertBodyMapLayout(a.body_maps.poses[1], BodyMapLayout::kDense, &converted);
+    EXPECT_EQ(c.code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(c.message().find("layers = " + std::to_string(layers)), std::string::npos)
+        << c.message();
+  }
+  // The same in a file with valid checksums: a corrupt error naming the field.
+  const std::vector<uint8_t> bytes = Encode(good);
+  const std::vector<uint8_t> pattern = {0, 1, 1, 3, 4, 0, 0, 0, 0, 0, 0, 0};  // encodings..count
+  const auto found = std::search(bytes.begin(), bytes.end(), pattern.begin(), pattern.end());
+  ASSERT_NE(found, bytes.end());
+  for (uint8_t layers : {uint8_t{0}, uint8_t{5}}) {
+    std::vector<uint8_t> bad = bytes;
+    bad[static_cast<size_t>(found - bytes.begin()) + 3] = layers;
+    FixChecksums(bad);
+    CharacterAsset out;
+    const Status s = DecodeAsset(bad, "layers.drape", &out);
+    EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+    EXPECT_EQ(s.message(), "layers.drape: body_maps.poses[1].layers = " + std::to_string(layers) +
+                               " is not in [1, 4]");
+    EXPECT_TRUE(out.body_maps.poses.empty());
+  }
+}
+
+TEST(BodyMapLayers, ArraysSizedForAnotherLayerCountAreRefusedNamingTheArray) {
+  const CharacterAsset good = LayeredAsset();  // 9 stored texels, 3 layers
+  const auto expect = [](const CharacterAsset& a, const std::string& text) {
+    const Status s = ValidateAsset(a);
+    EXPECT_NE(s.message().find(text), std::string::npos) << s.message();
+    std::vector<uint8_t> bytes;
+    EXPECT_FALSE(EncodeAsset(a, &bytes).ok()) << "the writer must refuse it: " << text;
+  };
+  const std::string at = "body_maps.poses[1].";
+  CharacterAsset a = good;
+  a.body_maps.poses[1].layers = 2;  // the arrays hold three
+  expect(a, at + "depth_f32_front has 27 elements, expected 18");
+  a = good;
+  a.body_maps.poses[1].layers = 4;
+  expect(a, at + "depth_f32_front has 27 elements, expected 36");
+  a = good;
+  a.body_maps.poses[1].depth_f32[1].resize(18);  // back depth of two layers only
+  expect(a, at + "depth_f32_back has 18 elements, expected 27");
+  a = good;
+  a.body_maps.poses[1].normal_oct16[1].resize(2 * 9);  // one layer of normals
+  expect(a, at + "normal_oct16_back has 18 elements, expected 54");
+  // Dense: 15 texels a layer.
+  CharacterAsset dense = SmallAsset();
+  dense.body_maps.poses.push_back(
+      LayeredDensePose(DepthEncoding::kUnorm16, NormalEncoding::kRgb8, 2));
+  ASSERT_TRUE(ValidateAsset(dense).ok()) << ValidateAsset(dense).message();
+  dense.body_maps.poses[1].normal_rgb8[0].resize(3 * 15);
+  expect(dense, at + "normal_rgb8_front has 45 elements, expected 90");
+}
+
+// Gaps hold a surface in both views or neither, and only where the layer outside them does:
+// otherwise the row spans, which follow the slab, would lose them.
+TEST(BodyMapLayers, GapsOutsideTheSlabOrOutOfOrderAreRefused) {
+  const auto expect = [](const BodyMapPose& pose, const std::string& text) {
+    CharacterAsset a = SmallAsset();
+    a.body_maps.poses.push_back(pose);
+    const Status s = ValidateAsset(a);
+    EXPECT_NE(s.message().find("body_maps.poses[1]." + text), std::string::npos) << s.message();
+    BodyMapPose converted;
+    const Status c = ConvertBodyMapLayout(pose, BodyMapLayout::kRowSpans, &converted);
+    EXPECT_NE(c.message().find(text), std::string::npos) << c.message();
+  };
+  const BodyMapPose good = LayeredDensePose(DepthEncoding::kFloat32, NormalEncoding::kFloat32, 3);
+  BodyMapPose p = good;
+  p.depth_f32[1][15 + 1] = p.depth_range;  // gap 1 at texel 1: upper boundary only
+  expect(p,
+         "depth_f32_back[16] is background where the other view is not (layer 1, stored "
+         "texel 1: a gap has both boundaries or neither)");
+  p = good;
+  p.depth_f32[0][15 + 3] = 0.3f;  // gap 1 at texel 3, where there is no slab
+  p.depth_f32[1][15 + 3] = 0.6f;
+  expect(p,
+         "depth_f32_front[18] holds a gap (layer 1, stored texel 3) where the slab (layer 0) "
+         "is background");
+  p = good;
+  p.depth_f32[0][30 + 0] = 0.5f;  // gap 2 at texel 0, which has no gap 1
+  p.depth_f32[1][30 + 0] = 0.4f;
+  expect(p, "depth_f32_front[30] holds a gap (layer 2, stored texel 0) where layer 1 holds none");
+  // unorm16 background is 65535.
+  BodyMapPose u = LayeredDensePose(DepthEncoding::kUnorm16, NormalEncoding::kOct16, 2);
+  u.depth_u16[0][15 + 2] = 65535;  // gap 1 at texel 2: lower boundary only
+  expect(u, "depth_u16_front[17] is background where the other view is not");
+}
+
+// Spans are decided by the slab alone and carry every layer of each kept texel; dense -> spans
+// -> dense gives back the same arrays. A two-layer pose with a gap on some texels only.
+TEST(BodyMapLayers, ConvertKeepsEveryLayerBothWays) {
+  for (DepthEncoding depth : {DepthEncoding::kFloat32, DepthEncoding::kUnorm16}) {
+    SCOPED_TRACE(int(depth));
+    const BodyMapPose dense = LayeredDensePose(depth, NormalEncoding::kRgb8, 2);
+    BodyMapPose spans;
+    ASSERT_TRUE(ConvertBodyMapLayout(dense, BodyMapLayout::kRowSpans, &spans).ok());
+    EXPECT_EQ(spans.layers, 2);
+    // The same spans as the slab alone: the gaps do not change which texels are stored.
+    BodyMapPose slab_only;
+    ASSERT_TRUE(ConvertBodyMapLayout(LayeredDensePose(depth, NormalEncoding::kRgb8, 1),
+                                     BodyMapLayout::kRowSpans, &slab_only)
+                    .ok());
+    EXPECT_EQ(spans.row_span_offsets, slab_only.row_span_offsets);
+    EXPECT_EQ(spans.span_begin, slab_only.span_begin);
+    EXPECT_EQ(spans.span_texel_offsets, (std::vector<uint32_t>{0, 3, 4, 7, 9}));
+    const size_t stored = BodyMapStoredTexels(spans);
+    ASSERT_EQ(stored, 9u);
+    EXPECT_EQ(spans.normal_rgb8[0].size(), 3 * 2 * stored);
+    // Layer 1 of texel (3, 1) (dense 8, gap 1) and of texel (1, 1) (dense 6, slab only).
+    const size_t gap = stored + static_cast<size_t>(BodyMapTexelIndex(spans, 3, 1));
+    const size_t no_gap = stored + static_cast<size_t>(BodyMapTexelIndex(spans, 1, 1));
+    EXPECT_EQ(spans.normal_rgb8[1][3 * gap + 2], 40 + 2 * 8 + 1 + 2);
+    EXPECT_EQ(spans.normal_rgb8[1][3 * no_gap], 0);
+    if (depth == DepthEncoding::kFloat32) {
+      EXPECT_EQ(spans.depth_f32[1][gap], LayerDepth(1, 1, 8));
+      EXPECT_EQ(spans.depth_f32[1][no_gap], spans.depth_range);
+    } else {
+      EXPECT_EQ(spans.depth_u16[1][no_gap], 65535);
+    }
+    BodyMapPose back;
+    ASSERT_TRUE(ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &back).ok());
+    EXPECT_TRUE(back.row_span_offsets.empty());
+    ExpectSameMaps(back, dense);
+  }
+}
+
+// Files of format versions 1 and 2 load with one layer; a BodyMapPose version 3 cannot be in
+// them.
+TEST(BodyMapLayers, OlderFormatsLoadWithOneLayerAndCannotHoldLayers) {
+  CharacterAsset v2;
+  ASSERT_TRUE(ReadAssetFile(test::GoldenDir() + "/mannequin_v2.drape", &v2).ok());
+  ASSERT_EQ(v2.body_maps.poses.size(), 1u);
+  EXPECT_EQ(v2.body_maps.poses[0].layers, 1);
+  // Written again as format version 3, it reads the same.
+  CharacterAsset again;
+  ASSERT_TRUE(DecodeAsset(Encode(v2), "v3.drape", &again).ok());
+  EXPECT_EQ(AssetToJson(again), AssetToJson(v2));
+  // A version 3 pose under a format version 2 header.
+  std::vector<uint8_t> bytes = Encode(LayeredAsset());
+  bytes[8] = 2;
+  FixChecksums(bytes);
+  CharacterAsset out;
+  const Status s = DecodeAsset(bytes, "v2.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(), "v2.drape: BodyMapPose version 3 in a format version 2 file");
+  EXPECT_TRUE(out.body_maps.poses.empty());
+}
+
+// A format version holds exactly its own BodyMapPose version. SmallAsset's pose rewritten as
+// class version 2 (the layers byte removed) is a valid format version 2 file, and refused under
+// a format version 3 header: no writer wrote it, and it would not re-encode to the same bytes.
+TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
+  const CharacterAsset small = SmallAsset();
+  std::vector<uint8_t> bytes = Encode(small);
+  // Class version 3, clip -1, time 0, width 2, height 2 (the pose's first fields).
+  // clang-format off
+  const std::vector<uint8_t> start = {3, 0, 0, 0,  0xFF, 0xFF, 0xFF, 0xFF,  0, 0, 0, 0,
+                                      2, 0, 0, 0,  2, 0, 0, 0};
+  // clang-format on
+  const auto found = std::search(bytes.begin(), bytes.end(), start.begin(), start.end());
+  ASSERT_NE(found, bytes.end());
+  const size_t pose = static_cast<size_t>(found - bytes.begin());
+  // 4 class version, 36 of clip .. depth_range, 2 encodings, 1 layout: then layers.
+  const size_t layers_at = pose + 4 + 36 + 2 + 1;
+  ASSERT_EQ(bytes[layers_at], 1);
+  bytes[pose] = 2;
+  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(layers_at));
+  const uint64_t payload = bytes.size() - kAssetHeaderSize;
+  for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
+  bytes[8] = 2;
+  FixChecksums(bytes);
+  CharacterAsset v2;
+  const Status read = DecodeAsset(bytes, "v2.drape", &v2);
+  ASSERT_TRUE(read.ok()) << read.message();
+  EXPECT_EQ(v2.body_maps.poses[0].layers, 1);
+  EXPECT_EQ(AssetToJson(v2), AssetToJson(small));
+  bytes[8] = 3;
+  FixChecksums(bytes);
+  CharacterAsset out;
+  const Status s = DecodeAsset(bytes, "v3.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(), "v3.drape: BodyMapPose version 2 in a format version 3 file");
+  EXPECT_TRUE(out.body_maps.poses.empty());
+}
+
+TEST(BodyMapLayers, EveryTruncationOfALayeredFileFailsCleanly) {
+  const std::vector<uint8_t> bytes = Encode(LayeredAsset());
+  for (size_t length = 0; length < bytes.size(); ++length) {
+    CharacterAsset out;
+    const Status s = DecodeAsset({bytes.data(), length}, "cut.drape", &out);
+    ASSERT_FALSE(s.ok()) << "length " << length;
+    EXPECT_TRUE(out.body_maps.poses.empty()) << "half-loaded at length " << length;
+  }
+}
+
 // The committed golden files of every format version this build reads load with their known
-// content: mannequin_v1.drape (format 1, every class at version 1) and mannequin_v2.drape
-// (format 2: BodyMapPose version 2, a row-span pose). Every truncation fails cleanly; flips are
-// tried on every header byte and spread over the payload.
+// content: mannequin_v1.drape (format 1, every class at version 1), mannequin_v2.drape (format 2:
+// BodyMapPose version 2, a row-span pose) and mannequin_v3.drape (format 3: BodyMapPose version
+// 3, four layers). Every truncation fails cleanly; flips are tried on every header byte and
+// spread over the payload.
 void ExpectMannequinContent(const CharacterAsset& a) {
   EXPECT_EQ(a.info.source_name, "mannequin.gltf");
   ASSERT_EQ(a.skeleton.joint_count(), 17u);
@@ -521,6 +913,7 @@ TEST(GoldenFile, MannequinVersion2LoadsWithExpectedContent) {
   EXPECT_EQ(a.body_maps.resolution, 64u);
   const BodyMapPose& pose = a.body_maps.poses[0];
   EXPECT_EQ(pose.layout, BodyMapLayout::kRowSpans);
+  EXPECT_EQ(pose.layers, 1);
   EXPECT_EQ(pose.width, 54u);
   EXPECT_EQ(pose.height, 66u);
   EXPECT_EQ(BodyMapStoredTexels(pose), 744u);
@@ -531,8 +924,48 @@ TEST(GoldenFile, MannequinVersion2LoadsWithExpectedContent) {
   EXPECT_TRUE(a.hulls.empty());
 }
 
+// tests/golden/mannequin_v3.json: version 2's bake with maps.layers = 4. Written once by the
+// format version 3 writer; never regenerated. The mannequin's rest pose has no air gap along z
+// at N = 64 (A-pose: the arms are clear of the torso's sides), so layers 1 to 3 are background
+// throughout: the file tests the layer-major arrays, the BodyMapLayers tests above the gap values.
+// Layer 0 is version 2's pose, texel for texel.
+TEST(GoldenFile, MannequinVersion3LoadsWithExpectedContent) {
+  CharacterAsset a;
+  ASSERT_NO_FATAL_FAILURE(ReadGoldenFile("mannequin_v3.drape", 3, &a));
+  ExpectMannequinContent(a);
+  ASSERT_EQ(a.body_maps.poses.size(), 1u);
+  EXPECT_EQ(a.body_maps.resolution, 64u);
+  const BodyMapPose& pose = a.body_maps.poses[0];
+  EXPECT_EQ(pose.layout, BodyMapLayout::kRowSpans);
+  EXPECT_EQ(pose.layers, 4);
+  EXPECT_EQ(pose.width, 54u);
+  EXPECT_EQ(pose.height, 66u);
+  const size_t stored = BodyMapStoredTexels(pose);
+  EXPECT_EQ(stored, 744u);
+  ASSERT_EQ(pose.depth_u16[0].size(), 4u * 744u);
+  ASSERT_EQ(pose.normal_oct16[1].size(), 2u * 4u * 744u);
+  EXPECT_EQ(a.joint_spheres.size(), 16u);
+  EXPECT_TRUE(a.hulls.empty());
+  CharacterAsset v2;
+  ASSERT_NO_FATAL_FAILURE(ReadGoldenFile("mannequin_v2.drape", 2, &v2));
+  const BodyMapPose& slab = v2.body_maps.poses[0];
+  EXPECT_EQ(pose.span_texel_offsets, slab.span_texel_offsets);
+  for (int view = 0; view < 2; ++view) {
+    const std::vector<uint16_t>& depth = pose.depth_u16[view];
+    const std::vector<uint16_t>& normal = pose.normal_oct16[view];
+    EXPECT_TRUE(std::equal(slab.depth_u16[view].begin(), slab.depth_u16[view].end(), depth.begin()))
+        << "layer 0 of view " << view;
+    EXPECT_TRUE(std::all_of(depth.begin() + static_cast<std::ptrdiff_t>(stored), depth.end(),
+                            [](uint16_t d) { return d == 65535; }))
+        << "gap depths of view " << view;
+    EXPECT_TRUE(std::all_of(normal.begin() + static_cast<std::ptrdiff_t>(2 * stored), normal.end(),
+                            [](uint16_t n) { return n == 0; }))
+        << "gap normals of view " << view;
+  }
+}
+
 TEST(GoldenFile, EveryTruncationAndSampledFlipsFail) {
-  for (const char* name : {"/mannequin_v1.drape", "/mannequin_v2.drape"}) {
+  for (const char* name : {"/mannequin_v1.drape", "/mannequin_v2.drape", "/mannequin_v3.drape"}) {
     SCOPED_TRACE(name);
     const std::vector<uint8_t> bytes = ReadBytes(test::GoldenDir() + name);
     ASSERT_GT(bytes.size(), kAssetHeaderSize);

@@ -15,8 +15,10 @@
 namespace drape {
 
 // The version the writer writes. 2: BodyMapPose class version 2 (layout and row spans).
-inline constexpr uint32_t kAssetFormatVersion = 2;
-// The oldest version the loader still reads (1: every class at version 1, body maps dense).
+// 3: BodyMapPose class version 3 (depth layers: the slab and up to three air gaps per texel).
+inline constexpr uint32_t kAssetFormatVersion = 3;
+// The oldest version the loader still reads (1: every class at version 1, body maps dense; the
+// loader reads every version from this one to kAssetFormatVersion).
 inline constexpr uint32_t kOldestAssetFormatVersion = 1;
 inline constexpr size_t kAssetHeaderSize = 32;
 
