@@ -135,7 +135,11 @@ Status BakeMaps(const BakeConfig& config, const Regions& regions, const Characte
          {"render_ms_front", stats.render_ms_front},
          {"render_ms_back", stats.render_ms_back},
          {"renderer", stats.renderer},
-         {"silhouette_conflicts", stats.silhouette_conflicts}});
+         {"silhouette_conflicts", stats.silhouette_conflicts},
+         {"layers", stats.layers},
+         {"gap_texels", stats.gap_texels},
+         {"dropped_gaps", stats.dropped_gaps},
+         {"gap_ms", stats.gap_ms}});
   }
   return Status::Ok();
 }

@@ -44,4 +44,38 @@ void RasterizeViewCpu(const MapRasterInput& input, int view, MapViewImage* image
 // RasterizeViewCpu() calls: the edge tests, most of the work, run once for both.
 void RasterizeViewsCpu(const MapRasterInput& input, MapViewImage images[2]);
 
+// Every fragment of the raster rectangle (the gap layers of body_map_baker.h step 8): for each
+// texel, every triangle that covers its centre, with the coverage rule and the barycentric depth
+// of RasterizeViewCpu() (the same code), so a texel's nearest fragment is exactly the depth and
+// triangle view 0 keeps. Texel n = j * width + i owns entries [offsets[n], offsets[n + 1]).
+struct MapFragments {
+  std::vector<uint32_t> offsets;   // width * height + 1 entries, from 0, non-decreasing
+  std::vector<double> depth;       // metres from the front (view 0) plane, as RasterizeViewCpu
+  std::vector<uint32_t> triangle;  // the covering triangle; a texel's entries ascend by it
+  // +1 where the triangle's geometric normal has z > 0 (counter-clockwise in the window: a ray
+  // along -z enters the body there), -1 where z < 0 (it leaves). Computed from the sign of the
+  // twice signed window area, the normal's z up to the positive factor 1 / texel_size^2; a
+  // triangle with zero window area covers no texel centre, so no fragment has normal z = 0.
+  std::vector<int8_t> facing;
+};
+
+// Fills *fragments (resizing its vectors; reused storage is not reallocated when big enough),
+// keeping only the texels covered by at least `min_fragments` triangles (the others get an empty
+// range; 1 keeps every fragment). Two passes over the triangles: count per texel, prefix sum,
+// fill. Single-threaded and deterministic: the order within a texel is the triangle order.
+// Returns false (and *fragments unspecified) when the kept fragments would exceed 2^32 - 1.
+bool CollectFragmentsCpu(const MapRasterInput& input, uint32_t min_fragments,
+                         MapFragments* fragments);
+
+// The depth in view `view` of triangle `triangle` at the centre of texel (i, j), bit-identical to
+// the value the rasterizer computes there (meaningful where the triangle covers that centre).
+double FragmentDepth(const MapRasterInput& input, int view, uint32_t triangle, uint32_t i,
+                     uint32_t j);
+
+// The normal rule of RasterizeViewCpu() for triangle `triangle` at the centre of texel (i, j):
+// vertex normals interpolated with the clamped barycentrics, else the offset triangle's face
+// normal, else (0, 0, fallback_z); unit length.
+void FragmentNormal(const MapRasterInput& input, uint32_t triangle, uint32_t i, uint32_t j,
+                    double fallback_z, float normal[3]);
+
 }  // namespace drape::bake

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "drape/bake/body_map_baker.h"
@@ -46,43 +47,67 @@ Status WritePreviewPng(const std::string& path, uint32_t width, uint32_t height,
   return Status::Ok();
 }
 
+namespace {
+
+// Grey: the valid depth range of one view and layer stretched to 255 (nearest) .. 40 (farthest),
+// so that background (0) stays distinguishable from the farthest surface. `colour`, when not
+// null, receives the normals as (n*0.5+0.5)*255.
+std::vector<uint8_t> DepthPreview(const BodyMapPose& pose, int view, uint32_t layer,
+                                  std::vector<uint8_t>* colour) {
+  const size_t texels = static_cast<size_t>(pose.width) * pose.height;
+  float near_depth = pose.depth_range, far_depth = 0.f;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const BodyMapTexel texel = ReadBodyMapTexel(pose, view, i, j, layer);
+      if (!texel.valid) continue;
+      near_depth = std::min(near_depth, texel.depth);
+      far_depth = std::max(far_depth, texel.depth);
+    }
+  }
+  const float span = std::max(far_depth - near_depth, 1e-9f);
+  std::vector<uint8_t> grey(texels, 0);
+  if (colour != nullptr) colour->assign(3 * texels, 0);
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const BodyMapTexel texel = ReadBodyMapTexel(pose, view, i, j, layer);
+      if (!texel.valid) continue;
+      const size_t index = static_cast<size_t>(j) * pose.width + i;
+      const float shade = 255.f - 215.f * (texel.depth - near_depth) / span;
+      grey[index] = static_cast<uint8_t>(std::lround(std::clamp(shade, 0.f, 255.f)));
+      if (colour != nullptr) EncodeNormalRgb8(texel.normal, &(*colour)[3 * index]);
+    }
+  }
+  return grey;
+}
+
+}  // namespace
+
 Status WriteBodyMapPreview(const BodyMapPose& pose, const std::string& directory,
                            const std::string& prefix) {
   if (pose.width == 0 || pose.height == 0 || !(pose.depth_range > 0.f)) {
     return Status(StatusCode::kInvalidArgument,
                   "WriteBodyMapPreview: the pose '" + prefix + "' holds no maps");
   }
-  const size_t texels = static_cast<size_t>(pose.width) * pose.height;
   const char* view_names[2] = {"front", "back"};
   for (int view = 0; view < 2; ++view) {
-    // Grey: the valid depth range of this view stretched to 255 (nearest) .. 40 (farthest), so
-    // that background (0) stays distinguishable from the farthest surface.
-    float near_depth = pose.depth_range, far_depth = 0.f;
-    for (uint32_t j = 0; j < pose.height; ++j) {
-      for (uint32_t i = 0; i < pose.width; ++i) {
-        const BodyMapTexel texel = ReadBodyMapTexel(pose, view, i, j);
-        if (!texel.valid) continue;
-        near_depth = std::min(near_depth, texel.depth);
-        far_depth = std::max(far_depth, texel.depth);
-      }
-    }
-    const float span = std::max(far_depth - near_depth, 1e-9f);
-    std::vector<uint8_t> grey(texels, 0), colour(3 * texels, 0);
-    for (uint32_t j = 0; j < pose.height; ++j) {
-      for (uint32_t i = 0; i < pose.width; ++i) {
-        const BodyMapTexel texel = ReadBodyMapTexel(pose, view, i, j);
-        if (!texel.valid) continue;
-        const size_t index = static_cast<size_t>(j) * pose.width + i;
-        const float shade = 255.f - 215.f * (texel.depth - near_depth) / span;
-        grey[index] = static_cast<uint8_t>(std::lround(std::clamp(shade, 0.f, 255.f)));
-        EncodeNormalRgb8(texel.normal, &colour[3 * index]);
-      }
-    }
+    std::vector<uint8_t> colour;
+    const std::vector<uint8_t> grey = DepthPreview(pose, view, 0, &colour);
     const std::string base = directory + "/" + prefix + "_" + view_names[view];
     Status status = WritePreviewPng(base + "_depth.png", pose.width, pose.height, 1, grey);
     if (!status.ok()) return status;
     status = WritePreviewPng(base + "_normal.png", pose.width, pose.height, 3, colour);
     if (!status.ok()) return status;
+  }
+  // Gap layers: the upper boundaries (front) and lower boundaries (back) of the k-th gap.
+  for (uint32_t layer = 1; layer < pose.layers; ++layer) {
+    for (int view = 0; view < 2; ++view) {
+      const std::vector<uint8_t> grey = DepthPreview(pose, view, layer, nullptr);
+      const std::string path = directory + "/" + prefix + "_gap" + std::to_string(layer) + "_" +
+                               view_names[view] + "_depth.png";
+      if (Status status = WritePreviewPng(path, pose.width, pose.height, 1, grey); !status.ok()) {
+        return status;
+      }
+    }
   }
   return Status::Ok();
 }

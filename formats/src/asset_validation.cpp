@@ -186,36 +186,49 @@ void CheckMesh(const MeshData& m, size_t joints, Checker& c) {
   }
 }
 
-// Gap layers (k >= 1, body_map_data.h) where they hold a surface: a gap has both boundaries or
-// neither, and gap k exists only where gap k - 1 does (the slab, in either view, for k = 1). So
-// the row-span layout, whose spans follow the slab alone, keeps every gap. The depth order of the
-// boundaries within a texel is left to the runtime's Build, which reads them decoded. `texels`
-// per layer; `prefix` starts the field names ("body_maps.poses[2]." or "").
+// The gap list and the gap layers (body_map_data.h): gap_texels strictly increasing stored
+// texels whose slab (layer 0) is valid in either view, each with gap 1 present; a gap has both
+// boundaries or neither, and gap k exists only where gap k - 1 does. So the row-span layout,
+// whose spans follow the slab alone, keeps every gap. The depth order of the boundaries within a
+// texel is left to the runtime's Build, which reads them decoded. `texels`: stored texels of
+// layer 0 (array sizes already checked); `prefix` starts the field names.
 bool CheckGapLayers(const BodyMapPose& p, size_t texels, const std::string& prefix, Checker& c) {
+  const std::vector<uint32_t>& list = p.gap_texels;
+  if (p.layers == 1 && !list.empty()) {
+    return c.Fail(prefix + "gap_texels has " + std::to_string(list.size()) +
+                  " entries but layers = 1 (no gap layers)");
+  }
   const std::string depth =
       prefix + (p.depth_encoding == DepthEncoding::kFloat32 ? "depth_f32_" : "depth_u16_");
-  for (size_t k = 1; k < p.layers; ++k) {
-    for (size_t n = 0; n < texels; ++n) {
-      const size_t entry = k * texels + n;
+  for (size_t t = 0; t < list.size(); ++t) {
+    const std::string entry_name =
+        "gap_texels[" + std::to_string(t) + "] = " + std::to_string(list[t]);
+    const std::string at = prefix + entry_name;
+    if (list[t] >= texels) {
+      return c.Fail(at + " is not a stored texel (" + std::to_string(texels) + " stored)");
+    }
+    if (t > 0 && list[t] <= list[t - 1]) return c.Fail(at + " does not increase");
+    if (!HasDepth(p, 0, list[t]) && !HasDepth(p, 1, list[t])) {
+      return c.Fail(at + " holds a gap where the slab (layer 0) is background");
+    }
+    for (size_t k = 1; k < p.layers; ++k) {
+      const size_t entry = texels + (k - 1) * list.size() + t;
       const bool upper = HasDepth(p, 0, entry);
       const bool lower = HasDepth(p, 1, entry);
-      const std::string where =
-          "layer " + std::to_string(k) + ", stored texel " + std::to_string(n);
+      const std::string where = "layer " + std::to_string(k) + " of " + entry_name;
       if (upper != lower) {
         return c.Fail(depth + (upper ? "back[" : "front[") + std::to_string(entry) +
                       "] is background where the other view is not (" + where +
                       ": a gap has both boundaries or neither)");
       }
-      if (!upper) continue;
-      const size_t outer = entry - texels;  // the same texel, one layer out
-      const bool enclosed =
-          k == 1 ? HasDepth(p, 0, outer) || HasDepth(p, 1, outer) : HasDepth(p, 0, outer);
-      if (!enclosed) {
+      if (k == 1 && !upper) {
+        return c.Fail(depth + "front[" + std::to_string(entry) + "] is background (" + where +
+                      ": a listed texel holds gap 1)");
+      }
+      if (k > 1 && upper && !HasDepth(p, 0, entry - list.size())) {
         return c.Fail(depth + "front[" + std::to_string(entry) + "] holds a gap (" + where +
-                      ") where " +
-                      (k == 1 ? std::string("the slab (layer 0) is background")
-                              : "layer " + std::to_string(k - 1) + " holds none") +
-                      " (gaps are nested and filled in order)");
+                      ") where layer " + std::to_string(k - 1) +
+                      " holds none (gaps are filled in order)");
       }
     }
   }
@@ -254,8 +267,8 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
       c.Fail(at + "." + problem);
       return;
     }
-    const size_t texels = BodyMapStoredTexels(pose);  // of one layer
-    const size_t entries = texels * pose.layers;      // values of one component, all layers
+    const size_t texels = BodyMapStoredTexels(pose);   // of layer 0
+    const size_t entries = BodyMapArrayEntries(pose);  // values of one component, all layers
     const bool f32 = pose.depth_encoding == DepthEncoding::kFloat32;
     for (int view = 0; view < 2; ++view) {
       const std::string v = view == 0 ? "front" : "back";
@@ -423,10 +436,9 @@ std::string Count(size_t actual, size_t expected, const std::string& field,
          std::to_string(expected);
 }
 
-// "" or a message when the arrays of the chosen encodings do not hold `texels` texels of each of
-// the pose's layers.
-std::string CheckArraySizes(const BodyMapPose& p, size_t texels_per_layer) {
-  const size_t texels = texels_per_layer * p.layers;
+// "" or a message when the arrays of the chosen encodings do not hold BodyMapArrayEntries().
+std::string CheckArraySizes(const BodyMapPose& p) {
+  const size_t texels = BodyMapArrayEntries(p);
   const bool f32 = p.depth_encoding == DepthEncoding::kFloat32;
   for (int view = 0; view < 2; ++view) {
     const std::string v = view == 0 ? "front" : "back";
@@ -449,7 +461,7 @@ std::string CheckArraySizes(const BodyMapPose& p, size_t texels_per_layer) {
   return {};
 }
 
-// Every field except the per-texel arrays and the span table.
+// Every field except the per-texel arrays, the span table and the gap list.
 BodyMapPose CopyHeader(const BodyMapPose& in, BodyMapLayout layout) {
   BodyMapPose out;
   out.clip = in.clip;
@@ -468,10 +480,9 @@ BodyMapPose CopyHeader(const BodyMapPose& in, BodyMapLayout layout) {
   return out;
 }
 
-// Sizes the arrays of the pose's encodings for `texels_per_layer` texels in each of its layers,
-// all background.
-void AssignBackground(BodyMapPose& p, size_t texels_per_layer) {
-  const size_t texels = texels_per_layer * p.layers;
+// Sizes the arrays of the pose's encodings for its stored texels and gap list, all background.
+void AssignBackground(BodyMapPose& p) {
+  const size_t texels = BodyMapArrayEntries(p);
   for (int view = 0; view < 2; ++view) {
     if (p.depth_encoding == DepthEncoding::kFloat32) {
       p.depth_f32[view].assign(texels, p.depth_range);
@@ -517,18 +528,15 @@ void CopyEntry(const BodyMapPose& src, size_t from, BodyMapPose& dst, size_t to)
   }
 }
 
-// Stored texels per layer of the source and the destination of a copy: layer k of stored texel
-// n is entry k * texels + n (layer-major).
-struct LayerStrides {
-  size_t src = 0;
-  size_t dst = 0;
-};
-
-// Copies stored texel `from` of `src` to stored texel `to` of `dst`, every layer.
-void CopyTexel(const BodyMapPose& src, size_t from, BodyMapPose& dst, size_t to,
-               LayerStrides texels) {
-  for (size_t k = 0; k < src.layers; ++k)
-    CopyEntry(src, k * texels.src + from, dst, k * texels.dst + to);
+// Copies the gap entries (everything after layer 0) of `src` to `dst`, in the same order, and
+// renumbers the gap list with `stored_index` (the destination's position of a source texel).
+template <class StoredIndex>
+void CopyGaps(const BodyMapPose& src, BodyMapPose& dst, StoredIndex stored_index) {
+  const size_t from = BodyMapStoredTexels(src), to = BodyMapStoredTexels(dst);
+  const size_t entries = BodyMapArrayEntries(src) - from;
+  for (size_t e = 0; e < entries; ++e) CopyEntry(src, from + e, dst, to + e);
+  for (size_t t = 0; t < src.gap_texels.size(); ++t)
+    dst.gap_texels[t] = stored_index(src.gap_texels[t]);
 }
 
 // The slab (layer 0, the first `texels` entries) is not background in either view. Gaps lie
@@ -539,16 +547,20 @@ bool ValidInEitherView(const BodyMapPose& p, size_t index) {
 
 BodyMapPose ExpandToDense(const BodyMapPose& in) {
   BodyMapPose out = CopyHeader(in, BodyMapLayout::kDense);
-  const LayerStrides texels{BodyMapStoredTexels(in), static_cast<size_t>(in.width) * in.height};
-  AssignBackground(out, texels.dst);
+  out.gap_texels.resize(in.gap_texels.size());
+  AssignBackground(out);
+  std::vector<uint32_t> dense_index(BodyMapStoredTexels(in));  // stored texel -> j * width + i
   for (uint32_t j = 0; j < in.height; ++j) {
     for (uint32_t s = in.row_span_offsets[j]; s < in.row_span_offsets[j + 1]; ++s) {
       const uint32_t length = in.span_texel_offsets[s + 1] - in.span_texel_offsets[s];
       const size_t to = static_cast<size_t>(j) * in.width + in.span_begin[s];
-      for (uint32_t t = 0; t < length; ++t)
-        CopyTexel(in, in.span_texel_offsets[s] + t, out, to + t, texels);
+      for (uint32_t t = 0; t < length; ++t) {
+        CopyEntry(in, in.span_texel_offsets[s] + t, out, to + t);
+        dense_index[in.span_texel_offsets[s] + t] = static_cast<uint32_t>(to + t);
+      }
     }
   }
+  CopyGaps(in, out, [&](uint32_t n) { return dense_index[n]; });
   return out;
 }
 
@@ -574,16 +586,21 @@ BodyMapPose PackRowSpans(const BodyMapPose& dense) {
     }
     out.row_span_offsets.push_back(static_cast<uint32_t>(out.span_begin.size()));
   }
-  const LayerStrides texels{width * dense.height, stored};
-  AssignBackground(out, texels.dst);
+  out.gap_texels.resize(dense.gap_texels.size());
+  AssignBackground(out);
   for (size_t j = 0; j < dense.height; ++j) {
     for (uint32_t s = out.row_span_offsets[j]; s < out.row_span_offsets[j + 1]; ++s) {
       const uint32_t length = out.span_texel_offsets[s + 1] - out.span_texel_offsets[s];
       const size_t from = j * width + out.span_begin[s];
       for (uint32_t t = 0; t < length; ++t)
-        CopyTexel(dense, from + t, out, out.span_texel_offsets[s] + t, texels);
+        CopyEntry(dense, from + t, out, out.span_texel_offsets[s] + t);
     }
   }
+  // A gap texel's slab is valid (checked before), so it lies in a span.
+  CopyGaps(dense, out, [&](uint32_t n) {
+    return static_cast<uint32_t>(
+        BodyMapTexelIndex(out, static_cast<uint32_t>(n % width), static_cast<uint32_t>(n / width)));
+  });
   return out;
 }
 
@@ -592,6 +609,11 @@ BodyMapPose PackRowSpans(const BodyMapPose& dense) {
 size_t BodyMapStoredTexels(const BodyMapPose& pose) {
   if (pose.layout == BodyMapLayout::kDense) return static_cast<size_t>(pose.width) * pose.height;
   return pose.span_texel_offsets.empty() ? 0 : pose.span_texel_offsets.back();
+}
+
+size_t BodyMapArrayEntries(const BodyMapPose& pose) {
+  const size_t gap_layers = pose.layers > 1 ? pose.layers - 1u : 0u;
+  return BodyMapStoredTexels(pose) + gap_layers * pose.gap_texels.size();
 }
 
 std::string CheckBodyMapLayout(const BodyMapPose& p) {
@@ -682,8 +704,7 @@ Status ConvertBodyMapLayout(const BodyMapPose& in, BodyMapLayout layout, BodyMap
     return invalid("layers = " + std::to_string(in.layers) + " is not in [1, " +
                    std::to_string(kMaxBodyMapLayers) + "]");
   if (std::string problem = CheckBodyMapLayout(in); !problem.empty()) return invalid(problem);
-  if (std::string problem = CheckArraySizes(in, BodyMapStoredTexels(in)); !problem.empty())
-    return invalid(problem);
+  if (std::string problem = CheckArraySizes(in); !problem.empty()) return invalid(problem);
   // Spans follow the slab alone: a gap outside it would be dropped without a word.
   if (Checker gaps; !CheckGapLayers(in, BodyMapStoredTexels(in), "", gaps))
     return invalid(gaps.message());

@@ -231,7 +231,8 @@ void serialize(Archive& ar, MeshData& m, const uint32_t version) {
 
 // Version 1 (format version 1): always dense, no layout field and no span table. Version 2
 // (format version 2): `layout` and the span table follow normal_encoding. Version 3 (format
-// version 3): `layers` (uint8) follows `layout`, before the span table. Writing is always
+// version 3): `layers` (uint8) follows `layout`, before the span table, and `gap_texels`
+// follows the span table. Writing is always
 // version 3; a version-1 pose loads as dense with an empty span table, and versions 1 and 2
 // load with one layer. Format version N holds exactly class version N (what its writer wrote):
 // a newer class in an older format is impossible, an older one in a newer format is a forgery
@@ -263,9 +264,15 @@ void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
     Array(ar, "row_span_offsets", p.row_span_offsets);
     Array(ar, "span_begin", p.span_begin);
     Array(ar, "span_texel_offsets", p.span_texel_offsets);
+    if (version >= 3) {
+      Array(ar, "gap_texels", p.gap_texels);
+    } else {
+      p.gap_texels.clear();
+    }
   } else {
     p.layout = BodyMapLayout::kDense;
     p.layers = 1;
+    p.gap_texels.clear();
     p.row_span_offsets.clear();
     p.span_begin.clear();
     p.span_texel_offsets.clear();

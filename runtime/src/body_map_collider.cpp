@@ -556,7 +556,9 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   }
   const size_t n = static_cast<size_t>(pose.width) * pose.height;
   const size_t layers = pose.layers;
-  const size_t values = n * layers;  // per array: every layer's texels, layer-major
+  const std::vector<uint32_t>& gap_list = pose.gap_texels;  // dense texel indices here
+  // Per array: layer 0 of every texel, then the gap layers of the listed texels.
+  const size_t values = n + (layers - 1) * gap_list.size();
   const char* view_name[2] = {"front", "back"};
 
   // Exactly the arrays of the chosen encodings are filled (body_map_data.h).
@@ -577,8 +579,9 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
       return fail(name + " depth arrays hold " + std::to_string(pose.depth_f32[view].size()) +
                   " float32 / " + std::to_string(pose.depth_u16[view].size()) +
                   " unorm16 values, expected " + std::to_string(depth_f32) + " / " +
-                  std::to_string(depth_u16) + " for width*height=" + std::to_string(n) + " and " +
-                  std::to_string(layers) + " layer(s)");
+                  std::to_string(depth_u16) + " for width*height=" + std::to_string(n) + ", " +
+                  std::to_string(layers) + " layer(s) and " + std::to_string(gap_list.size()) +
+                  " gap texels");
     }
     size_t normal_f32 = 0, normal_oct16 = 0, normal_rgb8 = 0;
     switch (pose.normal_encoding) {
@@ -609,13 +612,13 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   normals_.resize(n);
   const float depth_range = pose.depth_range;
   const float back_plane_z = pose.front_z - pose.depth_range;
-  // Depth of array entry `index` of one view: false (and a failure message) for a corrupt value.
+  // Array entry `index` of one view: false (and a failure message) for a corrupt value.
   std::string problem;
   const auto where = [&](int view, size_t index) {
-    const size_t layer = index / n, k = index % n;
-    return std::string(view_name[view]) +
-           (layer == 0 ? "" : " gap layer " + std::to_string(layer)) + " at texel " +
-           std::to_string(k);
+    if (index < n) return std::string(view_name[view]) + " at texel " + std::to_string(index);
+    const size_t layer = (index - n) / gap_list.size() + 1, t = (index - n) % gap_list.size();
+    return std::string(view_name[view]) + " gap layer " + std::to_string(layer) + " at texel " +
+           std::to_string(gap_list[t]);
   };
   const auto read_depth = [&](int view, size_t index, float* depth, bool* valid) {
     if (pose.depth_encoding == DepthEncoding::kFloat32) {
@@ -690,19 +693,29 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   // inside set is a sorted list of disjoint intervals (the walk relies on it).
   // Decoded densely (setup time), stored compactly by PackGaps below.
   gap_layers_ = static_cast<uint32_t>(layers - 1);
+  if (gap_layers_ == 0 && !gap_list.empty()) {
+    return fail("gap_texels lists " + std::to_string(gap_list.size()) +
+                " texels but layers = 1 (no gap layers)");
+  }
   std::vector<Slab> dense_gaps(n * gap_layers_, Slab{-kInf, kInf});
   std::vector<TexelNormals> dense_gap_normals(n * gap_layers_, TexelNormals{});
-  for (size_t k = 0; k < n && gap_layers_ > 0; ++k) {
+  for (size_t t = 0; t < gap_list.size(); ++t) {
+    const size_t k = gap_list[t];
+    if (k >= n || (t > 0 && k <= gap_list[t - 1])) {
+      return fail("gap_texels[" + std::to_string(t) + "] = " + std::to_string(k) +
+                  (k >= n ? " is not a texel of the rectangle" : " does not increase"));
+    }
     float floor_z = slabs_[k].top;  // the gap must lie below this (the previous interval's top)
     bool absent_before = false;
     for (size_t g = 0; g < gap_layers_; ++g) {
-      const size_t index = (g + 1) * n + k;
+      const size_t index = n + g * gap_list.size() + t;
       float depth[2];
       bool valid[2];
       for (int view = 0; view < 2; ++view) {
         if (!read_depth(view, index, &depth[view], &valid[view])) return fail(problem);
       }
       if (!valid[0] && !valid[1]) {
+        if (g == 0) return fail(where(0, index) + ": a listed texel has no gap 1");
         absent_before = true;
         continue;
       }

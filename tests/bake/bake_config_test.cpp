@@ -50,5 +50,24 @@ TEST(BakeConfig, ReferenceListsEveryParameterWithItsDefault) {
   }
 }
 
+TEST(BakeConfig, MapsLayersIsACountFromOneToFour) {
+  BakeConfig config;
+  EXPECT_EQ(config.maps.layers, 1) << "paper A's slab alone by default";
+  EXPECT_EQ(BakeConfigReference()["maps"]["layers"]["range"], "[1, 4]");
+  Status s = ApplyBakeConfig({{"maps", {{"layers", 3}}}}, "c.json", &config);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(config.maps.layers, 3);
+  EXPECT_EQ(BakeConfigToJson(config)["maps"]["layers"], 3);
+  for (const nlohmann::json& bad :
+       {nlohmann::json(0), nlohmann::json(5), nlohmann::json(-1), nlohmann::json(256),
+        nlohmann::json(2.5), nlohmann::json("two")}) {
+    s = ApplyBakeConfig({{"maps", {{"layers", bad}}}}, "c.json", &config);
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument) << bad.dump();
+    EXPECT_NE(s.message().find("c.json: /maps/layers must be"), std::string::npos) << s.message();
+    EXPECT_NE(s.message().find("[1, 4]"), std::string::npos) << s.message();
+    EXPECT_EQ(config.maps.layers, 3) << "a refused config changes nothing";
+  }
+}
+
 }  // namespace
 }  // namespace drape::bake

@@ -9,14 +9,19 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <limits>
+#include <map>
 #include <random>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "drape/bake/bake_config.h"
@@ -1136,6 +1141,783 @@ TEST(BodyMapBaker, PreviewWritesFourPngs) {
   // A directory that does not exist is an I/O error, not a crash.
   EXPECT_EQ(WriteBodyMapPreview(pose, (dir / "missing" / "deeper").string(), "x").code(),
             StatusCode::kIoError);
+}
+
+// --- Gap layers (body_map_baker.h step 8) ---
+
+// Appends an axis-aligned closed box to `m` with separate vertices per face, counter-clockwise
+// seen from outside, without the faces `skip` names (bit 2*axis + side: bit 4 is the z-low face),
+// so an open box can be built too. Same geometry as AddSplitBox; kept separate because the hash
+// constants of GapLayersLeaveTheSlabByteIdentical were recorded with exactly this vertex order.
+void AddPortableBox(Mesh* m, double x0, double y0, double z0, double x1, double y1, double z1,
+                    unsigned skip = 0) {
+  const double lo[3] = {x0, y0, z0}, hi[3] = {x1, y1, z1};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      if (skip & (1u << (2 * axis + side))) continue;
+      const uint32_t base = static_cast<uint32_t>(m->positions.size());
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      for (int corner = 0; corner < 4; ++corner) {
+        double c[3];
+        c[axis] = side ? hi[axis] : lo[axis];
+        c[u] = (corner == 1 || corner == 2) ? hi[u] : lo[u];
+        c[v] = (corner >= 2) ? hi[v] : lo[v];
+        m->positions.push_back(
+            {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])});
+      }
+      // Corners 0..3 go counter-clockwise around +axis: reversed on the low side.
+      if (side) {
+        m->triangles.insert(m->triangles.end(),
+                            {base, base + 1, base + 2, base, base + 2, base + 3});
+      } else {
+        m->triangles.insert(m->triangles.end(),
+                            {base, base + 2, base + 1, base, base + 3, base + 2});
+      }
+    }
+  }
+}
+
+// A sphere from a 4^levels-subdivided octahedron on radius r (square roots only, so the same
+// positions on every IEEE machine), counter-clockwise seen from outside, shared vertices.
+void AddOctaSphere(Mesh* m, double cx, double cy, double cz, double r, int levels) {
+  std::vector<std::array<double, 3>> p = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                          {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                            {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
+    const auto mid = [&](uint32_t a, uint32_t b) {
+      const auto key = std::minmax(a, b);
+      const auto found = midpoints.find(key);
+      if (found != midpoints.end()) return found->second;
+      std::array<double, 3> q = {p[a][0] + p[b][0], p[a][1] + p[b][1], p[a][2] + p[b][2]};
+      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+      for (double& c : q) c /= len;
+      p.push_back(q);
+      const uint32_t index = static_cast<uint32_t>(p.size() - 1);
+      midpoints.emplace(key, index);
+      return index;
+    };
+    std::vector<std::array<uint32_t, 3>> finer;
+    for (const auto& f : t) {
+      const uint32_t ab = mid(f[0], f[1]), bc = mid(f[1], f[2]), ca = mid(f[2], f[0]);
+      finer.push_back({f[0], ab, ca});
+      finer.push_back({ab, f[1], bc});
+      finer.push_back({ca, bc, f[2]});
+      finer.push_back({ab, bc, ca});
+    }
+    t = std::move(finer);
+  }
+  const uint32_t base = static_cast<uint32_t>(m->positions.size());
+  for (const auto& q : p) {
+    m->positions.push_back({static_cast<float>(cx + r * q[0]), static_cast<float>(cy + r * q[1]),
+                            static_cast<float>(cz + r * q[2])});
+  }
+  for (const auto& f : t) {
+    m->triangles.insert(m->triangles.end(), {base + f[0], base + f[1], base + f[2]});
+  }
+}
+
+// A single quad at height z over [x0, x1] x [y0, y1], facing +z (up) or -z: an open surface.
+void AddQuad(Mesh* m, double x0, double y0, double x1, double y1, double z, bool up) {
+  const uint32_t base = static_cast<uint32_t>(m->positions.size());
+  for (const auto& [x, y] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}) {
+    m->positions.push_back({static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)});
+  }
+  if (up) {
+    m->triangles.insert(m->triangles.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+  } else {
+    m->triangles.insert(m->triangles.end(), {base, base + 2, base + 1, base, base + 3, base + 2});
+  }
+}
+
+// A thin closed sheet over [x0, x1] x [y0, y1] whose bottom is z = z0 + slope * (x - x0) and whose
+// top is `thickness` above it (vertical sides; separate vertices per face).
+void AddSlantedSheet(Mesh* m, double x0, double y0, double x1, double y1, double z0, double slope,
+                     double thickness) {
+  const auto bottom = [&](double x) { return z0 + slope * (x - x0); };
+  const Vec3d corner[8] = {{x0, y0, bottom(x0)},
+                           {x1, y0, bottom(x1)},
+                           {x1, y1, bottom(x1)},
+                           {x0, y1, bottom(x0)},
+                           {x0, y0, bottom(x0) + thickness},
+                           {x1, y0, bottom(x1) + thickness},
+                           {x1, y1, bottom(x1) + thickness},
+                           {x0, y1, bottom(x0) + thickness}};
+  const int faces[6][4] = {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                           {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  const Vec3d centre = Scale(Add(corner[0], corner[6]), 0.5);
+  for (const auto& face : faces) {
+    const uint32_t base = static_cast<uint32_t>(m->positions.size());
+    Vec3d face_centre;
+    for (int k : face) {
+      m->positions.push_back({static_cast<float>(corner[k].x), static_cast<float>(corner[k].y),
+                              static_cast<float>(corner[k].z)});
+      face_centre = Add(face_centre, Scale(corner[k], 0.25));
+    }
+    const Vec3d outward = Sub(face_centre, centre);
+    AddOutwardTriangle(m, base, base + 1, base + 2, outward);
+    AddOutwardTriangle(m, base, base + 2, base + 3, outward);
+  }
+}
+
+// FNV-1a 64 over the bytes of everything a bake writes (header floats, span table, arrays).
+uint64_t Fnv(uint64_t h, const void* data, size_t bytes) {
+  const unsigned char* b = static_cast<const unsigned char*>(data);
+  for (size_t k = 0; k < bytes; ++k) {
+    h ^= b[k];
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+template <class T>
+uint64_t FnvVector(uint64_t h, const std::vector<T>& v) {
+  const uint64_t n = v.size();
+  h = Fnv(h, &n, sizeof(n));
+  return Fnv(h, v.data(), v.size() * sizeof(T));
+}
+uint64_t PoseHash(const BodyMapPose& p) {
+  uint64_t h = 14695981039346656037ull;
+  for (const void* field :
+       {static_cast<const void*>(&p.width), static_cast<const void*>(&p.height),
+        static_cast<const void*>(&p.origin_x), static_cast<const void*>(&p.origin_y),
+        static_cast<const void*>(&p.texel_size), static_cast<const void*>(&p.front_z),
+        static_cast<const void*>(&p.depth_range)}) {
+    h = Fnv(h, field, 4);
+  }
+  h = FnvVector(h, p.row_span_offsets);
+  h = FnvVector(h, p.span_begin);
+  h = FnvVector(h, p.span_texel_offsets);
+  for (int view = 0; view < 2; ++view) {
+    h = FnvVector(h, p.depth_f32[view]);
+    h = FnvVector(h, p.depth_u16[view]);
+    h = FnvVector(h, p.normal_f32[view]);
+    h = FnvVector(h, p.normal_oct16[view]);
+    h = FnvVector(h, p.normal_rgb8[view]);
+  }
+  return h;
+}
+
+// A block, a plate in front of it, a sphere further in front and one beside it: flat and curved
+// surfaces, shared and split vertices, air between them along z.
+Mesh GapScene() {
+  Mesh m;
+  AddPortableBox(&m, -0.20, -0.30, -0.10, 0.20, 0.30, 0.05);  // block
+  AddPortableBox(&m, -0.10, -0.12, 0.12, 0.14, 0.08, 0.15);   // plate in front of it
+  AddOctaSphere(&m, 0.05, 0.20, 0.30, 0.07, 4);               // sphere further in front
+  AddOctaSphere(&m, -0.25, -0.05, -0.02, 0.09, 3);            // sphere overlapping the side
+  return m;
+}
+
+// The array entry of `layer` at texel (i, j) (body_map_baker.h, encodings), or -1 where the
+// texel is not stored (layer 0) or not in the gap list (layers >= 1).
+int64_t LayerEntry(const BodyMapPose& pose, uint32_t i, uint32_t j, uint32_t layer) {
+  const int64_t index = BodyMapTexelIndex(pose, i, j);
+  if (index < 0 || layer == 0) return index;
+  const auto& list = pose.gap_texels;
+  const auto found = std::lower_bound(list.begin(), list.end(), static_cast<uint32_t>(index));
+  if (found == list.end() || *found != index) return -1;
+  return static_cast<int64_t>(BodyMapStoredTexels(pose) + (layer - 1) * list.size() +
+                              static_cast<size_t>(found - list.begin()));
+}
+
+// The raw depth code of `layer` at texel (i, j) decoded as a float reader would (unorm16:
+// code / 65535 * depth_range in float), or NaN on background.
+float FloatReaderDepth(const BodyMapPose& pose, int view, uint32_t i, uint32_t j, uint32_t layer) {
+  const int64_t index = LayerEntry(pose, i, j, layer);
+  if (index < 0) return std::numeric_limits<float>::quiet_NaN();
+  const size_t entry = static_cast<size_t>(index);
+  if (pose.depth_encoding == DepthEncoding::kFloat32) {
+    const float d = pose.depth_f32[view][entry];
+    return d < pose.depth_range ? d : std::numeric_limits<float>::quiet_NaN();
+  }
+  const uint16_t code = pose.depth_u16[view][entry];
+  if (code == 65535) return std::numeric_limits<float>::quiet_NaN();
+  return static_cast<float>(code) / 65535.f * pose.depth_range;
+}
+
+// Every texel's layers as body_map_data.h requires: a gap has both boundaries or neither, layers
+// are filled in order, and top > upper_1 > lower_1 > upper_2 > ... > bottom in asset z, with the
+// documented decoder in double and with a float reader's arithmetic. Returns the texels checked
+// that hold at least one gap.
+size_t ExpectStrictlyNested(const BodyMapPose& pose) {
+  const double back_z = double(pose.front_z) - double(pose.depth_range);
+  const float back_zf = pose.front_z - pose.depth_range;
+  size_t with_gaps = 0, violations = 0;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const BodyMapTexel top = ReadBodyMapTexel(pose, 0, i, j),
+                         bottom = ReadBodyMapTexel(pose, 1, i, j);
+      double ceiling = double(pose.front_z) - top.depth;
+      float ceiling_f = pose.front_z - FloatReaderDepth(pose, 0, i, j, 0);
+      const double floor = back_z + bottom.depth;
+      const float floor_f = back_zf + FloatReaderDepth(pose, 1, i, j, 0);
+      bool absent = !top.valid;
+      for (uint32_t layer = 1; layer < pose.layers; ++layer) {
+        const BodyMapTexel upper = ReadBodyMapTexel(pose, 0, i, j, layer);
+        const BodyMapTexel lower = ReadBodyMapTexel(pose, 1, i, j, layer);
+        if (!upper.valid && !lower.valid) {
+          absent = true;
+          continue;
+        }
+        with_gaps += layer == 1;
+        const double upper_z = double(pose.front_z) - upper.depth;
+        const double lower_z = back_z + lower.depth;
+        const float upper_f = pose.front_z - FloatReaderDepth(pose, 0, i, j, layer);
+        const float lower_f = back_zf + FloatReaderDepth(pose, 1, i, j, layer);
+        const bool ok = !absent && upper.valid && lower.valid && ceiling > upper_z &&
+                        upper_z > lower_z && lower_z > floor && ceiling_f > upper_f &&
+                        upper_f > lower_f && lower_f > floor_f;
+        if (!ok && violations++ < 5) {
+          ADD_FAILURE() << "texel " << i << "," << j << " layer " << layer << ": ceiling "
+                        << ceiling << " upper " << upper_z << " lower " << lower_z << " floor "
+                        << floor;
+        }
+        ceiling = lower_z;
+        ceiling_f = lower_f;
+      }
+    }
+  }
+  EXPECT_EQ(violations, 0u);
+  // The gap list: strictly increasing, exactly the texels with a gap.
+  EXPECT_EQ(with_gaps, pose.gap_texels.size());
+  EXPECT_TRUE(std::adjacent_find(pose.gap_texels.begin(), pose.gap_texels.end(),
+                                 std::greater_equal<uint32_t>()) == pose.gap_texels.end());
+  if (pose.layers == 1) {
+    EXPECT_TRUE(pose.gap_texels.empty());
+  }
+  return with_gaps;
+}
+
+// The gaps a texel centre should hold: (upper z, lower z) front to back.
+using ExpectedGaps = std::vector<std::pair<double, double>>;
+
+struct GapCheck {
+  size_t texels_with_gaps = 0;  // texels checked that hold a gap
+  size_t skipped = 0;           // texel centres within 1e-4 texel of an outline
+};
+
+// Compares every texel's gap layers with `expected` (positions within `tolerance` metres, the
+// upper normal (0,0,-1) and the lower (0,0,+1) within `normal_tolerance`); texel centres within
+// 1e-4 texel of one of the x = `outline_x` or y = `outline_y` lines are skipped.
+template <class Expected>
+GapCheck ExpectGaps(const BodyMapPose& pose, Expected expected,
+                    const std::vector<double>& outline_x, const std::vector<double>& outline_y,
+                    double tolerance, double normal_tolerance) {
+  GapCheck check;
+  const double t = pose.texel_size;
+  const double back_z = double(pose.front_z) - double(pose.depth_range);
+  size_t failures = 0;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      const Vec3d p = TexelCentre(pose, i, j);
+      bool on_outline = false;
+      for (double x : outline_x) on_outline |= std::fabs(p.x - x) < 1e-4 * t;
+      for (double y : outline_y) on_outline |= std::fabs(p.y - y) < 1e-4 * t;
+      if (on_outline) {
+        ++check.skipped;
+        continue;
+      }
+      const ExpectedGaps gaps = expected(p);
+      for (uint32_t layer = 1; layer < pose.layers; ++layer) {
+        const BodyMapTexel upper = ReadBodyMapTexel(pose, 0, i, j, layer);
+        const BodyMapTexel lower = ReadBodyMapTexel(pose, 1, i, j, layer);
+        const bool want = layer <= gaps.size();
+        bool ok = upper.valid == want && lower.valid == want;
+        if (ok && want) {
+          const auto [upper_z, lower_z] = gaps[layer - 1];
+          ok = std::fabs(double(pose.front_z) - upper.depth - upper_z) <= tolerance &&
+               std::fabs(back_z + lower.depth - lower_z) <= tolerance &&
+               std::fabs(upper.normal.z + 1.0) <= normal_tolerance &&
+               std::fabs(lower.normal.z - 1.0) <= normal_tolerance;
+        }
+        if (!ok && failures++ < 5) {
+          ADD_FAILURE() << "texel " << i << "," << j << " (" << p.x << ", " << p.y << ") layer "
+                        << layer << ": expected " << (want ? "a gap" : "none") << ", read "
+                        << (upper.valid ? "upper " + std::to_string(pose.front_z - upper.depth)
+                                        : std::string("no upper"))
+                        << " / "
+                        << (lower.valid ? "lower " + std::to_string(back_z + lower.depth)
+                                        : std::string("no lower"));
+        }
+      }
+      check.texels_with_gaps += !gaps.empty();
+    }
+  }
+  EXPECT_EQ(failures, 0u);
+  return check;
+}
+
+bool Inside(Vec3d p, double x0, double y0, double x1, double y1) {
+  return p.x > x0 && p.x < x1 && p.y > y0 && p.y < y1;
+}
+
+TEST(BodyMapBaker, GapLayerHoldsTheAirBetweenAPlateAndABlock) {
+  Mesh mesh;
+  const Vec3d block_lo{-0.20, -0.30, -0.10}, block_hi{0.20, 0.30, 0.05};
+  const Vec3d plate_lo{-0.10, -0.12, 0.12}, plate_hi{0.14, 0.08, 0.15};
+  AddSplitBox(&mesh, block_lo, block_hi);
+  AddSplitBox(&mesh, plate_lo, plate_hi);
+  for (const bool compact : {false, true}) {
+    SCOPED_TRACE(compact ? "unorm16 + oct16" : "float32");
+    BodyMapOptions o = FloatOptions(200);
+    if (compact) {
+      o.depth_encoding = DepthEncoding::kUnorm16;
+      o.normal_encoding = NormalEncoding::kOct16;
+    }
+    o.layout = BodyMapLayout::kDense;
+    o.layers = 3;
+    BodyMapPoseStats stats;
+    const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
+    ASSERT_EQ(pose.layers, 3);
+    // The split boxes' faces move by exactly epsilon along their normals: the gap is the plate's
+    // back face lowered by epsilon down to the block's front face raised by epsilon, over the
+    // plate's own x,y rectangle (its side faces are edge-on).
+    const double eps = o.epsilon;
+    const double tolerance = compact ? double(pose.depth_range) / 65535.0 + 1e-6 : 1e-6;
+    const GapCheck check = ExpectGaps(
+        pose,
+        [&](Vec3d p) {
+          return Inside(p, plate_lo.x, plate_lo.y, plate_hi.x, plate_hi.y)
+                     ? ExpectedGaps{{plate_lo.z - eps, block_hi.z + eps}}
+                     : ExpectedGaps{};
+        },
+        {plate_lo.x, plate_hi.x}, {plate_lo.y, plate_hi.y}, tolerance, compact ? 1e-3 : 1e-6);
+    const double t = pose.texel_size;
+    const double area = (plate_hi.x - plate_lo.x) * (plate_hi.y - plate_lo.y) / (t * t);
+    EXPECT_NEAR(double(check.texels_with_gaps), area,
+                2 * ((plate_hi.x - plate_lo.x) + (plate_hi.y - plate_lo.y)) / t + 4);
+    EXPECT_GT(check.texels_with_gaps, 1000u);
+    EXPECT_NEAR(double(stats.gap_texels), double(check.texels_with_gaps), double(check.skipped));
+    EXPECT_EQ(stats.layers, 3);
+    EXPECT_EQ(stats.dropped_gaps, 0u);
+    EXPECT_GT(stats.gap_ms, 0.0);
+    // Layer 0 for every texel of the rectangle, the two gap layers and the list for the texels
+    // with a gap.
+    const size_t per_texel = compact ? 2 * (2 + 4) : 2 * (4 + 12);
+    const size_t listed = pose.gap_texels.size();
+    EXPECT_EQ(listed, stats.gap_texels);
+    EXPECT_EQ(stats.bytes,
+              per_texel * (size_t(pose.width) * pose.height + 2 * listed) + 4 * listed);
+    // Layer 0 is still the slab: the plate's front face to the block's back face.
+    const uint32_t ci = pose.width / 2, cj = pose.height / 2;
+    ASSERT_TRUE(Inside(TexelCentre(pose, ci, cj), plate_lo.x, plate_lo.y, plate_hi.x, plate_hi.y));
+    EXPECT_NEAR(pose.front_z - ReadBodyMapTexel(pose, 0, ci, cj).depth, plate_hi.z + eps,
+                tolerance);
+    EXPECT_NEAR(pose.front_z - pose.depth_range + ReadBodyMapTexel(pose, 1, ci, cj).depth,
+                block_lo.z - eps, tolerance);
+    EXPECT_GT(ExpectStrictlyNested(pose), 1000u);
+  }
+}
+
+TEST(BodyMapBaker, GapLayersKeepTheThickestGapsInDepthOrder) {
+  // Plate B in front of plate A in front of a block; B covers x < 0.05, A covers x > -0.05.
+  // Where both are: the gap B -> A (20 mm) and, deeper but thicker, A -> block (60 mm).
+  Mesh mesh;
+  const double eps = 0.005;
+  AddSplitBox(&mesh, {-0.20, -0.20, -0.10}, {0.20, 0.20, 0.00});  // block
+  AddSplitBox(&mesh, {-0.05, -0.10, 0.07}, {0.10, 0.10, 0.09});   // A
+  AddSplitBox(&mesh, {-0.10, -0.10, 0.12}, {0.05, 0.10, 0.14});   // B
+  const std::pair<double, double> b_to_a{0.12 - eps, 0.09 + eps}, a_to_block{0.07 - eps, eps},
+      b_to_block{0.12 - eps, eps};
+  const std::vector<double> outline_x = {-0.10, -0.05, 0.05, 0.10}, outline_y = {-0.10, 0.10};
+  const auto in_y = [](Vec3d p) { return p.y > -0.10 && p.y < 0.10; };
+  for (const int layers : {2, 3, 4}) {
+    SCOPED_TRACE(testing::Message() << "layers " << int(layers));
+    BodyMapOptions o = FloatOptions(160);
+    o.epsilon = static_cast<float>(eps);
+    o.layout = BodyMapLayout::kDense;
+    o.layers = static_cast<uint8_t>(layers);
+    BodyMapPoseStats stats;
+    const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
+    size_t both = 0;
+    const GapCheck check = ExpectGaps(
+        pose,
+        [&](Vec3d p) {
+          if (!in_y(p) || p.x <= -0.10 || p.x >= 0.10) return ExpectedGaps{};
+          if (p.x < -0.05) return ExpectedGaps{b_to_block};
+          if (p.x > 0.05) return ExpectedGaps{a_to_block};
+          ++both;
+          // layers = 2 keeps one: the thicker, although it is the deeper.
+          return layers == 2 ? ExpectedGaps{a_to_block} : ExpectedGaps{b_to_a, a_to_block};
+        },
+        outline_x, outline_y, 1e-6, 1e-6);
+    EXPECT_GT(both, 500u);
+    EXPECT_GT(check.texels_with_gaps, both + 500);  // and texels under one plate only
+    EXPECT_NEAR(double(stats.gap_texels), double(check.texels_with_gaps), double(check.skipped));
+    EXPECT_NEAR(double(stats.dropped_gaps), layers == 2 ? double(both) : 0.0,
+                double(check.skipped));
+    ExpectStrictlyNested(pose);
+  }
+}
+
+TEST(BodyMapBaker, OpenOrInconsistentSurfacesGiveNoGap) {
+  // Six things in front of a block, each over its own cell (columns x in [-0.15, -0.02] and
+  // [0.02, 0.15], rows y in [-0.18, -0.07], [-0.05, 0.05], [0.07, 0.18]); no epsilon, so that
+  // the lone quads stay flat.
+  Mesh mesh;
+  AddPortableBox(&mesh, -0.20, -0.20, -0.10, 0.20, 0.20, 0.00);
+  // Closed: a plate (a gap from 0.05 down to the block), and a plate over a flattened box of
+  // zero thickness at z = 0.03, whose faces enter and leave at the same depth: entering sorts
+  // first, so the count stays >= 0 and the texel keeps its thicker gap, plate -> sheet (the
+  // sheet -> block one is beyond layers - 1 = 1).
+  AddPortableBox(&mesh, 0.02, 0.07, 0.05, 0.15, 0.18, 0.08);
+  AddPortableBox(&mesh, 0.02, -0.05, 0.12, 0.15, 0.05, 0.14);
+  AddPortableBox(&mesh, 0.02, -0.05, 0.03, 0.15, 0.05, 0.03);
+  // Open: a box without its back face under a closed plate (the count reaches 0 between them but
+  // ends at 1), a lone quad facing +z (it ends at 1), a lone quad facing -z (it goes negative at
+  // once), and a plate wound inside out (-1, +1, then the block's +1, -1: it ends at 0 but went
+  // negative first).
+  AddPortableBox(&mesh, -0.15, 0.07, 0.10, -0.02, 0.18, 0.12);
+  AddPortableBox(&mesh, -0.15, 0.07, 0.05, -0.02, 0.18, 0.08, 1u << 4);
+  AddQuad(&mesh, -0.15, -0.05, -0.02, 0.05, 0.06, /*up=*/true);
+  AddQuad(&mesh, -0.15, -0.18, -0.02, -0.07, 0.06, /*up=*/false);
+  AddPortableBox(&mesh, 0.02, -0.18, 0.05, 0.15, -0.07, 0.08);
+  for (size_t t = mesh.triangles.size() - 36; t < mesh.triangles.size(); t += 3) {
+    std::swap(mesh.triangles[t + 1], mesh.triangles[t + 2]);
+  }
+  BodyMapOptions o = FloatOptions(160);
+  o.epsilon = 0.f;
+  o.layout = BodyMapLayout::kDense;
+  o.layers = 2;
+  BodyMapPoseStats stats;
+  const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
+  size_t plate = 0, sheet = 0;
+  const GapCheck check = ExpectGaps(
+      pose,
+      [&](Vec3d p) {
+        if (Inside(p, 0.02, 0.07, 0.15, 0.18)) return ++plate, ExpectedGaps{{0.05, 0.0}};
+        if (Inside(p, 0.02, -0.05, 0.15, 0.05)) return ++sheet, ExpectedGaps{{0.12, 0.03}};
+        return ExpectedGaps{};
+      },
+      {-0.15, -0.02, 0.02, 0.15}, {-0.18, -0.07, -0.05, 0.05, 0.07, 0.18}, 1e-6, 1e-6);
+  EXPECT_GT(plate, 1000u);
+  EXPECT_GT(sheet, 1000u);
+  EXPECT_EQ(check.texels_with_gaps, plate + sheet);
+  EXPECT_NEAR(double(stats.dropped_gaps), double(sheet), double(check.skipped));
+  EXPECT_NEAR(double(stats.gap_texels), double(check.texels_with_gaps), double(check.skipped));
+  // The open surfaces are in layer 0 all the same: paper A's slab from them to the block's back.
+  for (const auto& [x, y, top] : {std::tuple{-0.085, 0.125, 0.12},
+                                  {-0.085, 0.0, 0.06},
+                                  {-0.085, -0.125, 0.06},
+                                  {0.085, -0.125, 0.08}}) {
+    const uint32_t i = static_cast<uint32_t>((x - pose.origin_x) / pose.texel_size);
+    const uint32_t j = static_cast<uint32_t>((y - pose.origin_y) / pose.texel_size);
+    const BodyMapTexel front = ReadBodyMapTexel(pose, 0, i, j);
+    ASSERT_TRUE(front.valid) << x << ", " << y;
+    EXPECT_NEAR(pose.front_z - front.depth, top, 1e-6) << x << ", " << y;
+    EXPECT_FALSE(ReadBodyMapTexel(pose, 0, i, j, 1).valid) << x << ", " << y;
+  }
+}
+
+TEST(BodyMapBaker, GapsThinnerThanTheMinimumAreNotStored) {
+  // Two plates above a block, no epsilon: 0.05 mm of air under the first (below kMinBodyMapGap,
+  // 0.1 mm), 0.2 mm under the second.
+  ASSERT_EQ(kMinBodyMapGap, 1e-4);
+  Mesh mesh;
+  AddPortableBox(&mesh, -0.20, -0.20, -0.10, 0.20, 0.20, 0.00);
+  AddPortableBox(&mesh, -0.15, -0.15, 0.00005, -0.02, 0.15, 0.02);
+  AddPortableBox(&mesh, 0.02, -0.15, 0.0002, 0.15, 0.15, 0.02);
+  BodyMapOptions o = FloatOptions(160);
+  o.epsilon = 0.f;
+  o.layout = BodyMapLayout::kDense;
+  o.layers = 2;
+  BodyMapPoseStats stats;
+  const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
+  const GapCheck check = ExpectGaps(
+      pose,
+      [](Vec3d p) {
+        return Inside(p, 0.02, -0.15, 0.15, 0.15) ? ExpectedGaps{{0.0002, 0.0}} : ExpectedGaps{};
+      },
+      {-0.15, -0.02, 0.02, 0.15}, {-0.15, 0.15}, 1e-6, 1e-6);
+  EXPECT_GT(check.texels_with_gaps, 1000u);
+  EXPECT_EQ(stats.dropped_gaps, 0u);
+}
+
+TEST(BodyMapBaker, GapLayersLeaveTheSlabByteIdentical) {
+  const Mesh scene = GapScene();
+  // Hashes of layers = 1 bakes recorded before gap layers existed (the same meshes and options):
+  // asking for no gap must not change a byte. FNV-1a over every field the bake writes.
+  struct Case {
+    DepthEncoding depth;
+    NormalEncoding normal;
+    BodyMapLayout layout;
+    uint32_t resolution;
+    uint64_t hash;
+  };
+  const Case cases[] = {{DepthEncoding::kFloat32, NormalEncoding::kFloat32, BodyMapLayout::kDense,
+                         200, 0x25a4ba18ef37c2b9ull},
+                        {DepthEncoding::kUnorm16, NormalEncoding::kOct16, BodyMapLayout::kRowSpans,
+                         256, 0xd90cb6c4340bd0f2ull},
+                        {DepthEncoding::kUnorm16, NormalEncoding::kRgb8, BodyMapLayout::kDense, 160,
+                         0x8160848a5c820c99ull}};
+  for (const Case& c : cases) {
+    BodyMapOptions o;
+    o.resolution = c.resolution;
+    o.depth_encoding = c.depth;
+    o.normal_encoding = c.normal;
+    o.layout = c.layout;
+    ASSERT_EQ(o.layers, 1) << "paper A's slab alone is the default";
+    BodyMapPoseStats stats;
+    const BodyMapPose one = BakeOrDie(scene, o, &stats);
+    EXPECT_EQ(PoseHash(one), c.hash) << "resolution " << c.resolution;
+    EXPECT_EQ(one.layers, 1);
+    EXPECT_EQ(stats.gap_texels, 0u);
+    EXPECT_EQ(stats.gap_ms, 0.0);
+    // Layer 0 of a bake with gaps is the same bytes, followed by the gap layers.
+    if (c.layout != BodyMapLayout::kDense) continue;
+    o.layers = 3;
+    const BodyMapPose three = BakeOrDie(scene, o, &stats);
+    EXPECT_GT(stats.gap_texels, 1000u);
+    const size_t texels = size_t(one.width) * one.height;
+    const size_t gap_entries = 2 * three.gap_texels.size();
+    EXPECT_EQ(three.gap_texels.size(), stats.gap_texels);
+    EXPECT_TRUE(one.gap_texels.empty());
+    for (int view = 0; view < 2; ++view) {
+      const auto same_prefix = [&](const auto& a, const auto& b, size_t per_texel) {
+        ASSERT_EQ(a.size(), per_texel * texels);
+        ASSERT_EQ(b.size(), per_texel * (texels + gap_entries));
+        if (!a.empty()) {
+          EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])));
+        }
+      };
+      same_prefix(one.depth_f32[view], three.depth_f32[view], c.depth == DepthEncoding::kFloat32);
+      same_prefix(one.depth_u16[view], three.depth_u16[view], c.depth == DepthEncoding::kUnorm16);
+      same_prefix(one.normal_f32[view], three.normal_f32[view],
+                  c.normal == NormalEncoding::kFloat32 ? 3 : 0);
+      same_prefix(one.normal_oct16[view], three.normal_oct16[view],
+                  c.normal == NormalEncoding::kOct16 ? 2 : 0);
+      same_prefix(one.normal_rgb8[view], three.normal_rgb8[view],
+                  c.normal == NormalEncoding::kRgb8 ? 3 : 0);
+    }
+  }
+}
+
+TEST(BodyMapBaker, Unorm16GapsAreStrictlyNestedAfterQuantisation) {
+  // A slanted sheet 1 um thick (less than a unorm16 step, ~2.9 um here) between a slanted slab
+  // and a block, no epsilon: the lower boundary of the first gap (the sheet's top, from the
+  // back) and the upper boundary of the second (the sheet's bottom, from the front) quantise on
+  // different grids and often swap. Such a gap must be dropped, the texel keeping the first.
+  Mesh mesh;
+  AddPortableBox(&mesh, -0.20, -0.20, -0.10, 0.20, 0.20, 0.00);
+  AddSlantedSheet(&mesh, -0.15, -0.15, 0.15, 0.15, 0.030, 0.01, 1e-6);
+  AddSlantedSheet(&mesh, -0.15, -0.15, 0.15, 0.15, 0.060, 0.01, 0.01);
+  BodyMapOptions o;
+  o.resolution = 200;
+  o.epsilon = 0.f;
+  o.depth_encoding = DepthEncoding::kUnorm16;
+  o.normal_encoding = NormalEncoding::kOct16;
+  o.layout = BodyMapLayout::kDense;
+  o.layers = 3;
+  BodyMapPoseStats stats;
+  const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
+  EXPECT_GT(ExpectStrictlyNested(pose), 10000u);
+  size_t two = 0, one = 0;
+  for (uint32_t j = 0; j < pose.height; ++j) {
+    for (uint32_t i = 0; i < pose.width; ++i) {
+      if (!Inside(TexelCentre(pose, i, j), -0.149, -0.149, 0.149, 0.149)) continue;
+      const bool first = ReadBodyMapTexel(pose, 0, i, j, 1).valid;
+      const bool second = ReadBodyMapTexel(pose, 0, i, j, 2).valid;
+      two += first && second;
+      one += first && !second;
+    }
+  }
+  std::printf("[ unorm16 nesting ] %zu texels keep both gaps, %zu only the first; %zu dropped\n",
+              two, one, stats.dropped_gaps);
+  // Both outcomes occur, and every single-gap texel is a dropped one.
+  EXPECT_GT(two, 1000u);
+  EXPECT_GT(one, 1000u);
+  EXPECT_GE(stats.dropped_gaps, one);
+  // With float32 depth nothing needs dropping.
+  o.depth_encoding = DepthEncoding::kFloat32;
+  BodyMapPoseStats float_stats;
+  const BodyMapPose exact = BakeOrDie(mesh, o, &float_stats);
+  ExpectStrictlyNested(exact);
+  EXPECT_EQ(float_stats.dropped_gaps, 0u);
+  EXPECT_EQ(float_stats.gap_texels, stats.gap_texels);
+}
+
+TEST(BodyMapBaker, GapLayersOnCurvedClosedMeshesAreNested) {
+  const Mesh scene = GapScene();
+  for (const bool compact : {false, true}) {
+    BodyMapOptions o = FloatOptions(256);
+    if (compact) {
+      o.depth_encoding = DepthEncoding::kUnorm16;
+      o.normal_encoding = NormalEncoding::kRgb8;
+    }
+    o.layout = BodyMapLayout::kDense;
+    o.layers = 4;
+    BodyMapPoseStats stats;
+    const BodyMapPose pose = BakeOrDie(scene, o, &stats);
+    EXPECT_EQ(ExpectStrictlyNested(pose), stats.gap_texels);
+    // Upper boundaries face into the gap (down), lower ones up: clearly so, except near a
+    // sphere's silhouette, where the vertex normals of the equator ring have z = 0.
+    size_t wrong_way = 0, clear = 0, gaps = 0;
+    for (uint32_t j = 0; j < pose.height; ++j) {
+      for (uint32_t i = 0; i < pose.width; ++i) {
+        for (uint32_t layer = 1; layer < pose.layers; ++layer) {
+          const BodyMapTexel upper = ReadBodyMapTexel(pose, 0, i, j, layer);
+          if (!upper.valid) break;
+          const BodyMapTexel lower = ReadBodyMapTexel(pose, 1, i, j, layer);
+          ++gaps;
+          wrong_way += upper.normal.z > 0.05f || lower.normal.z < -0.05f;
+          clear += upper.normal.z < -0.5f && lower.normal.z > 0.5f;
+        }
+      }
+    }
+    EXPECT_GT(gaps, 5000u);
+    EXPECT_EQ(wrong_way, 0u);
+    EXPECT_GT(clear, gaps * 9 / 10);
+  }
+}
+
+TEST(BodyMapBaker, RowSpansCarryEveryGapLayer) {
+  const Mesh scene = GapScene();
+  for (const bool compact : {false, true}) {
+    SCOPED_TRACE(compact ? "unorm16 + oct16" : "float32");
+    BodyMapOptions o = FloatOptions(256);
+    if (compact) {
+      o.depth_encoding = DepthEncoding::kUnorm16;
+      o.normal_encoding = NormalEncoding::kOct16;
+    }
+    o.layers = 3;
+    o.layout = BodyMapLayout::kDense;
+    BodyMapPoseStats dense_stats, spans_stats, slab_stats;
+    const BodyMapPose dense = BakeOrDie(scene, o, &dense_stats);
+    o.layout = BodyMapLayout::kRowSpans;
+    const BodyMapPose spans = BakeOrDie(scene, o, &spans_stats);
+    o.layers = 1;
+    const BodyMapPose slab = BakeOrDie(scene, o, &slab_stats);
+    ASSERT_EQ(spans.layers, 3);
+    // Layer 0 decides the spans.
+    EXPECT_EQ(spans.row_span_offsets, slab.row_span_offsets);
+    EXPECT_EQ(spans.span_begin, slab.span_begin);
+    EXPECT_EQ(spans.span_texel_offsets, slab.span_texel_offsets);
+    EXPECT_EQ(spans_stats.gap_texels, dense_stats.gap_texels);
+    EXPECT_EQ(spans_stats.stored_texels, slab_stats.stored_texels);
+    const size_t per_texel = compact ? 2 * (2 + 4) : 2 * (4 + 12);
+    const size_t listed = spans.gap_texels.size();
+    EXPECT_EQ(listed, spans_stats.gap_texels);
+    EXPECT_EQ(spans_stats.bytes, per_texel * (spans_stats.stored_texels + 2 * listed) +
+                                     SpanTableBytes(spans) + 4 * listed);
+    BodyMapPose expanded;
+    const Status status = ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &expanded);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(expanded.gap_texels, dense.gap_texels);
+    for (int view = 0; view < 2; ++view) {
+      EXPECT_EQ(expanded.depth_f32[view], dense.depth_f32[view]);
+      EXPECT_EQ(expanded.depth_u16[view], dense.depth_u16[view]);
+      EXPECT_EQ(expanded.normal_f32[view], dense.normal_f32[view]);
+      EXPECT_EQ(expanded.normal_oct16[view], dense.normal_oct16[view]);
+    }
+    size_t mismatches = 0;
+    for (uint32_t j = 0; j < dense.height; ++j) {
+      for (uint32_t i = 0; i < dense.width; ++i) {
+        for (uint32_t layer = 0; layer < 3; ++layer) {
+          for (int view = 0; view < 2; ++view) {
+            const BodyMapTexel a = ReadBodyMapTexel(dense, view, i, j, layer);
+            const BodyMapTexel b = ReadBodyMapTexel(spans, view, i, j, layer);
+            mismatches += a.valid != b.valid || Bits(a.depth) != Bits(b.depth) ||
+                          !SameBits(a.normal, b.normal);
+          }
+        }
+      }
+    }
+    EXPECT_EQ(mismatches, 0u);
+  }
+}
+
+TEST(BodyMapBaker, OsMesaSlabGetsTheCpuGaps) {
+  if (!OsMesaRendererAvailable()) GTEST_SKIP() << "OSMesa renderer not available in this build";
+  const Mesh scene = GapScene();
+  BodyMapOptions o = FloatOptions(256);
+  o.layout = BodyMapLayout::kDense;
+  o.layers = 3;
+  BodyMapPoseStats cpu_stats, gl_stats;
+  const BodyMapPose cpu = BakeOrDie(scene, o, &cpu_stats);
+  o.renderer = MapRenderer::kOsMesa;
+  const BodyMapPose gl = BakeOrDie(scene, o, &gl_stats);
+  ASSERT_EQ(gl.width, cpu.width);
+  ASSERT_EQ(gl.height, cpu.height);
+  EXPECT_EQ(ExpectStrictlyNested(gl), gl_stats.gap_texels);
+  // The gaps come from the same CPU fragment pass: they differ only where OSMesa's slab does.
+  size_t differ = 0;
+  for (uint32_t j = 0; j < cpu.height; ++j) {
+    for (uint32_t i = 0; i < cpu.width; ++i) {
+      for (uint32_t layer = 1; layer < 3; ++layer) {
+        const BodyMapTexel a = ReadBodyMapTexel(cpu, 0, i, j, layer);
+        const BodyMapTexel b = ReadBodyMapTexel(gl, 0, i, j, layer);
+        differ += a.valid != b.valid || (a.valid && Bits(a.depth) != Bits(b.depth));
+      }
+    }
+  }
+  std::printf("[ osmesa gaps ] %zu gap texels (cpu %zu), %zu texel-layers differ, %zu dropped\n",
+              gl_stats.gap_texels, cpu_stats.gap_texels, differ, gl_stats.dropped_gaps);
+  EXPECT_GT(cpu_stats.gap_texels, 1000u);
+  EXPECT_LE(differ, cpu_stats.gap_texels / 100);
+}
+
+TEST(BodyMapBaker, BadLayerCountsAreRefused) {
+  const Mesh scene = GapScene();
+  BodyMapPose pose;
+  pose.width = 42;
+  for (const int layers : {0, 5, 255}) {
+    BodyMapOptions o;
+    o.resolution = 64;
+    o.layers = static_cast<uint8_t>(layers);
+    const Status status = BakeBodyMapPose(scene.positions, scene.triangles, o, &pose);
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << layers;
+    EXPECT_NE(status.message().find("layers " + std::to_string(layers) + " is outside [1, 4]"),
+              std::string::npos)
+        << status.message();
+    EXPECT_EQ(pose.width, 42u);
+  }
+}
+
+TEST(BodyMapBaker, PreviewWritesGapLayerPngs) {
+  const Mesh scene = GapScene();
+  BodyMapOptions o;
+  o.resolution = 128;
+  o.depth_encoding = DepthEncoding::kUnorm16;
+  o.layout = BodyMapLayout::kDense;
+  o.layers = 3;
+  const BodyMapPose pose = BakeOrDie(scene, o);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("drape_body_map_gap_preview_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const Status status = WriteBodyMapPreview(pose, dir.string(), "scene");
+  ASSERT_TRUE(status.ok()) << status.message();
+  for (const char* name :
+       {"scene_front_depth.png", "scene_back_depth.png", "scene_front_normal.png",
+        "scene_back_normal.png", "scene_gap1_front_depth.png", "scene_gap1_back_depth.png",
+        "scene_gap2_front_depth.png", "scene_gap2_back_depth.png"}) {
+    const std::filesystem::path file = dir / name;
+    ASSERT_TRUE(std::filesystem::exists(file)) << file;
+    EXPECT_GT(std::filesystem::file_size(file), 60u) << file;
+  }
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    files += entry.is_regular_file();
+  EXPECT_EQ(files, 8u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BodyMapBaker, BakeReportCarriesTheGapFields) {
+  BakeConfig config;
+  config.hulls_enabled = false;
+  config.spheres_enabled = false;
+  config.maps.resolution = 128;
+  config.maps.layers = 2;
+  BakeResult result;
+  const Status status = BakeCharacter(test::MannequinPath(), config, &result);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(result.asset.body_maps.poses.size(), 1u);
+  EXPECT_EQ(result.asset.body_maps.poses[0].layers, 2);
+  const nlohmann::json& report = result.report["body_maps"]["poses"][0];
+  EXPECT_EQ(report["layers"], 2);
+  EXPECT_TRUE(report["gap_texels"].is_number_unsigned()) << report.dump();
+  EXPECT_TRUE(report["dropped_gaps"].is_number_unsigned()) << report.dump();
+  EXPECT_GT(report["gap_ms"].get<double>(), 0.0);
 }
 
 }  // namespace

@@ -1,16 +1,24 @@
 // Tests of the body map bake's private CPU rasterizer (bake/src/cpu_rasterizer.h): the two-view
 // pass is bit-identical to two single-view passes, and images reused from an earlier call (the
 // same input again, or a bigger raster before a smaller one; the rasterizer keeps its working
-// depths in them) give exactly what fresh images give, with no stale texel.
+// depths in them) give exactly what fresh images give, with no stale texel. The fragment pass
+// of the gap layers: its nearest fragments are the rasterizer's texels bit for bit, and on a
+// closed mesh every texel's facing signs sum to zero (even with texel centres on edges and
+// vertices: the top-left rule is a consistent tie-break).
 
 #include "../../bake/src/cpu_rasterizer.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace drape::bake {
@@ -138,6 +146,176 @@ TEST(CpuRasterizer, ReusedBuffersMatchFreshOnesAndKeepNoStaleTexel) {
       ExpectSameImage(reused[view], fresh[view]);
     }
   }
+}
+
+// --- The fragment pass (CollectFragmentsCpu) ---
+
+uint32_t Bits(float v) { return std::bit_cast<uint32_t>(v); }
+uint64_t Bits(double v) { return std::bit_cast<uint64_t>(v); }
+
+TEST(CpuRasterizer, NearestFragmentsAreTheRasterizedTexelsBitForBit) {
+  for (uint64_t seed : {21u, 22u, 23u}) {
+    const Soup soup = MakeSoup(seed, 110 + static_cast<uint32_t>(seed), 95, 4000, 14.0);
+    const MapRasterInput in = soup.Input();
+    MapViewImage images[2];
+    std::vector<uint32_t> faces[2];
+    for (int view = 0; view < 2; ++view) RasterizeViewCpu(in, view, &images[view], &faces[view]);
+    MapFragments fragments;
+    ASSERT_TRUE(CollectFragmentsCpu(in, 1, &fragments));
+    const size_t texels = static_cast<size_t>(in.width) * in.height;
+    ASSERT_EQ(fragments.offsets.size(), texels + 1);
+    ASSERT_EQ(fragments.offsets.back(), fragments.depth.size());
+    ASSERT_EQ(fragments.triangle.size(), fragments.depth.size());
+    ASSERT_EQ(fragments.facing.size(), fragments.depth.size());
+    size_t mismatches = 0, multi = 0;
+    for (uint32_t j = 0; j < in.height; ++j) {
+      for (uint32_t i = 0; i < in.width; ++i) {
+        const size_t n = static_cast<size_t>(j) * in.width + i;
+        const uint32_t begin = fragments.offsets[n], end = fragments.offsets[n + 1];
+        ASSERT_LE(begin, end);
+        mismatches += (begin < end) != (images[0].valid[n] != 0);
+        if (begin == end) continue;
+        multi += end - begin > 1;
+        // The winners: minimum depth, ties to the lower triangle (the rasterizer's GL_LESS).
+        for (int view = 0; view < 2; ++view) {
+          double best = 0.0;
+          uint32_t best_triangle = 0;
+          for (uint32_t f = begin; f < end; ++f) {
+            const uint32_t t = fragments.triangle[f];
+            const double d = FragmentDepth(in, view, t, i, j);
+            if (view == 0) mismatches += Bits(d) != Bits(fragments.depth[f]);
+            if (f == begin || d < best) {
+              best = d;
+              best_triangle = t;
+            }
+          }
+          mismatches += Bits(static_cast<float>(best)) != Bits(images[view].depth[n]);
+          mismatches += best_triangle != faces[view][n];
+          float normal[3];
+          FragmentNormal(in, best_triangle, i, j, view == 0 ? 1.0 : -1.0, normal);
+          for (int c = 0; c < 3; ++c) {
+            mismatches += Bits(normal[c]) != Bits(images[view].normal[3 * n + c]);
+          }
+        }
+        for (uint32_t f = begin; f < end; ++f) {
+          // Ascending triangles; the facing is the sign of the window area.
+          if (f > begin) mismatches += fragments.triangle[f] <= fragments.triangle[f - 1];
+          const uint32_t t = fragments.triangle[f];
+          const uint32_t a = soup.triangles[3 * t], b = soup.triangles[3 * t + 1],
+                         c = soup.triangles[3 * t + 2];
+          const double area2 =
+              (soup.window_x[b] - soup.window_x[a]) * (soup.window_y[c] - soup.window_y[a]) -
+              (soup.window_y[b] - soup.window_y[a]) * (soup.window_x[c] - soup.window_x[a]);
+          mismatches += fragments.facing[f] != (area2 > 0.0 ? 1 : -1);
+        }
+      }
+    }
+    SCOPED_TRACE(testing::Message() << "seed " << seed);
+    EXPECT_EQ(mismatches, 0u);
+    EXPECT_GT(multi, 1000u) << "the soup must overlap itself";
+    // Reused storage gives the same fragments.
+    MapFragments again = fragments;
+    ASSERT_TRUE(CollectFragmentsCpu(MakeSoup(seed + 100, 40, 30, 200, 5.0).Input(), 1, &again));
+    ASSERT_TRUE(CollectFragmentsCpu(in, 1, &again));
+    EXPECT_EQ(again.offsets, fragments.offsets);
+    EXPECT_EQ(again.triangle, fragments.triangle);
+    EXPECT_EQ(again.facing, fragments.facing);
+    EXPECT_EQ(0, std::memcmp(again.depth.data(), fragments.depth.data(),
+                             fragments.depth.size() * sizeof(double)));
+    // min_fragments = 3: the texels with 3 or more keep the same fragments, the others none.
+    MapFragments three;
+    ASSERT_TRUE(CollectFragmentsCpu(in, 3, &three));
+    ASSERT_EQ(three.offsets.size(), fragments.offsets.size());
+    size_t kept = 0, filter_mismatches = 0;
+    for (size_t n = 0; n < texels; ++n) {
+      const uint32_t begin = fragments.offsets[n], end = fragments.offsets[n + 1];
+      const uint32_t count = three.offsets[n + 1] - three.offsets[n];
+      if (end - begin < 3) {
+        filter_mismatches += count != 0;
+        continue;
+      }
+      ++kept;
+      filter_mismatches += count != end - begin;
+      for (uint32_t k = 0; k < count && count == end - begin; ++k) {
+        filter_mismatches +=
+            three.triangle[three.offsets[n] + k] != fragments.triangle[begin + k] ||
+            Bits(three.depth[three.offsets[n] + k]) != Bits(fragments.depth[begin + k]) ||
+            three.facing[three.offsets[n] + k] != fragments.facing[begin + k];
+      }
+    }
+    EXPECT_GT(kept, 100u);
+    EXPECT_EQ(filter_mismatches, 0u);
+    EXPECT_LT(three.depth.size(), fragments.depth.size());
+  }
+}
+
+// A closed sphere (a subdivided octahedron, counter-clockwise seen from outside) in raster
+// coordinates, its vertices snapped to the half-texel lattice so that texel centres fall on
+// edges and vertices and every edge test is exact.
+Soup MakeSnappedSphere(double cx, double cy, double radius, int levels) {
+  std::vector<std::array<double, 3>> p = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                          {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                            {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
+    const auto mid = [&](uint32_t a, uint32_t b) {
+      const auto key = std::minmax(a, b);
+      if (const auto found = midpoints.find(key); found != midpoints.end()) return found->second;
+      std::array<double, 3> q = {p[a][0] + p[b][0], p[a][1] + p[b][1], p[a][2] + p[b][2]};
+      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+      for (double& c : q) c /= len;
+      p.push_back(q);
+      midpoints.emplace(key, static_cast<uint32_t>(p.size() - 1));
+      return static_cast<uint32_t>(p.size() - 1);
+    };
+    std::vector<std::array<uint32_t, 3>> finer;
+    for (const auto& f : t) {
+      const uint32_t ab = mid(f[0], f[1]), bc = mid(f[1], f[2]), ca = mid(f[2], f[0]);
+      finer.insert(finer.end(), {{f[0], ab, ca}, {ab, f[1], bc}, {ca, bc, f[2]}, {ab, bc, ca}});
+    }
+    t = std::move(finer);
+  }
+  Soup s;
+  s.width = static_cast<uint32_t>(2 * cx);
+  s.height = static_cast<uint32_t>(2 * cy);
+  for (const auto& q : p) {
+    s.window_x.push_back(std::round(2.0 * (cx + radius * q[0])) / 2.0);
+    s.window_y.push_back(std::round(2.0 * (cy + radius * q[1])) / 2.0);
+    s.depth_front.push_back(2.0 - q[2]);
+    s.depth_back.push_back(2.0 + q[2]);
+    for (int c = 0; c < 3; ++c) s.normals.push_back(q[c]);
+    s.positions.insert(s.positions.end(), {s.window_x.back(), s.window_y.back(), q[2]});
+  }
+  for (const auto& f : t) s.triangles.insert(s.triangles.end(), {f[0], f[1], f[2]});
+  return s;
+}
+
+TEST(CpuRasterizer, ClosedMeshFacingsSumToZeroAtEveryTexel) {
+  const Soup sphere = MakeSnappedSphere(40.0, 35.0, 30.0, 4);  // 2048 triangles
+  const MapRasterInput in = sphere.Input();
+  MapFragments fragments;
+  ASSERT_TRUE(CollectFragmentsCpu(in, 1, &fragments));
+  size_t covered = 0, unbalanced = 0, entering_first = 0;
+  for (size_t n = 0; n + 1 < fragments.offsets.size(); ++n) {
+    const uint32_t begin = fragments.offsets[n], end = fragments.offsets[n + 1];
+    if (begin == end) continue;
+    ++covered;
+    int sum = 0;
+    for (uint32_t f = begin; f < end; ++f) sum += fragments.facing[f];
+    unbalanced += sum != 0;
+    // Among the nearest fragments (depths within rounding of the minimum: at the silhouette the
+    // front and back triangles meet) one enters the body.
+    double nearest = fragments.depth[begin];
+    for (uint32_t f = begin; f < end; ++f) nearest = std::min(nearest, fragments.depth[f]);
+    bool enters = false;
+    for (uint32_t f = begin; f < end; ++f)
+      enters = enters || (fragments.depth[f] <= nearest + 1e-9 && fragments.facing[f] == 1);
+    entering_first += enters;
+  }
+  EXPECT_GT(covered, 2500u);  // about pi * 30^2
+  EXPECT_EQ(unbalanced, 0u);
+  EXPECT_EQ(entering_first, covered);
 }
 
 }  // namespace

@@ -5,6 +5,10 @@
 // render times the baker reports (CPU: rasterize + normals; OSMesa: upload + clear + draw + finish
 // + readback), front_min_ms / back_min_ms the fastest iteration's (the least disturbed figure on
 // a shared machine). The OSMesa context and its shader JIT (~60 ms) are warmed up before timing.
+// The last argument is BodyMapOptions::layers: with 3 the bake adds the gap layers' CPU fragment
+// pass (body_map_baker.h step 8), whichever renderer drew layer 0; gap_ms / gap_min_ms are its
+// mean and fastest time (included in the wall time and, half each, in front_ms / back_ms), and
+// gap_texels the texels that got a gap.
 
 #include <benchmark/benchmark.h>
 
@@ -103,7 +107,7 @@ Mesh MakeMannequin(int t) {
 }
 
 // Arguments: mesh (0 sphere, 1 mannequin), size (0: ~5k triangles, 1: ~80k), N, renderer
-// (0 CPU, 1 OSMesa).
+// (0 CPU, 1 OSMesa), layers (1: paper A's slab; 3: up to two gaps).
 void BM_BodyMapBake(benchmark::State& state) {
   const bool mannequin = state.range(0) == 1;
   const bool large = state.range(1) == 1;
@@ -112,6 +116,7 @@ void BM_BodyMapBake(benchmark::State& state) {
   options.resolution = static_cast<uint32_t>(state.range(2));
   options.renderer =
       state.range(3) == 0 ? drape::bake::MapRenderer::kCpu : drape::bake::MapRenderer::kOsMesa;
+  options.layers = static_cast<uint8_t>(state.range(4));
   if (options.renderer == drape::bake::MapRenderer::kOsMesa &&
       !drape::bake::OsMesaRendererAvailable()) {
     state.SkipWithError("OSMesa renderer not available in this build");
@@ -126,6 +131,7 @@ void BM_BodyMapBake(benchmark::State& state) {
   }
   double front_ms = 0.0, back_ms = 0.0;
   double front_min_ms = 1e300, back_min_ms = 1e300;  // the least disturbed view on a busy machine
+  double gap_ms = 0.0, gap_min_ms = 1e300;
   int64_t bakes = 0;
   for (auto _ : state) {
     const drape::Status status =
@@ -138,6 +144,8 @@ void BM_BodyMapBake(benchmark::State& state) {
     back_ms += stats.render_ms_back;
     front_min_ms = std::min(front_min_ms, stats.render_ms_front);
     back_min_ms = std::min(back_min_ms, stats.render_ms_back);
+    gap_ms += stats.gap_ms;
+    gap_min_ms = std::min(gap_min_ms, stats.gap_ms);
     ++bakes;
     benchmark::DoNotOptimize(pose.depth_f32[0].data());
   }
@@ -147,12 +155,22 @@ void BM_BodyMapBake(benchmark::State& state) {
   state.counters["front_min_ms"] = front_min_ms;
   state.counters["back_min_ms"] = back_min_ms;
   state.counters["coverage"] = stats.coverage;
+  state.counters["gap_ms"] = gap_ms / static_cast<double>(bakes);
+  state.counters["gap_min_ms"] = gap_min_ms;
+  state.counters["gap_texels"] = static_cast<double>(stats.gap_texels);
   state.SetLabel(stats.renderer);
 }
 
 BENCHMARK(BM_BodyMapBake)
-    ->ArgNames({"mannequin", "80k", "N", "osmesa"})
-    ->ArgsProduct({{0, 1}, {0, 1}, {512, 1024, 2048}, {0, 1}})
+    ->ArgNames({"mannequin", "80k", "N", "osmesa", "layers"})
+    ->ArgsProduct({{0, 1}, {0, 1}, {512, 1024, 2048}, {0, 1}, {1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+// The gap layers' cost: the ~80k-triangle meshes at N = 1024 with up to two gaps (compare with
+// the layers:1 rows above).
+BENCHMARK(BM_BodyMapBake)
+    ->ArgNames({"mannequin", "80k", "N", "osmesa", "layers"})
+    ->ArgsProduct({{0, 1}, {1}, {1024}, {0, 1}, {3}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -515,8 +515,10 @@ bool HasLayer(size_t k, size_t n) {
   return k == 0 ? c != '.' : (c == '2' || (c == '1' && k == 1));
 }
 
-// A dense pose with `layers` layers (1 to 3) of the texels above, in the given encodings;
-// background values everywhere a layer has no surface (as the bake writes).
+// A dense pose with `layers` layers (1 to 3) of the texels above, in the given encodings, stored
+// as the format stores them: layer 0 of every texel, then the gap layers of the texels with a
+// gap ('1' and '2': gap_texels = {1, 2, 7, 8, 10}); background values everywhere a layer has
+// no surface (as the bake writes).
 BodyMapPose LayeredDensePose(DepthEncoding depth, NormalEncoding normal, uint8_t layers) {
   BodyMapPose p;
   p.clip = 0;
@@ -532,7 +534,10 @@ BodyMapPose LayeredDensePose(DepthEncoding depth, NormalEncoding normal, uint8_t
   p.normal_encoding = normal;
   p.layers = layers;
   const size_t texels = 15;
-  const size_t entries = texels * layers;
+  for (size_t n = 0; n < texels && layers > 1; ++n)
+    if (HasLayer(1, n)) p.gap_texels.push_back(static_cast<uint32_t>(n));
+  const size_t gaps = p.gap_texels.size();
+  const size_t entries = texels + (layers - 1u) * gaps;
   for (int v = 0; v < 2; ++v) {
     if (depth == DepthEncoding::kFloat32) {
       p.depth_f32[v].assign(entries, p.depth_range);
@@ -543,9 +548,10 @@ BodyMapPose LayeredDensePose(DepthEncoding depth, NormalEncoding normal, uint8_t
     p.normal_oct16[v].assign(normal == NormalEncoding::kOct16 ? 2 * entries : 0, 0);
     p.normal_rgb8[v].assign(normal == NormalEncoding::kRgb8 ? 3 * entries : 0, 0);
     for (size_t k = 0; k < layers; ++k) {
-      for (size_t n = 0; n < texels; ++n) {
+      for (size_t t = 0; t < (k == 0 ? texels : gaps); ++t) {
+        const size_t n = k == 0 ? t : p.gap_texels[t];
         if (!HasLayer(k, n)) continue;
-        const size_t e = k * texels + n;
+        const size_t e = k == 0 ? n : texels + (k - 1) * gaps + t;
         const float d = LayerDepth(v, k, n);
         if (depth == DepthEncoding::kFloat32) {
           p.depth_f32[v][e] = d;
@@ -574,6 +580,7 @@ void ExpectSameMaps(const BodyMapPose& a, const BodyMapPose& b) {
   EXPECT_EQ(a.row_span_offsets, b.row_span_offsets);
   EXPECT_EQ(a.span_begin, b.span_begin);
   EXPECT_EQ(a.span_texel_offsets, b.span_texel_offsets);
+  EXPECT_EQ(a.gap_texels, b.gap_texels);
   for (int v = 0; v < 2; ++v) {
     EXPECT_EQ(a.depth_f32[v], b.depth_f32[v]) << "view " << v;
     EXPECT_EQ(a.depth_u16[v], b.depth_u16[v]) << "view " << v;
@@ -619,17 +626,21 @@ TEST(BodyMapLayers, ThreeLayersRoundTripInEveryEncodingAndBothLayouts) {
         const BodyMapPose& back = b.body_maps.poses[1];
         EXPECT_EQ(back.layers, 3);
         ExpectSameMaps(back, pose);
-        // Gap 2 at texel (0, 2) (dense texel 10), front view: entry 2 * stored + index.
+        // Gap 2 at texel (0, 2) (dense texel 10, the last of the 5 gap texels), front view:
+        // entry stored + 1 * 5 + 4.
         const size_t stored = BodyMapStoredTexels(back);
         EXPECT_EQ(stored, layout == BodyMapLayout::kDense ? 15u : 9u);
         const int64_t index = BodyMapTexelIndex(back, 0, 2);
         ASSERT_GE(index, 0);
-        const size_t entry = 2 * stored + static_cast<size_t>(index);
+        ASSERT_EQ(back.gap_texels.size(), 5u);
+        EXPECT_EQ(back.gap_texels[4], static_cast<uint32_t>(index));
+        EXPECT_EQ(BodyMapArrayEntries(back), stored + 2 * 5);
+        const size_t entry = stored + 5 + 4;
         if (depth == DepthEncoding::kFloat32) {
-          EXPECT_EQ(back.depth_f32[0].size(), 3 * stored);
+          EXPECT_EQ(back.depth_f32[0].size(), stored + 10);
           EXPECT_EQ(back.depth_f32[0][entry], LayerDepth(0, 2, 10));
         } else {
-          EXPECT_EQ(back.depth_u16[1].size(), 3 * stored);
+          EXPECT_EQ(back.depth_u16[1].size(), stored + 10);
           EXPECT_EQ(back.depth_u16[1][entry], std::lround(LayerDepth(1, 2, 10) * 65535.f));
         }
         EXPECT_EQ(Encode(b), bytes) << "the writer is deterministic";
@@ -655,7 +666,7 @@ TEST(BodyMapLayers, LayersFollowLayoutBeforeTheSpanTable) {
   CharacterAsset out;
   const Status s = DecodeAsset(bad, "layers.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_NE(s.message().find("body_maps.poses[1].depth_f32_front has 27 elements, expected 18"),
+  EXPECT_NE(s.message().find("body_maps.poses[1].depth_f32_front has 19 elements, expected 14"),
             std::string::npos)
       << s.message();
 }
@@ -697,7 +708,7 @@ TEST(BodyMapLayers, LayerCountOutsideOneToFourIsRefusedNamingTheField) {
 }
 
 TEST(BodyMapLayers, ArraysSizedForAnotherLayerCountAreRefusedNamingTheArray) {
-  const CharacterAsset good = LayeredAsset();  // 9 stored texels, 3 layers
+  const CharacterAsset good = LayeredAsset();  // 9 stored texels, 3 layers, 5 gap texels: 19
   const auto expect = [](const CharacterAsset& a, const std::string& text) {
     const Status s = ValidateAsset(a);
     EXPECT_NE(s.message().find(text), std::string::npos) << s.message();
@@ -706,28 +717,32 @@ TEST(BodyMapLayers, ArraysSizedForAnotherLayerCountAreRefusedNamingTheArray) {
   };
   const std::string at = "body_maps.poses[1].";
   CharacterAsset a = good;
-  a.body_maps.poses[1].layers = 2;  // the arrays hold three
-  expect(a, at + "depth_f32_front has 27 elements, expected 18");
+  a.body_maps.poses[1].layers = 2;  // the arrays hold two gap layers
+  expect(a, at + "depth_f32_front has 19 elements, expected 14");
   a = good;
   a.body_maps.poses[1].layers = 4;
-  expect(a, at + "depth_f32_front has 27 elements, expected 36");
+  expect(a, at + "depth_f32_front has 19 elements, expected 24");
   a = good;
-  a.body_maps.poses[1].depth_f32[1].resize(18);  // back depth of two layers only
-  expect(a, at + "depth_f32_back has 18 elements, expected 27");
+  a.body_maps.poses[1].gap_texels.pop_back();  // a gap texel fewer: 9 + 2 * 4
+  expect(a, at + "depth_f32_front has 19 elements, expected 17");
   a = good;
-  a.body_maps.poses[1].normal_oct16[1].resize(2 * 9);  // one layer of normals
-  expect(a, at + "normal_oct16_back has 18 elements, expected 54");
-  // Dense: 15 texels a layer.
+  a.body_maps.poses[1].depth_f32[1].resize(14);  // back depth of one gap layer only
+  expect(a, at + "depth_f32_back has 14 elements, expected 19");
+  a = good;
+  a.body_maps.poses[1].normal_oct16[1].resize(2 * 9);  // the slab's normals only
+  expect(a, at + "normal_oct16_back has 18 elements, expected 38");
+  // Dense: 15 texels and 5 gap texels.
   CharacterAsset dense = SmallAsset();
   dense.body_maps.poses.push_back(
       LayeredDensePose(DepthEncoding::kUnorm16, NormalEncoding::kRgb8, 2));
   ASSERT_TRUE(ValidateAsset(dense).ok()) << ValidateAsset(dense).message();
   dense.body_maps.poses[1].normal_rgb8[0].resize(3 * 15);
-  expect(dense, at + "normal_rgb8_front has 45 elements, expected 90");
+  expect(dense, at + "normal_rgb8_front has 45 elements, expected 60");
 }
 
-// Gaps hold a surface in both views or neither, and only where the layer outside them does:
-// otherwise the row spans, which follow the slab, would lose them.
+// The gap list names stored texels with a slab, in increasing order, each holding gap 1; a gap
+// holds a surface in both views or neither: otherwise the row spans, which follow the slab,
+// would lose gaps, or a gap would read another texel's values.
 TEST(BodyMapLayers, GapsOutsideTheSlabOrOutOfOrderAreRefused) {
   const auto expect = [](const BodyMapPose& pose, const std::string& text) {
     CharacterAsset a = SmallAsset();
@@ -738,26 +753,34 @@ TEST(BodyMapLayers, GapsOutsideTheSlabOrOutOfOrderAreRefused) {
     const Status c = ConvertBodyMapLayout(pose, BodyMapLayout::kRowSpans, &converted);
     EXPECT_NE(c.message().find(text), std::string::npos) << c.message();
   };
+  // 15 texels; gap_texels {1, 2, 7, 8, 10}: layer 1 of the t-th is entry 15 + t, layer 2 20 + t.
   const BodyMapPose good = LayeredDensePose(DepthEncoding::kFloat32, NormalEncoding::kFloat32, 3);
+  ASSERT_EQ(good.gap_texels, (std::vector<uint32_t>{1, 2, 7, 8, 10}));
   BodyMapPose p = good;
-  p.depth_f32[1][15 + 1] = p.depth_range;  // gap 1 at texel 1: upper boundary only
+  p.depth_f32[1][15] = p.depth_range;  // gap 1 at texel 1: upper boundary only
   expect(p,
-         "depth_f32_back[16] is background where the other view is not (layer 1, stored "
-         "texel 1: a gap has both boundaries or neither)");
+         "depth_f32_back[15] is background where the other view is not (layer 1 of "
+         "gap_texels[0] = 1: a gap has both boundaries or neither)");
   p = good;
-  p.depth_f32[0][15 + 3] = 0.3f;  // gap 1 at texel 3, where there is no slab
-  p.depth_f32[1][15 + 3] = 0.6f;
-  expect(p,
-         "depth_f32_front[18] holds a gap (layer 1, stored texel 3) where the slab (layer 0) "
-         "is background");
+  p.depth_f32[0][16] = p.depth_range;  // texel 2 is listed but has no gap 1
+  p.depth_f32[1][16] = p.depth_range;
+  expect(p, "depth_f32_front[16] is background (layer 1 of");
   p = good;
-  p.depth_f32[0][30 + 0] = 0.5f;  // gap 2 at texel 0, which has no gap 1
-  p.depth_f32[1][30 + 0] = 0.4f;
-  expect(p, "depth_f32_front[30] holds a gap (layer 2, stored texel 0) where layer 1 holds none");
+  p.gap_texels[2] = 3;  // texel 3 has no slab
+  expect(p, "gap_texels[2] = 3 holds a gap where the slab (layer 0) is background");
+  p = good;
+  p.gap_texels[1] = 1;
+  expect(p, "gap_texels[1] = 1 does not increase");
+  p = good;
+  p.gap_texels[4] = 15;
+  expect(p, "gap_texels[4] = 15 is not a stored texel (15 stored)");
+  p = LayeredDensePose(DepthEncoding::kFloat32, NormalEncoding::kFloat32, 1);
+  p.gap_texels = {1};
+  expect(p, "gap_texels has 1 entries but layers = 1 (no gap layers)");
   // unorm16 background is 65535.
   BodyMapPose u = LayeredDensePose(DepthEncoding::kUnorm16, NormalEncoding::kOct16, 2);
-  u.depth_u16[0][15 + 2] = 65535;  // gap 1 at texel 2: lower boundary only
-  expect(u, "depth_u16_front[17] is background where the other view is not");
+  u.depth_u16[0][15 + 1] = 65535;  // gap 1 at texel 2: lower boundary only
+  expect(u, "depth_u16_front[16] is background where the other view is not");
 }
 
 // Spans are decided by the slab alone and carry every layer of each kept texel; dense -> spans
@@ -779,17 +802,17 @@ TEST(BodyMapLayers, ConvertKeepsEveryLayerBothWays) {
     EXPECT_EQ(spans.span_texel_offsets, (std::vector<uint32_t>{0, 3, 4, 7, 9}));
     const size_t stored = BodyMapStoredTexels(spans);
     ASSERT_EQ(stored, 9u);
-    EXPECT_EQ(spans.normal_rgb8[0].size(), 3 * 2 * stored);
-    // Layer 1 of texel (3, 1) (dense 8, gap 1) and of texel (1, 1) (dense 6, slab only).
-    const size_t gap = stored + static_cast<size_t>(BodyMapTexelIndex(spans, 3, 1));
-    const size_t no_gap = stored + static_cast<size_t>(BodyMapTexelIndex(spans, 1, 1));
+    // The gap list renumbered to span positions (dense 1, 2, 7, 8, 10), the gaps in order.
+    EXPECT_EQ(spans.gap_texels, (std::vector<uint32_t>{1, 2, 5, 6, 7}));
+    EXPECT_EQ(spans.normal_rgb8[0].size(), 3 * (stored + 5));
+    // Layer 1 of texel (3, 1) (dense 8, the fourth gap texel).
+    EXPECT_EQ(spans.gap_texels[3], static_cast<uint32_t>(BodyMapTexelIndex(spans, 3, 1)));
+    const size_t gap = stored + 3;
     EXPECT_EQ(spans.normal_rgb8[1][3 * gap + 2], 40 + 2 * 8 + 1 + 2);
-    EXPECT_EQ(spans.normal_rgb8[1][3 * no_gap], 0);
     if (depth == DepthEncoding::kFloat32) {
       EXPECT_EQ(spans.depth_f32[1][gap], LayerDepth(1, 1, 8));
-      EXPECT_EQ(spans.depth_f32[1][no_gap], spans.depth_range);
     } else {
-      EXPECT_EQ(spans.depth_u16[1][no_gap], 65535);
+      EXPECT_EQ(spans.depth_u16[1][gap], std::lround(LayerDepth(1, 1, 8) * 65535.f));
     }
     BodyMapPose back;
     ASSERT_TRUE(ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &back).ok());
@@ -839,6 +862,11 @@ TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
   ASSERT_EQ(bytes[layers_at], 1);
   bytes[pose] = 2;
   bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(layers_at));
+  // The dense pose's empty span table (three uint64 counts), then gap_texels' count: remove it.
+  const size_t gap_count_at = layers_at + 3 * 8;
+  for (size_t i = 0; i < 8; ++i) ASSERT_EQ(bytes[gap_count_at + i], 0) << i;
+  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at),
+              bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at + 8));
   const uint64_t payload = bytes.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   bytes[8] = 2;
@@ -924,43 +952,45 @@ TEST(GoldenFile, MannequinVersion2LoadsWithExpectedContent) {
   EXPECT_TRUE(a.hulls.empty());
 }
 
-// tests/golden/mannequin_v3.json: version 2's bake with maps.layers = 4. Written once by the
-// format version 3 writer; never regenerated. The mannequin's rest pose has no air gap along z
-// at N = 64 (A-pose: the arms are clear of the torso's sides), so layers 1 to 3 are background
-// throughout: the file tests the layer-major arrays, the BodyMapLayers tests above the gap values.
-// Layer 0 is version 2's pose, texel for texel.
+// tests/golden/mannequin_v3.json: the walk at two poses (t = 0 and 1 s) at N = 192 with
+// maps.layers = 4, joint spheres, no hulls. Written once by the format version 3 writer; never
+// regenerated. At N = 192 the walking mannequin has air along z on 5 texels per pose (a hand
+// passing before the thigh): the file carries a real gap list. Every listed texel holds gap 1,
+// strictly nested in its slab after decoding, as the runtime's Build requires.
 TEST(GoldenFile, MannequinVersion3LoadsWithExpectedContent) {
   CharacterAsset a;
   ASSERT_NO_FATAL_FAILURE(ReadGoldenFile("mannequin_v3.drape", 3, &a));
   ExpectMannequinContent(a);
-  ASSERT_EQ(a.body_maps.poses.size(), 1u);
-  EXPECT_EQ(a.body_maps.resolution, 64u);
-  const BodyMapPose& pose = a.body_maps.poses[0];
-  EXPECT_EQ(pose.layout, BodyMapLayout::kRowSpans);
-  EXPECT_EQ(pose.layers, 4);
-  EXPECT_EQ(pose.width, 54u);
-  EXPECT_EQ(pose.height, 66u);
-  const size_t stored = BodyMapStoredTexels(pose);
-  EXPECT_EQ(stored, 744u);
-  ASSERT_EQ(pose.depth_u16[0].size(), 4u * 744u);
-  ASSERT_EQ(pose.normal_oct16[1].size(), 2u * 4u * 744u);
+  ASSERT_EQ(a.body_maps.poses.size(), 2u);
+  EXPECT_EQ(a.body_maps.resolution, 192u);
   EXPECT_EQ(a.joint_spheres.size(), 16u);
   EXPECT_TRUE(a.hulls.empty());
-  CharacterAsset v2;
-  ASSERT_NO_FATAL_FAILURE(ReadGoldenFile("mannequin_v2.drape", 2, &v2));
-  const BodyMapPose& slab = v2.body_maps.poses[0];
-  EXPECT_EQ(pose.span_texel_offsets, slab.span_texel_offsets);
-  for (int view = 0; view < 2; ++view) {
-    const std::vector<uint16_t>& depth = pose.depth_u16[view];
-    const std::vector<uint16_t>& normal = pose.normal_oct16[view];
-    EXPECT_TRUE(std::equal(slab.depth_u16[view].begin(), slab.depth_u16[view].end(), depth.begin()))
-        << "layer 0 of view " << view;
-    EXPECT_TRUE(std::all_of(depth.begin() + static_cast<std::ptrdiff_t>(stored), depth.end(),
-                            [](uint16_t d) { return d == 65535; }))
-        << "gap depths of view " << view;
-    EXPECT_TRUE(std::all_of(normal.begin() + static_cast<std::ptrdiff_t>(2 * stored), normal.end(),
-                            [](uint16_t n) { return n == 0; }))
-        << "gap normals of view " << view;
+  for (const BodyMapPose& pose : a.body_maps.poses) {
+    SCOPED_TRACE(::testing::Message() << "t = " << pose.time);
+    EXPECT_EQ(pose.clip, 0);
+    EXPECT_EQ(pose.layout, BodyMapLayout::kRowSpans);
+    EXPECT_EQ(pose.layers, 4);
+    const size_t stored = BodyMapStoredTexels(pose);
+    EXPECT_EQ(stored, 6593u);
+    ASSERT_EQ(pose.gap_texels.size(), 5u);
+    const size_t gaps = pose.gap_texels.size();
+    ASSERT_EQ(pose.depth_u16[0].size(), stored + 3 * gaps);
+    ASSERT_EQ(pose.normal_oct16[1].size(), 2 * (stored + 3 * gaps));
+    const double range = pose.depth_range;
+    for (size_t t = 0; t < gaps; ++t) {
+      const size_t n = pose.gap_texels[t];
+      // z of a front-view / back-view code (docs/FORMAT.md's decoder).
+      const auto front = [&](uint16_t q) { return pose.front_z - q * range / 65535.0; };
+      const auto back = [&](uint16_t q) { return pose.front_z - range + q * range / 65535.0; };
+      const size_t gap1 = stored + t;
+      ASSERT_NE(pose.depth_u16[0][gap1], 65535) << t;
+      ASSERT_NE(pose.depth_u16[1][gap1], 65535) << t;
+      const double top = front(pose.depth_u16[0][n]), bottom = back(pose.depth_u16[1][n]);
+      const double upper = front(pose.depth_u16[0][gap1]), lower = back(pose.depth_u16[1][gap1]);
+      EXPECT_GT(top, upper) << t;
+      EXPECT_GT(upper, lower) << t;
+      EXPECT_GT(lower, bottom) << t;
+    }
   }
 }
 

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -1137,48 +1138,98 @@ constexpr ZBox kMidPlate{0.f, 10 * kTexel, -10 * kTexel, 10 * kTexel, 0.065f, 0.
 const Float3 kGapUpperNormal = NormalizeOr(Float3{0.3f, 0.f, -1.f}, Float3{});
 const Float3 kGapLowerNormal = NormalizeOr(Float3{0.f, 0.3f, 1.f}, Float3{});
 
-// The boxes' z intervals at every texel centre: slab = their hull, gaps = the air between them;
-// at most layers - 1 gaps are kept, the widest (as the bake keeps them), in order from the top.
-BodyMapPose LayeredPose(uint8_t layers, const std::vector<ZBox>& boxes,
+// The boxes' z intervals (top, bottom) at the centre of texel (i, j), from the top; disjoint by
+// construction.
+std::vector<std::pair<float, float>> BoxSpans(const std::vector<ZBox>& boxes, uint32_t i,
+                                              uint32_t j) {
+  const GridSpec g = SphereGrid();
+  const double x = g.origin_x + (i + 0.5) * g.texel;
+  const double y = g.origin_y + (j + 0.5) * g.texel;
+  std::vector<std::pair<float, float>> spans;
+  for (const ZBox& b : boxes) {
+    if (x > b.x_lo && x < b.x_hi && y > b.y_lo && y < b.y_hi) spans.push_back({b.z_hi, b.z_lo});
+  }
+  std::sort(spans.begin(), spans.end(), std::greater<>());
+  return spans;
+}
+
+// One gap as a test writes it; a boundary may be left out, to test the checks.
+struct GapSpec {
+  double upper = 0.0, lower = 0.0;  // asset-frame z
+  bool has_upper = true, has_lower = true;
+};
+using GapsByTexel = std::map<size_t, std::vector<GapSpec>>;  // dense texel -> gaps from the top
+
+// The air between the boxes at every texel: at most layers - 1 gaps, the widest (as the bake
+// keeps them), in order from the top.
+GapsByTexel BoxGaps(uint8_t layers, const std::vector<ZBox>& boxes) {
+  const GridSpec g = SphereGrid();
+  GapsByTexel result;
+  for (uint32_t j = 0; j < g.height; ++j) {
+    for (uint32_t i = 0; i < g.width; ++i) {
+      const std::vector<std::pair<float, float>> spans = BoxSpans(boxes, i, j);
+      std::vector<GapSpec> gaps;
+      for (size_t s = 1; s < spans.size(); ++s)
+        gaps.push_back({spans[s - 1].second, spans[s].first});
+      std::stable_sort(gaps.begin(), gaps.end(), [](const GapSpec& a, const GapSpec& b) {
+        return a.upper - a.lower > b.upper - b.lower;
+      });
+      if (gaps.size() > layers - 1u) gaps.resize(layers - 1u);
+      std::sort(gaps.begin(), gaps.end(),
+                [](const GapSpec& a, const GapSpec& b) { return a.upper > b.upper; });
+      if (!gaps.empty()) result[static_cast<size_t>(j) * g.width + i] = gaps;
+    }
+  }
+  return result;
+}
+
+// A dense pose of the boxes' slab with the given gaps, stored as the format stores them: layer 0
+// of every texel, then the gap layers of the texels in gap_texels.
+BodyMapPose PackLayered(uint8_t layers, const std::vector<ZBox>& boxes, const GapsByTexel& gaps,
                         DepthEncoding depth_encoding = DepthEncoding::kFloat32,
                         NormalEncoding normal_encoding = NormalEncoding::kFloat32) {
   const GridSpec g = SphereGrid();
-  BodyMapPose pose = EmptyPose(g, depth_encoding, normal_encoding, layers);
   const size_t n = static_cast<size_t>(g.width) * g.height;
+  BodyMapPose pose = EmptyPose(g, depth_encoding, normal_encoding);
+  pose.layers = layers;
+  for (const auto& [texel, list] : gaps) pose.gap_texels.push_back(static_cast<uint32_t>(texel));
+  const size_t entries = n + (layers - 1u) * gaps.size();
+  for (int view = 0; view < 2; ++view) {
+    if (depth_encoding == DepthEncoding::kFloat32) pose.depth_f32[view].resize(entries);
+    if (depth_encoding == DepthEncoding::kUnorm16) pose.depth_u16[view].resize(entries);
+    if (normal_encoding == NormalEncoding::kFloat32) pose.normal_f32[view].resize(3 * entries);
+    if (normal_encoding == NormalEncoding::kOct16) pose.normal_oct16[view].resize(2 * entries);
+    if (normal_encoding == NormalEncoding::kRgb8) pose.normal_rgb8[view].resize(3 * entries);
+  }
   const double back_plane = static_cast<double>(g.front_z) - g.depth_range;
   for (uint32_t j = 0; j < g.height; ++j) {
     for (uint32_t i = 0; i < g.width; ++i) {
       const size_t k = static_cast<size_t>(j) * g.width + i;
-      const double x = g.origin_x + (i + 0.5) * g.texel;
-      const double y = g.origin_y + (j + 0.5) * g.texel;
-      std::vector<std::pair<float, float>> spans;  // (top, bottom), disjoint by construction
-      for (const ZBox& b : boxes) {
-        if (x > b.x_lo && x < b.x_hi && y > b.y_lo && y < b.y_hi) spans.push_back({b.z_hi, b.z_lo});
-      }
-      std::sort(spans.begin(), spans.end(), std::greater<>());
-      std::vector<std::pair<float, float>> gaps;  // (upper, lower)
-      for (size_t s = 1; s < spans.size(); ++s)
-        gaps.push_back({spans[s - 1].second, spans[s].first});
-      std::stable_sort(gaps.begin(), gaps.end(), [](const auto& a, const auto& b) {
-        return a.first - a.second > b.first - b.second;
-      });
-      if (gaps.size() > layers - 1u) gaps.resize(layers - 1u);
-      std::sort(gaps.begin(), gaps.end(), std::greater<>());
+      const std::vector<std::pair<float, float>> spans = BoxSpans(boxes, i, j);
       const bool valid = !spans.empty();
       const double top = valid ? spans.front().first : 0.0;
       const double bottom = valid ? spans.back().second : 0.0;
       PutSurface(pose, k, 0, valid, g.front_z - top, Float3{0.f, 0.f, 1.f});
       PutSurface(pose, k, 1, valid, bottom - back_plane, Float3{0.f, 0.f, -1.f});
-      for (size_t layer = 1; layer < layers; ++layer) {
-        const bool has = layer <= gaps.size();
-        const double upper = has ? gaps[layer - 1].first : 0.0;
-        const double lower = has ? gaps[layer - 1].second : 0.0;
-        PutSurface(pose, layer * n + k, 0, has, g.front_z - upper, kGapUpperNormal);
-        PutSurface(pose, layer * n + k, 1, has, lower - back_plane, kGapLowerNormal);
-      }
     }
   }
+  size_t t = 0;
+  for (const auto& [texel, list] : gaps) {
+    for (size_t layer = 1; layer < layers; ++layer) {
+      const size_t entry = n + (layer - 1) * gaps.size() + t;
+      const GapSpec gap = layer <= list.size() ? list[layer - 1] : GapSpec{0, 0, false, false};
+      PutSurface(pose, entry, 0, gap.has_upper, g.front_z - gap.upper, kGapUpperNormal);
+      PutSurface(pose, entry, 1, gap.has_lower, gap.lower - back_plane, kGapLowerNormal);
+    }
+    ++t;
+  }
   return pose;
+}
+
+BodyMapPose LayeredPose(uint8_t layers, const std::vector<ZBox>& boxes,
+                        DepthEncoding depth_encoding = DepthEncoding::kFloat32,
+                        NormalEncoding normal_encoding = NormalEncoding::kFloat32) {
+  return PackLayered(layers, boxes, BoxGaps(layers, boxes), depth_encoding, normal_encoding);
 }
 
 const std::vector<ZBox> kStack = {kBlock, kPlate, kMidPlate};
@@ -1377,10 +1428,8 @@ TEST(BodyMapGaps, QuickPathsAndBatchAnswerAsTheWalkAtAnyThreadCount) {
 
 TEST(BodyMapGaps, BuildRejectsGapsThatDoNotNest) {
   const GridSpec g = SphereGrid();
-  const size_t n = static_cast<size_t>(g.width) * g.height;
   const uint32_t i = 30, j = 44;  // under the plate only (x = -0.11 m)
   const size_t k = static_cast<size_t>(j) * g.width + i;
-  const double back_plane = static_cast<double>(g.front_z) - g.depth_range;
   const auto expect_rejected = [](const BodyMapPose& pose, const std::string& words) {
     BodyMapCollider c;
     const Status status = c.Build(pose);
@@ -1388,14 +1437,17 @@ TEST(BodyMapGaps, BuildRejectsGapsThatDoNotNest) {
     EXPECT_NE(status.message().find(words), std::string::npos) << status.message();
     EXPECT_TRUE(c.empty());
   };
-  const auto with_gap = [&](size_t layer, size_t texel, bool front_valid, double upper,
-                            bool back_valid, double lower) {
-    BodyMapPose pose = LayeredPose(3, kStack);
-    PutSurface(pose, layer * n + texel, 0, front_valid, g.front_z - upper, kGapUpperNormal);
-    PutSurface(pose, layer * n + texel, 1, back_valid, lower - back_plane, kGapLowerNormal);
-    return pose;
+  // The stack's own gaps with texel `texel`'s replaced by `gaps`.
+  const auto with_gaps = [&](size_t texel, const std::vector<GapSpec>& gaps) {
+    GapsByTexel all = BoxGaps(3, kStack);
+    all[texel] = gaps;
+    return PackLayered(3, kStack, all);
   };
-  ASSERT_TRUE(BodyMapCollider().Build(with_gap(1, k, true, 0.09, true, 0.06)).ok());
+  const auto with_gap = [&](size_t texel, bool front_valid, double upper, bool back_valid,
+                            double lower) {
+    return with_gaps(texel, {GapSpec{upper, lower, front_valid, back_valid}});
+  };
+  ASSERT_TRUE(BodyMapCollider().Build(with_gap(k, true, 0.09, true, 0.06)).ok());
   for (uint8_t layers : {uint8_t{0}, uint8_t{5}}) {
     BodyMapPose pose = LayeredPose(3, kStack);
     pose.layers = layers;
@@ -1406,18 +1458,48 @@ TEST(BodyMapGaps, BuildRejectsGapsThatDoNotNest) {
     pose.layers = 2;
     expect_rejected(pose, "2 layer(s)");
   }
-  expect_rejected(with_gap(1, k, true, 0.09, false, 0.0), "only one of its two boundaries");
-  expect_rejected(with_gap(1, k, true, 0.13, true, 0.06), "not strictly inside");  // above top
-  expect_rejected(with_gap(1, k, true, 0.07, true, 0.09), "not strictly inside");  // inverted
-  expect_rejected(with_gap(1, k, true, 0.09, true, -0.2), "not strictly inside");  // below bottom
+  {  // a gap list with one layer
+    BodyMapPose pose = LayeredPose(1, kStack);
+    pose.gap_texels = {static_cast<uint32_t>(k)};
+    expect_rejected(pose, "layers = 1 (no gap layers)");
+  }
+  {  // a gap list that does not increase
+    BodyMapPose pose = LayeredPose(3, kStack);
+    ASSERT_GE(pose.gap_texels.size(), 2u);
+    std::swap(pose.gap_texels[0], pose.gap_texels[1]);
+    expect_rejected(pose, "does not increase");
+  }
+  expect_rejected(with_gap(k, true, 0.09, false, 0.0), "only one of its two boundaries");
+  expect_rejected(with_gap(k, true, 0.13, true, 0.06), "not strictly inside");  // above top
+  expect_rejected(with_gap(k, true, 0.07, true, 0.09), "not strictly inside");  // inverted
+  expect_rejected(with_gap(k, true, 0.09, true, -0.2), "not strictly inside");  // below bottom
   const size_t block_only = static_cast<size_t>(j) * g.width + 16;  // x = -0.215 m: no gap
-  expect_rejected(with_gap(2, block_only, true, 0.0, true, -0.05), "follows an absent gap");
-  expect_rejected(with_gap(1, 0, true, 0.09, true, 0.06), "background texel");
-  {                                             // gap 2 overlapping gap 1
-    BodyMapPose pose = LayeredPose(3, kStack);  // gap 1 of texel k: (0.10, 0.05)
-    PutSurface(pose, 2 * n + k, 0, true, g.front_z - 0.07, kGapUpperNormal);
-    PutSurface(pose, 2 * n + k, 1, true, 0.03 - back_plane, kGapLowerNormal);
-    expect_rejected(pose, "gap layer 2");
+  expect_rejected(with_gaps(block_only, {GapSpec{0, 0, false, false}, GapSpec{0.0, -0.05}}),
+                  "has no gap 1");
+  expect_rejected(with_gap(0, true, 0.09, true, 0.06), "background texel");
+  // Gap 2 overlapping gap 1.
+  expect_rejected(with_gaps(k, {GapSpec{0.10, 0.05}, GapSpec{0.07, 0.03}}), "gap layer 2");
+}
+
+TEST(BodyMapGaps, RowSpanLayoutAnswersExactlyAsDense) {
+  for (DepthEncoding de : {DepthEncoding::kFloat32, DepthEncoding::kUnorm16}) {
+    BodyMapPose dense = LayeredPose(3, kStack, de, NormalEncoding::kOct16);
+    ZeroBackgroundNormals(dense);
+    BodyMapPose spans, back;
+    ASSERT_TRUE(ConvertBodyMapLayout(dense, BodyMapLayout::kRowSpans, &spans).ok());
+    ASSERT_TRUE(ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &back).ok());
+    EXPECT_EQ(spans.gap_texels.size(), dense.gap_texels.size());
+    EXPECT_NE(spans.gap_texels, dense.gap_texels);  // renumbered: spans store fewer texels
+    EXPECT_EQ(back.gap_texels, dense.gap_texels);
+    EXPECT_EQ(back.depth_f32[0], dense.depth_f32[0]);
+    EXPECT_EQ(back.depth_u16[1], dense.depth_u16[1]);
+    EXPECT_EQ(back.normal_oct16[0], dense.normal_oct16[0]);
+    for (DepthSampling sampling : {DepthSampling::kNearest, DepthSampling::kBilinear}) {
+      SCOPED_TRACE(::testing::Message() << "depth " << int(de) << " sampling " << int(sampling));
+      const BodyMapCollider a = BuildOrDie(dense, sampling), b = BuildOrDie(spans, sampling);
+      EXPECT_EQ(a.stats().gap_texels, b.stats().gap_texels);
+      ExpectIdenticalColliders(a, b, 2000, 0.05f);
+    }
   }
 }
 

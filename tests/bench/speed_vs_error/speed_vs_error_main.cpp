@@ -160,12 +160,14 @@ struct MapSetting {
   float epsilon = 0.005f;
   DepthEncoding depth = DepthEncoding::kUnorm16;
   NormalEncoding normals = NormalEncoding::kOct16;
+  uint8_t layers = 1;  // the slab plus layers - 1 air gaps per texel
 };
 
 std::string Describe(const MapSetting& m) {
   std::ostringstream s;
   s << "N=" << m.resolution << (m.sampling == DepthSampling::kBilinear ? " bilinear" : " nearest");
   if (m.fitted) s << " fitted";
+  if (m.layers != 1) s << " layers=" << int(m.layers);
   if (m.epsilon != 0.005f) s << " eps=" << m.epsilon * 1000.f << "mm";
   if (m.depth != DepthEncoding::kUnorm16 || m.normals != NormalEncoding::kOct16) {
     s << (m.depth == DepthEncoding::kFloat32 ? " depth=f32" : " depth=u16")
@@ -184,6 +186,7 @@ bake::BodyMapOptions BodyMapOptionsFor(const MapSetting& m) {
   o.epsilon = m.epsilon;
   o.depth_encoding = m.depth;
   o.normal_encoding = m.normals;
+  o.layers = m.layers;
   return o;
 }
 
@@ -196,6 +199,14 @@ std::vector<MapSetting> MapSweep(bool quick) {
       MapSetting m;
       m.resolution = n;
       m.sampling = s;
+      sweep.push_back(m);
+    }
+    // Air-gap layers (nearest): what paper A's slab bias costs in missed crossings.
+    for (uint8_t layers : {uint8_t{2}, uint8_t{4}}) {
+      if (n > 1024) continue;
+      MapSetting m;
+      m.resolution = n;
+      m.layers = layers;
       sweep.push_back(m);
     }
   }

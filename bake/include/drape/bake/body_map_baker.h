@@ -1,8 +1,9 @@
 #pragma once
 // Bakes one pose of paper A's image-space body collider (Lin et al. 2015, section 2): the front
 // and back orthographic depth maps and normal maps of the posed body mesh, offset by epsilon
-// along its normals. The result is a drape::BodyMapPose (formats/body_map_data.h); this header
-// documents exactly how each of its fields is filled.
+// along its normals, and optionally the air gaps inside that slab (step 8). The result is a
+// drape::BodyMapPose (formats/body_map_data.h); this header documents exactly how each of its
+// fields is filled.
 //
 // Geometry (asset frame, metres; the view axis is z and the body faces +z):
 //  1. Area-weighted vertex normals n_v = normalize(sum over incident triangles of
@@ -44,9 +45,41 @@
 //     normalised (for an exact offset surface the normal at p + eps*n is n). The front map's
 //     normals mostly have n.z > 0, the back map's n.z < 0. A zero interpolated normal falls back to
 //     the triangle's face normal, then to (0,0,+1) front / (0,0,-1) back.
+//  8. Gap layers (options.layers > 1; layer 0 is steps 5-7, paper A's slab). Paper A counts all
+//     the air between a texel's front and back surfaces as inside (an arm before the chest,
+//     fingers over a palm). A CPU fragment pass, run whichever renderer drew layer 0 (OSMesa
+//     too), collects at every texel centre every fragment of every offset triangle covering it,
+//     with the coverage rule and barycentric front depth of the CPU rasterizer (the same code,
+//     so the nearest fragment is bit for bit the CPU's layer 0). Each fragment gets a facing sign
+//     from the z of its triangle's geometric normal (triangles are counter-clockwise seen from
+//     outside): z > 0: a ray along -z enters the body there, +1; z < 0: it leaves, -1. The
+//     fragments are sorted front to back (equal depths: entering first, then by triangle index)
+//     and a winding count swept over them; the body is where the count is > 0. A texel's gaps
+//     are the depth ranges strictly between its first and last fragment where the count is 0,
+//     from the fragment that leaves (the gap's upper boundary) to the next one, which enters
+//     (its lower boundary), thicker than kMinBodyMapGap. If the count ever goes negative or does
+//     not end at 0 (an open mesh: a ray through a sleeve or neck opening; inconsistent winding),
+//     the texel gets no gap: paper A's slab, the conservative answer. At most layers - 1 gaps
+//     are kept per texel, the thickest (equal thickness: the nearer), stored front to back:
+//     dropping a gap only makes more of the slab count as inside. Layer k holds the k-th kept
+//     gap: front arrays the front depth of its upper boundary (the leaving fragment's depth),
+//     back arrays the back depth of its lower boundary (the entering triangle's back-view
+//     barycentric depth, as step 5), normals by step 7's rule on those triangles (upper: mostly
+//     n.z < 0, into the gap, fallback (0,0,-1); lower: mostly n.z > 0, fallback (0,0,+1)).
+//     After encoding, each gap is checked with the decoded values (in double, and in float as
+//     asset z = front_z - d and (front_z - depth_range) + d, with either unorm16 decoder): top
+//     > upper > lower > bottom, and upper below the previous kept gap's lower. A gap failing it
+//     (or at a texel that is background in layer 0, possible with OSMesa) is dropped and the
+//     later gaps move up, so a texel's layers are filled in order. The texels left with at
+//     least one gap form pose.gap_texels (their layer-0 entries, increasing); the gap layers
+//     are stored for them only. Layer 0 alone decides the row spans.
 //
 // Encodings (what a decoder must do; formats/body_map_data.h). Texel k below is j*width+i in
-// the dense layout and BodyMapTexelIndex(pose, i, j) in the row-span layout:
+// the dense layout and BodyMapTexelIndex(pose, i, j) in the row-span layout; it is the entry of
+// layer 0 in every array (times 2 or 3 for normals). Gap layer l >= 1 of a texel k listed in
+// gap_texels, at position t of that list, is entry stored_texels + (l - 1) * gap_texels.size()
+// + t (stored_texels = BodyMapStoredTexels(pose)); a texel not listed has no gap, a listed one
+// without gap l holds background in every array there. The rules below apply to every layer.
 //  - Depth kFloat32: depth_f32[view][k] in metres from that view's plane.
 //    Valid texels hold a value in [0, depth_range); background holds exactly depth_range
 //    (a decoder tests `d >= depth_range`).
@@ -93,7 +126,18 @@ struct BodyMapOptions {
   // kRowSpans: store only the covered texels (the mannequin at N = 512 is 18 % of its
   // rectangle); kDense: the whole rectangle, as format version 1 did. Same maps either way.
   BodyMapLayout layout = BodyMapLayout::kRowSpans;
+  // Depth layers per texel, 1..kMaxBodyMapLayers: 1 is paper A's slab alone; k adds up to k - 1
+  // air gaps inside it (step 8), at the cost of a CPU fragment pass and (k - 1) entries more
+  // per texel that has a gap (a few percent of a character's texels).
+  uint8_t layers = 1;
 };
+
+// Gaps thinner than this (metres) are not stored: the body counts as inside there. 0.1 mm is far
+// below the cloth's collision scale (epsilon, 5 mm by default; a texel, 1-2 mm), so no real air
+// is lost, while the ranges it drops are numerical: touching parts whose surfaces (nearly)
+// coincide, slivers between folded offset triangles. It is also >= 3 unorm16 codes at
+// a depth range up to 2 m, so quantisation cannot turn a stored gap inside out.
+inline constexpr double kMinBodyMapGap = 1e-4;
 
 struct BodyMapPoseStats {
   uint32_t width = 0, height = 0;                // the cropped rectangle, texels
@@ -102,13 +146,20 @@ struct BodyMapPoseStats {
   float coverage = 0.f;                          // fraction of window texels that are valid, [0, 1]
   size_t valid_texels = 0;                       // texels valid in both views
   size_t stored_texels = 0;  // texels the arrays hold: width*height, or the spans' total
-  size_t bytes = 0;  // bytes stored: the per-texel arrays (both views, depth + normals) plus the
-                     // span table (row spans: 4 per row + 1, 6 per span + 4)
+  size_t bytes = 0;  // bytes stored: the per-texel arrays (both views, depth + normals, every
+                     // layer) plus the span table (row spans: 4 per row + 1, 6 per span + 4) and
+                     // the gap list (4 per texel with a gap)
   double render_ms_front = 0.0;       // wall time of rendering the view (CPU: both views share one
   double render_ms_back = 0.0;        // pass, each is charged half of it: rasterize + normals;
-                                      // OSMesa: upload + clear + draw + finish + readback)
+                                      // OSMesa: upload + clear + draw + finish + readback), plus
+                                      // half of gap_ms each
   const char* renderer = "";          // "cpu" or "osmesa (<GL_RENDERER>)"; static storage
   uint32_t silhouette_conflicts = 0;  // texels covered in exactly one view, made background
+  uint8_t layers = 1;                 // options.layers: the slab plus up to layers - 1 gaps
+  size_t gap_texels = 0;              // texels with at least one stored gap
+  size_t dropped_gaps = 0;  // gaps found but not stored: beyond layers - 1 at their texel, or
+                            // failing the nesting check after encoding (step 8)
+  double gap_ms = 0.0;      // wall time of step 8: fragment pass, sweep, encoding; 0 if layers 1
 };
 
 // Bakes the maps of one pose. positions: the posed mesh in the asset frame (metres); triangles:
@@ -123,7 +174,9 @@ Status BakeBodyMapPose(std::span<const Float3> positions, std::span<const uint32
 // Writes 4 PNGs into `directory` (which must exist): <prefix>_front_depth.png,
 // <prefix>_back_depth.png (grey, nearer is brighter, background black) and
 // <prefix>_front_normal.png, <prefix>_back_normal.png (colour (n*0.5+0.5)*255, background
-// black). Image rows are flipped so that +y is up.
+// black), and for each gap layer k = 1 .. layers - 1 two more: <prefix>_gap<k>_front_depth.png
+// (the gaps' upper boundaries) and <prefix>_gap<k>_back_depth.png (their lower boundaries), grey
+// as above. Image rows are flipped so that +y is up.
 Status WriteBodyMapPreview(const BodyMapPose& pose, const std::string& directory,
                            const std::string& prefix);
 
@@ -144,12 +197,15 @@ uint16_t EncodeDepthUnorm16(float depth, float depth_range);  // valid depth -> 
 float DecodeDepthUnorm16(uint16_t code, float depth_range);
 
 // One decoded texel of a baked pose; view 0 = front, 1 = back; (i, j) inside width x height.
+// Layer 0 is the slab; layer k >= 1 the k-th gap (front: its upper boundary, back: its lower).
 struct BodyMapTexel {
   bool valid = false;
   float depth = 0.f;  // metres from the view's plane (depth_range on background)
   Float3 normal;      // unit length when valid, (0,0,0) on background
 };
-// Either layout; a texel outside the spans (or the rectangle) reads as background.
-BodyMapTexel ReadBodyMapTexel(const BodyMapPose& pose, int view, uint32_t i, uint32_t j);
+// Either layout; a texel outside the spans (or the rectangle), or a layer >= pose.layers, reads
+// as background.
+BodyMapTexel ReadBodyMapTexel(const BodyMapPose& pose, int view, uint32_t i, uint32_t j,
+                              uint32_t layer = 0);
 
 }  // namespace drape::bake

@@ -56,10 +56,17 @@ struct BodyMapPose {
   // camera of the gap's upper boundary (where the body is left going along -z), the back arrays
   // the depth from the back camera of its lower boundary (where the body is entered again).
   // Normals are the body's outward normals at those surfaces, so a gap's upper normal points
-  // into the gap (-z side). A texel without that gap holds background in every array of the
-  // layer. At one texel the gaps are filled in order and nested strictly inside the slab without
-  // touching: top > upper_1 > lower_1 > upper_2 > lower_2 > ... > bottom (asset-frame z).
+  // into the gap (-z side). Gap layers are stored only for the texels in gap_texels. At one
+  // texel the gaps are filled in order and nested strictly inside the slab without touching:
+  // top > upper_1 > lower_1 > upper_2 > lower_2 > ... > bottom (asset-frame z).
   uint8_t layers = 1;
+  // The stored texels that hold at least one gap (positions n within layer 0, strictly
+  // increasing, each with gap 1 present; empty when layers = 1; class version 3). Layer k >= 1
+  // of the t-th of them is entry stored_texels + (k - 1) * gap_texels.size() + t of every
+  // per-texel array (times 2 or 3 for normals); a listed texel without gap k holds background
+  // there. On a character a few percent of the texels have a gap, so the gap layers cost a few
+  // percent of the slab's bytes, not `layers` times them.
+  std::vector<uint32_t> gap_texels;
   // kRowSpans only (empty when dense), compressed rows: row j's spans are the entries
   // [row_span_offsets[j], row_span_offsets[j + 1]) of the span arrays (height + 1 entries, from
   // 0, non-decreasing). Span s covers texels i in [span_begin[s], span_begin[s] + length) of its
@@ -74,8 +81,8 @@ struct BodyMapPose {
   // Index 0 is the front view (looking along -z), 1 the back view (looking along +z). The back
   // map is not mirrored: the same texel covers the same (x, y) in both. Depth is measured from
   // each view's own camera plane. Exactly the arrays of the chosen encodings are filled, each
-  // with one value (or 2 or 3 per texel, as noted) per stored texel and layer, layer-major: the
-  // value of layer k at stored texel n is entry k * stored_texels + n (times 2 or 3).
+  // with BodyMapArrayEntries() values (times 2 or 3, as noted): layer 0 of every stored texel
+  // (entry n), then the gap layers of the texels in gap_texels (see there).
   std::vector<float> depth_f32[2];
   std::vector<uint16_t> depth_u16[2];
   std::vector<float> normal_f32[2];       // 3 per texel
@@ -91,31 +98,33 @@ struct BodyMapSet {
   std::vector<BodyMapPose> poses;
 };
 
-// Texels each layer of the per-texel arrays holds: width * height (dense) or the spans' total
-// (row spans; 0 when the span table is empty). Every layer stores the same texels, so an array
-// holds layers times this many values (times 2 or 3 for normals). Assumes a span table that
-// CheckBodyMapLayout accepts.
+// Texels layer 0 of the per-texel arrays holds: width * height (dense) or the spans' total
+// (row spans; 0 when the span table is empty). Assumes a span table that CheckBodyMapLayout
+// accepts.
 size_t BodyMapStoredTexels(const BodyMapPose& pose);
+
+// Values of one component in each per-texel array: the stored texels (layer 0) plus
+// (layers - 1) * gap_texels.size() gap entries.
+size_t BodyMapArrayEntries(const BodyMapPose& pose);
 
 // Checks the layout and the span table against width and height, without trusting any count:
 // returns "" or the first problem as "<field> <reason>", e.g.
 // "span_begin[7] = 3 overlaps the previous span of row 2 (ends at 5)".
 std::string CheckBodyMapLayout(const BodyMapPose& pose);
 
-// Position n of texel (i, j) within one layer of the per-texel arrays (layer k's value is entry
-// k * BodyMapStoredTexels(pose) + n), or -1 when it is outside the rectangle or (row spans)
-// outside every span, i.e. background in every layer. O(log spans in row j). Assumes a span
-// table that CheckBodyMapLayout accepts.
+// Position n of texel (i, j) in layer 0 of the per-texel arrays (and in gap_texels), or -1 when
+// it is outside the rectangle or (row spans) outside every span, i.e. background in every layer.
+// O(log spans in row j). Assumes a span table that CheckBodyMapLayout accepts.
 int64_t BodyMapTexelIndex(const BodyMapPose& pose, uint32_t i, uint32_t j);
 
 // Copies `in` into `out` in `layout`, every layer. To row spans: keeps every texel whose slab
-// (layer 0) is valid (depth not background) in either view, in maximal runs, with its values in
-// every layer (a gap lies inside its texel's slab, so no gap is lost). To dense: texels outside
-// the spans get the background values in every layer (depth: depth_range or 65535; normals:
-// zeros). Dense -> spans -> dense gives back the same arrays when every texel without a slab
-// holds those values in every layer (as the bake writes). kInvalidArgument (and `out`
-// untouched) when `in`'s layers, layout or array sizes are inconsistent, or a gap lies outside
-// the slab or out of order (the presence checks of ValidateAsset; not the depth order).
+// (layer 0) is valid (depth not background) in either view, in maximal runs (a gap lies inside
+// its texel's slab, so no gap is lost; gap_texels is renumbered, the gap entries keep their
+// order). To dense: texels outside the spans get the background values (depth: depth_range or
+// 65535; normals: zeros). Dense -> spans -> dense gives back the same arrays when every texel
+// without a slab holds those values (as the bake writes). kInvalidArgument (and `out`
+// untouched) when `in`'s layers, layout, gap list or array sizes are inconsistent, or a gap lies
+// outside the slab or out of order (the presence checks of ValidateAsset; not the depth order).
 Status ConvertBodyMapLayout(const BodyMapPose& in, BodyMapLayout layout, BodyMapPose* out);
 
 }  // namespace drape
