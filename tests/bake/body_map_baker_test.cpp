@@ -27,6 +27,7 @@
 #include "drape/bake/bake_config.h"
 #include "drape/bake/bake_pipeline.h"
 #include "drape/runtime/body_map_collider.h"
+#include "octahedron_sphere.h"
 #include "test_support.h"
 
 namespace drape::bake {
@@ -1115,6 +1116,20 @@ TEST(BodyMapBaker, DegenerateInputReturnsAnErrorAndLeavesThePoseUnchanged) {
   EXPECT_EQ(BakeBodyMapPose(flat, flat_tri, zero, nullptr).code(), StatusCode::kInvalidArgument);
 }
 
+// `dir` holds exactly the named files (no other), each larger than `min_bytes`.
+void ExpectExactlyTheseFiles(const std::filesystem::path& dir,
+                             std::initializer_list<const char*> names, uintmax_t min_bytes) {
+  for (const char* name : names) {
+    const std::filesystem::path file = dir / name;
+    ASSERT_TRUE(std::filesystem::exists(file)) << file;
+    EXPECT_GT(std::filesystem::file_size(file), min_bytes) << file;
+  }
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    files += entry.is_regular_file();
+  EXPECT_EQ(files, names.size());
+}
+
 TEST(BodyMapBaker, PreviewWritesFourPngs) {
   const Mesh capsule = MakeCapsule({0.0, 0.0, 0.0}, 0.2, 0.3, 16, 32);
   BodyMapOptions o;
@@ -1127,16 +1142,10 @@ TEST(BodyMapBaker, PreviewWritesFourPngs) {
   std::filesystem::create_directories(dir);
   const Status status = WriteBodyMapPreview(pose, dir.string(), "capsule");
   ASSERT_TRUE(status.ok()) << status.message();
-  for (const char* name : {"capsule_front_depth.png", "capsule_back_depth.png",
-                           "capsule_front_normal.png", "capsule_back_normal.png"}) {
-    const std::filesystem::path file = dir / name;
-    ASSERT_TRUE(std::filesystem::exists(file)) << file;
-    EXPECT_GT(std::filesystem::file_size(file), 100u) << file;
-  }
-  size_t files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-    files += entry.is_regular_file();
-  EXPECT_EQ(files, 4u);
+  ExpectExactlyTheseFiles(dir,
+                          {"capsule_front_depth.png", "capsule_back_depth.png",
+                           "capsule_front_normal.png", "capsule_back_normal.png"},
+                          100);
   std::filesystem::remove_all(dir);
   // A directory that does not exist is an I/O error, not a crash.
   EXPECT_EQ(WriteBodyMapPreview(pose, (dir / "missing" / "deeper").string(), "x").code(),
@@ -1180,40 +1189,13 @@ void AddPortableBox(Mesh* m, double x0, double y0, double z0, double x1, double 
 // A sphere from a 4^levels-subdivided octahedron on radius r (square roots only, so the same
 // positions on every IEEE machine), counter-clockwise seen from outside, shared vertices.
 void AddOctaSphere(Mesh* m, double cx, double cy, double cz, double r, int levels) {
-  std::vector<std::array<double, 3>> p = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                          {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
-                                            {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  for (int level = 0; level < levels; ++level) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
-    const auto mid = [&](uint32_t a, uint32_t b) {
-      const auto key = std::minmax(a, b);
-      const auto found = midpoints.find(key);
-      if (found != midpoints.end()) return found->second;
-      std::array<double, 3> q = {p[a][0] + p[b][0], p[a][1] + p[b][1], p[a][2] + p[b][2]};
-      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-      for (double& c : q) c /= len;
-      p.push_back(q);
-      const uint32_t index = static_cast<uint32_t>(p.size() - 1);
-      midpoints.emplace(key, index);
-      return index;
-    };
-    std::vector<std::array<uint32_t, 3>> finer;
-    for (const auto& f : t) {
-      const uint32_t ab = mid(f[0], f[1]), bc = mid(f[1], f[2]), ca = mid(f[2], f[0]);
-      finer.push_back({f[0], ab, ca});
-      finer.push_back({ab, f[1], bc});
-      finer.push_back({ca, bc, f[2]});
-      finer.push_back({ab, bc, ca});
-    }
-    t = std::move(finer);
-  }
+  const test::UnitSphereMesh sphere = test::OctahedronSphere(levels);
   const uint32_t base = static_cast<uint32_t>(m->positions.size());
-  for (const auto& q : p) {
+  for (const auto& q : sphere.positions) {
     m->positions.push_back({static_cast<float>(cx + r * q[0]), static_cast<float>(cy + r * q[1]),
                             static_cast<float>(cz + r * q[2])});
   }
-  for (const auto& f : t) {
+  for (const auto& f : sphere.triangles) {
     m->triangles.insert(m->triangles.end(), {base + f[0], base + f[1], base + f[2]});
   }
 }
@@ -1887,18 +1869,12 @@ TEST(BodyMapBaker, PreviewWritesGapLayerPngs) {
   std::filesystem::create_directories(dir);
   const Status status = WriteBodyMapPreview(pose, dir.string(), "scene");
   ASSERT_TRUE(status.ok()) << status.message();
-  for (const char* name :
-       {"scene_front_depth.png", "scene_back_depth.png", "scene_front_normal.png",
-        "scene_back_normal.png", "scene_gap1_front_depth.png", "scene_gap1_back_depth.png",
-        "scene_gap2_front_depth.png", "scene_gap2_back_depth.png"}) {
-    const std::filesystem::path file = dir / name;
-    ASSERT_TRUE(std::filesystem::exists(file)) << file;
-    EXPECT_GT(std::filesystem::file_size(file), 60u) << file;
-  }
-  size_t files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir))
-    files += entry.is_regular_file();
-  EXPECT_EQ(files, 8u);
+  ExpectExactlyTheseFiles(
+      dir,
+      {"scene_front_depth.png", "scene_back_depth.png", "scene_front_normal.png",
+       "scene_back_normal.png", "scene_gap1_front_depth.png", "scene_gap1_back_depth.png",
+       "scene_gap2_front_depth.png", "scene_gap2_back_depth.png"},
+      60);
   std::filesystem::remove_all(dir);
 }
 

@@ -21,6 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include "octahedron_sphere.h"
+
 namespace drape::bake {
 namespace {
 
@@ -253,29 +255,9 @@ TEST(CpuRasterizer, NearestFragmentsAreTheRasterizedTexelsBitForBit) {
 // coordinates, its vertices snapped to the half-texel lattice so that texel centres fall on
 // edges and vertices and every edge test is exact.
 Soup MakeSnappedSphere(double cx, double cy, double radius, int levels) {
-  std::vector<std::array<double, 3>> p = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                          {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
-                                            {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  for (int level = 0; level < levels; ++level) {
-    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
-    const auto mid = [&](uint32_t a, uint32_t b) {
-      const auto key = std::minmax(a, b);
-      if (const auto found = midpoints.find(key); found != midpoints.end()) return found->second;
-      std::array<double, 3> q = {p[a][0] + p[b][0], p[a][1] + p[b][1], p[a][2] + p[b][2]};
-      const double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-      for (double& c : q) c /= len;
-      p.push_back(q);
-      midpoints.emplace(key, static_cast<uint32_t>(p.size() - 1));
-      return static_cast<uint32_t>(p.size() - 1);
-    };
-    std::vector<std::array<uint32_t, 3>> finer;
-    for (const auto& f : t) {
-      const uint32_t ab = mid(f[0], f[1]), bc = mid(f[1], f[2]), ca = mid(f[2], f[0]);
-      finer.insert(finer.end(), {{f[0], ab, ca}, {ab, f[1], bc}, {ca, bc, f[2]}, {ab, bc, ca}});
-    }
-    t = std::move(finer);
-  }
+  const test::UnitSphereMesh sphere = test::OctahedronSphere(levels);
+  const std::vector<std::array<double, 3>>& p = sphere.positions;
+  const std::vector<std::array<uint32_t, 3>>& t = sphere.triangles;
   Soup s;
   s.width = static_cast<uint32_t>(2 * cx);
   s.height = static_cast<uint32_t>(2 * cy);

@@ -378,40 +378,53 @@ TEST(BodyMapCollider, StraightDownOnSphereGivesSurfacePointAndNormal) {
 
 // The walk against an exact brute-force reference over every texel column, for random segments
 // of every length (short ones walk texel by texel, long ones use the 8x8 min/max blocks).
+// Query against the brute-force first entry on `segments` random segments (RandomSegment) that
+// start outside: contact, t, point on the segment and a unit normal. `start` sees each p0.
+struct WalkCounts {
+  int hits = 0, misses = 0, side_walls = 0;
+};
+WalkCounts ExpectWalkMatchesReference(const BodyMapCollider& c, uint32_t seed, int segments,
+                                      const std::function<void(Float3)>& start = {}) {
+  std::mt19937 rng(seed);
+  WalkCounts counts;
+  for (int k = 0; k < segments; ++k) {
+    Float3 p0, p1;
+    RandomSegment(rng, k, &p0, &p1);
+    if (c.IsInside(p0)) continue;
+    if (start) start(p0);
+    const ContactQuery q = c.Query(p0, p1);
+    const double reference = ReferenceFirstEntry(c, p0, p1);
+    EXPECT_EQ(q.inside_end, c.IsInside(p1));
+    EXPECT_TRUE(!q.inside_end || q.contact);
+    EXPECT_EQ(q.contact, reference >= 0.0) << "segment " << k << " ref " << reference;
+    if (!q.contact || reference < 0.0) {
+      ++counts.misses;
+      continue;
+    }
+    ++counts.hits;
+    if (q.flags & kCollisionSideWall) ++counts.side_walls;
+    // t resolution: float positions (~1e-7 m here) over the segment's length.
+    EXPECT_NEAR(q.t, reference, 2e-6 + 2e-7 / Length(p1 - p0)) << "segment " << k;
+    // The point lies on the segment (x, y exactly up to rounding) and on the surface (z).
+    const Float3 on_segment = Lerp(p0, p1, q.t);
+    EXPECT_NEAR(q.point.x, on_segment.x, 1e-5) << "segment " << k;
+    EXPECT_NEAR(q.point.y, on_segment.y, 1e-5) << "segment " << k;
+    EXPECT_NEAR(q.point.z, on_segment.z, 1e-5) << "segment " << k;
+    EXPECT_NEAR(Length(q.normal), 1.f, 1e-5);
+  }
+  return counts;
+}
+
 TEST(BodyMapCollider, WalkMatchesExactReferenceOnRandomSegments) {
   for (int shape = 0; shape < 2; ++shape) {
     const BodyMapCollider c = shape == 0 ? BuildOrDie(MakePose(SphereGrid(), Sphere))
                                          : BuildOrDie(MakePose(BoxGrid(), Box));
-    std::mt19937 rng(11 + shape);
-    int hits = 0, misses = 0, side_walls = 0;
-    for (int k = 0; k < 1200; ++k) {
-      Float3 p0, p1;
-      RandomSegment(rng, k, &p0, &p1);
-      if (c.IsInside(p0)) continue;
-      const ContactQuery q = c.Query(p0, p1);
-      const double reference = ReferenceFirstEntry(c, p0, p1);
-      EXPECT_EQ(q.inside_end, c.IsInside(p1));
-      EXPECT_TRUE(!q.inside_end || q.contact);
-      ASSERT_EQ(q.contact, reference >= 0.0) << "segment " << k << " ref " << reference;
-      if (!q.contact) {
-        ++misses;
-        continue;
-      }
-      ++hits;
-      if (q.flags & kCollisionSideWall) ++side_walls;
-      // t resolution: float positions (~1e-7 m here) over the segment's length.
-      EXPECT_NEAR(q.t, reference, 2e-6 + 2e-7 / Length(p1 - p0)) << "segment " << k;
-      // The point lies on the segment (x, y exactly up to rounding) and on the surface (z).
-      const Float3 on_segment = Lerp(p0, p1, q.t);
-      EXPECT_NEAR(q.point.x, on_segment.x, 1e-5);
-      EXPECT_NEAR(q.point.y, on_segment.y, 1e-5);
-      EXPECT_NEAR(q.point.z, on_segment.z, 1e-5);
-      EXPECT_NEAR(Length(q.normal), 1.f, 1e-5);
-    }
-    std::printf("shape %d: %d hits (%d side walls), %d misses\n", shape, hits, side_walls, misses);
-    EXPECT_GT(hits, 200) << shape;
-    EXPECT_GT(misses, 50) << shape;
-    EXPECT_GT(side_walls, 20) << shape;
+    const WalkCounts n = ExpectWalkMatchesReference(c, 11 + shape, 1200);
+    std::printf("shape %d: %d hits (%d side walls), %d misses\n", shape, n.hits, n.side_walls,
+                n.misses);
+    EXPECT_GT(n.hits, 200) << shape;
+    EXPECT_GT(n.misses, 50) << shape;
+    EXPECT_GT(n.side_walls, 20) << shape;
   }
 }
 
@@ -1353,36 +1366,17 @@ TEST(BodyMapGaps, EntriesAcrossAGapUseTheGapsSurfaces) {
 }
 
 TEST(BodyMapGaps, WalkMatchesExactReferenceOnRandomSegments) {
+  const BodyMapCollider paper = BuildOrDie(LayeredPose(1, kStack));
   for (uint8_t layers : {uint8_t{2}, uint8_t{3}}) {
     const BodyMapCollider c = BuildOrDie(LayeredPose(layers, kStack));
-    std::mt19937 rng(17 + layers);
-    int hits = 0, misses = 0, from_gap = 0;
-    const BodyMapCollider paper = BuildOrDie(LayeredPose(1, kStack));
-    for (int k = 0; k < 3000; ++k) {
-      Float3 p0, p1;
-      RandomSegment(rng, k, &p0, &p1);
-      if (c.IsInside(p0)) continue;
-      from_gap += paper.IsInside(p0);
-      const ContactQuery q = c.Query(p0, p1);
-      const double reference = ReferenceFirstEntry(c, p0, p1);
-      EXPECT_EQ(q.inside_end, c.IsInside(p1));
-      EXPECT_TRUE(!q.inside_end || q.contact);
-      ASSERT_EQ(q.contact, reference >= 0.0) << "segment " << k << " ref " << reference;
-      if (!q.contact) {
-        ++misses;
-        continue;
-      }
-      ++hits;
-      EXPECT_NEAR(q.t, reference, 2e-6 + 2e-7 / Length(p1 - p0)) << "segment " << k;
-      const Float3 on_segment = Lerp(p0, p1, q.t);
-      EXPECT_NEAR(q.point.z, on_segment.z, 1e-5) << "segment " << k;
-      EXPECT_NEAR(Length(q.normal), 1.f, 1e-5);
-    }
-    std::printf("layers %d: %d hits, %d misses, %d starts in a gap\n", layers, hits, misses,
-                from_gap);
-    EXPECT_GT(hits, 300);
-    EXPECT_GT(misses, 100);
-    EXPECT_GT(from_gap, 50);  // starts that paper A's slab would call inside
+    int from_gap = 0;  // starts that paper A's slab would call inside
+    const WalkCounts n = ExpectWalkMatchesReference(
+        c, 17 + layers, 3000, [&](Float3 p0) { from_gap += paper.IsInside(p0); });
+    std::printf("layers %d: %d hits (%d side walls), %d misses, %d starts in a gap\n", layers,
+                n.hits, n.side_walls, n.misses, from_gap);
+    EXPECT_GT(n.hits, 300);
+    EXPECT_GT(n.misses, 100);
+    EXPECT_GT(from_gap, 50);
   }
 }
 

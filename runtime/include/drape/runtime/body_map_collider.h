@@ -116,8 +116,9 @@ class BodyMapSequence;
 // (top, bottom z as float) + 8 bytes of normals (front and back, re-encoded as oct16 whatever the
 // input encoding: float32 input loses < 0.004 degrees) + 1 byte of bilinear eligibility in
 // kBilinear mode, plus 8 bytes per 8x8 block for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB
-// (17.1 MiB bilinear). A pose with gap layers adds 16 bytes per texel and gap layer (the gap's
-// upper and lower z, their normals). memory_bytes() reports the exact figure.
+// (17.1 MiB bilinear). A pose with gap layers adds 12 bytes per 8x8 block and, per texel that
+// has a gap, 16 bytes per gap layer (the gaps' upper and lower z, their normals). memory_bytes()
+// reports the exact figure.
 //
 // Air gaps (BodyMapPose::layers > 1): a texel's inside set is its slab minus its gaps, i.e. up to
 // `layers` disjoint z intervals. Every query honours them: an entry into the body below a gap is
