@@ -481,7 +481,15 @@ class Measurement {
     std::printf("%s\n", posed.label.c_str());
     const bake::MeshReference reference(positions, triangles);
     Context context = MakeContext(posed, positions, triangles, reference);
-    for (const MapSetting& m : MapSweep(true)) {
+    // The quick sweep's nearest settings, and N = 1024 with and without air gaps: posed bodies
+    // are where parts overlap along the view axis.
+    std::vector<MapSetting> posed_maps = MapSweep(true);
+    for (uint8_t layers : {uint8_t{1}, uint8_t{4}}) {
+      MapSetting m;
+      m.layers = layers;
+      posed_maps.push_back(m);  // N = 1024
+    }
+    for (const MapSetting& m : posed_maps) {
       const MapSetting defaults;
       if (m.sampling != DepthSampling::kNearest || m.fitted || m.epsilon != defaults.epsilon ||
           m.depth != defaults.depth || m.normals != defaults.normals) {
