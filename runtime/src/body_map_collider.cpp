@@ -690,20 +690,27 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   }
 
   // Gap layers: each gap must sit strictly inside the interval above it, so that the texel's
-  // inside set is a sorted list of disjoint intervals (the walk relies on it).
-  // Decoded densely (setup time), stored compactly by PackGaps below.
+  // inside set is a sorted list of disjoint intervals (the walk relies on it). Decoded per listed
+  // texel, stored compactly by PackGaps below.
   gap_layers_ = static_cast<uint32_t>(layers - 1);
   if (gap_layers_ == 0 && !gap_list.empty()) {
     return fail("gap_texels lists " + std::to_string(gap_list.size()) +
                 " texels but layers = 1 (no gap layers)");
   }
-  std::vector<Slab> dense_gaps(n * gap_layers_, Slab{-kInf, kInf});
-  std::vector<TexelNormals> dense_gap_normals(n * gap_layers_, TexelNormals{});
+  std::vector<GapTexel> gap_texels;
+  gap_texels.reserve(gap_list.size());
   for (size_t t = 0; t < gap_list.size(); ++t) {
     const size_t k = gap_list[t];
     if (k >= n || (t > 0 && k <= gap_list[t - 1])) {
       return fail("gap_texels[" + std::to_string(t) + "] = " + std::to_string(k) +
                   (k >= n ? " is not a texel of the rectangle" : " does not increase"));
+    }
+    GapTexel& texel = gap_texels.emplace_back();
+    texel.i = static_cast<uint32_t>(k % pose.width);
+    texel.j = static_cast<uint32_t>(k / pose.width);
+    for (size_t g = 0; g < gap_layers_; ++g) {
+      texel.gaps[g] = Slab{-kInf, kInf};
+      texel.normals[g] = TexelNormals{};
     }
     float floor_z = slabs_[k].top;  // the gap must lie below this (the previous interval's top)
     bool absent_before = false;
@@ -733,9 +740,9 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
         reason = "is not strictly inside the slab below the previous gap";
       }
       if (reason != nullptr) return fail(where(0, index) + ": the gap " + reason);
-      dense_gaps[k * gap_layers_ + g] = {upper, lower};
+      texel.gaps[g] = {upper, lower};
       floor_z = lower;
-      TexelNormals& normals = dense_gap_normals[k * gap_layers_ + g];
+      TexelNormals& normals = texel.normals[g];
       if (!read_normal(0, index, normals.front) || !read_normal(1, index, normals.back)) {
         return fail(problem);
       }
@@ -753,16 +760,15 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   sampling_ = sampling;
   clip_ = pose.clip;
   time_ = pose.time;
-  PackGaps(dense_gaps, dense_gap_normals);
+  PackGaps(&gap_texels);
   Finish();
   return Status::Ok();
 }
 
-void BodyMapCollider::PackGaps(const std::vector<Slab>& gaps,
-                               const std::vector<TexelNormals>& normals) {
-  const size_t w = width_, h = height_, layers = gap_layers_;
-  blocks_w_ = static_cast<uint32_t>((w + kBlockTexels - 1) >> kBlockShift);
-  blocks_h_ = static_cast<uint32_t>((h + kBlockTexels - 1) >> kBlockShift);
+void BodyMapCollider::PackGaps(std::vector<GapTexel>* texels) {
+  const size_t layers = gap_layers_;
+  blocks_w_ = static_cast<uint32_t>((width_ + kBlockTexels - 1) >> kBlockShift);
+  blocks_h_ = static_cast<uint32_t>((height_ + kBlockTexels - 1) >> kBlockShift);
   gap_masks_.clear();
   gap_block_first_.clear();
   gaps_.clear();
@@ -770,29 +776,28 @@ void BodyMapCollider::PackGaps(const std::vector<Slab>& gaps,
   if (layers == 0) return;
   gap_masks_.assign(static_cast<size_t>(blocks_w_) * blocks_h_, 0);
   gap_block_first_.assign(gap_masks_.size(), 0);
-  size_t with_gaps = 0;  // exact capacity: memory_bytes() reports what the gaps need
-  for (size_t k = 0; k < gaps.size(); k += layers) with_gaps += gaps[k].top > gaps[k].bottom;
-  gaps_.reserve(with_gaps * layers);
-  gap_normals_.reserve(with_gaps * layers);
-  uint32_t gap_texels = 0;
-  for (size_t bj = 0; bj < blocks_h_; ++bj) {
-    for (size_t bi = 0; bi < blocks_w_; ++bi) {
-      const size_t block = bj * blocks_w_ + bi;
-      gap_block_first_[block] = gap_texels;
-      for (size_t b = 0; b < kBlockTexels * kBlockTexels; ++b) {  // bit order: (j % 8) * 8 + i % 8
-        const size_t i = (bi << kBlockShift) + (b & (kBlockTexels - 1));
-        const size_t j = (bj << kBlockShift) + (b >> kBlockShift);
-        if (i >= w || j >= h) continue;
-        const size_t first = (j * w + i) * layers;
-        if (!(gaps[first].top > gaps[first].bottom)) continue;
-        gap_masks_[block] |= uint64_t{1} << b;
-        ++gap_texels;
-        gaps_.insert(gaps_.end(), gaps.begin() + static_cast<ptrdiff_t>(first),
-                     gaps.begin() + static_cast<ptrdiff_t>(first + layers));
-        gap_normals_.insert(gap_normals_.end(), normals.begin() + static_cast<ptrdiff_t>(first),
-                            normals.begin() + static_cast<ptrdiff_t>(first + layers));
-      }
-    }
+  // Block order, then the bit order within a block ((j % 8) * 8 + i % 8): GapBase's order.
+  const auto block_of = [&](const GapTexel& t) {
+    return static_cast<size_t>(t.j >> kBlockShift) * blocks_w_ + (t.i >> kBlockShift);
+  };
+  const auto bit_of = [](const GapTexel& t) {
+    return ((t.j & (kBlockTexels - 1)) << kBlockShift) | (t.i & (kBlockTexels - 1));
+  };
+  std::sort(texels->begin(), texels->end(), [&](const GapTexel& a, const GapTexel& b) {
+    const size_t block_a = block_of(a), block_b = block_of(b);
+    return block_a != block_b ? block_a < block_b : bit_of(a) < bit_of(b);
+  });
+  gaps_.reserve(texels->size() * layers);  // exactly: memory_bytes() reports what gaps need
+  gap_normals_.reserve(texels->size() * layers);
+  for (const GapTexel& t : *texels) {
+    gap_masks_[block_of(t)] |= uint64_t{1} << bit_of(t);
+    gaps_.insert(gaps_.end(), t.gaps, t.gaps + layers);
+    gap_normals_.insert(gap_normals_.end(), t.normals, t.normals + layers);
+  }
+  uint32_t before = 0;  // gap texels in the blocks before this one
+  for (size_t block = 0; block < gap_masks_.size(); ++block) {
+    gap_block_first_[block] = before;
+    before += static_cast<uint32_t>(std::popcount(gap_masks_[block]));
   }
 }
 
@@ -815,7 +820,6 @@ void BodyMapCollider::Finish() {
     }
   }
   stats_.valid_texels = valid;
-  stats_.gap_texels = 0;
   stats_.gap_texels = gap_layers_ == 0 ? 0u : static_cast<uint32_t>(gaps_.size() / gap_layers_);
   const double s = texel_size_;
   if (valid == 0) {

@@ -259,9 +259,15 @@ class BodyMapCollider {
   // The interval holding z at texel (i, j); the slab itself when no interval does.
   Interval IntervalAt(uint32_t i, uint32_t j, float z) const;
   Float3 SlotNormal(uint32_t i, uint32_t j, int slot) const;
-  // Stores dense per-texel gaps (gap_layers_ per texel, texel-major) compactly. Needs width_,
-  // height_ and gap_layers_; sets blocks_w_ and blocks_h_ as Finish does.
-  void PackGaps(const std::vector<Slab>& gaps, const std::vector<TexelNormals>& normals);
+  // One texel's gaps while Build decodes them (absent gaps: top = -inf, bottom = +inf).
+  struct GapTexel {
+    uint32_t i, j;
+    Slab gaps[kMaxBodyMapLayers - 1];
+    TexelNormals normals[kMaxBodyMapLayers - 1];
+  };
+  // Stores the texels' gaps compactly, in block order (sorts *texels). Needs width_, height_ and
+  // gap_layers_; sets blocks_w_ and blocks_h_ as Finish does.
+  void PackGaps(std::vector<GapTexel>* texels);
 
   static constexpr uint32_t kBlockShift = 3;  // 8x8 texels per min/max block
   static constexpr uint32_t kBlockTexels = 1u << kBlockShift;
