@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <type_traits>
 #include <vector>
 
 namespace drape::bake {
@@ -132,8 +133,12 @@ Parameter MakeEnum(std::string section, std::string key,
   return p;
 }
 
-Parameter MakeUint(std::string section, std::string key, std::string unit, uint32_t lo, uint32_t hi,
-                   std::string description, std::function<uint32_t&(BakeConfig&)> field) {
+// An unsigned count in a field of type UInt (uint32_t unless the call names another).
+template <class UInt = uint32_t>
+Parameter MakeUint(std::string section, std::string key, std::string unit,
+                   std::type_identity_t<UInt> lo, std::type_identity_t<UInt> hi,
+                   std::string description,
+                   std::type_identity_t<std::function<UInt&(BakeConfig&)>> field) {
   Parameter p{std::move(section),
               std::move(key),
               std::move(unit),
@@ -146,23 +151,7 @@ Parameter MakeUint(std::string section, std::string key, std::string unit, uint3
     if (!v.is_number_integer() && !v.is_number_unsigned()) return "must be an integer in " + range;
     const int64_t x = v.get<int64_t>();
     if (x < lo || x > hi) return "must be in " + range;
-    field(c) = static_cast<uint32_t>(x);
-    return "";
-  };
-  return p;
-}
-
-// A small count stored in a uint8_t field, range-checked like MakeUint.
-Parameter MakeUint8(std::string section, std::string key, std::string unit, uint8_t lo, uint8_t hi,
-                    std::string description, std::function<uint8_t&(BakeConfig&)> field) {
-  Parameter p = MakeUint(std::move(section), std::move(key), std::move(unit), lo, hi,
-                         std::move(description), nullptr);
-  p.get = [field](const BakeConfig& c) { return json(field(const_cast<BakeConfig&>(c))); };
-  p.set = [field, lo, hi, range = p.range](const json& v, BakeConfig& c) -> std::string {
-    if (!v.is_number_integer() && !v.is_number_unsigned()) return "must be an integer in " + range;
-    const int64_t x = v.get<int64_t>();
-    if (x < lo || x > hi) return "must be in " + range;
-    field(c) = static_cast<uint8_t>(x);
+    field(c) = static_cast<UInt>(x);
     return "";
   };
   return p;
@@ -221,12 +210,13 @@ const std::vector<Parameter>& Parameters() {
           "spans: store only the covered texels, as row spans; dense: the whole rectangle around "
           "them (format version 1's layout); the runtime answers the same",
           [](BakeConfig& c) -> BodyMapLayout& { return c.maps.layout; }),
-      MakeUint8("maps", "layers", "layers", 1, kMaxBodyMapLayers,
-                "depth layers per texel: 1 = paper A's slab (the air between an arm and the "
-                "chest counts as inside); k adds up to k - 1 air gaps inside the slab, found by a "
-                "CPU fragment pass (also with renderer osmesa); only the texels with a gap store "
-                "the extra layers",
-                [](BakeConfig& c) -> uint8_t& { return c.maps.layers; }),
+      MakeUint<uint8_t>(
+          "maps", "layers", "layers", 1, kMaxBodyMapLayers,
+          "depth layers per texel: 1 = paper A's slab (the air between an arm and the "
+          "chest counts as inside); k adds up to k - 1 air gaps inside the slab, found by a "
+          "CPU fragment pass (also with renderer osmesa); only the texels with a gap store "
+          "the extra layers",
+          [](BakeConfig& c) -> uint8_t& { return c.maps.layers; }),
       MakeEnum<MapRenderer>(
           "maps", "renderer", {{"cpu", MapRenderer::kCpu}, {"osmesa", MapRenderer::kOsMesa}},
           "cpu: in-house deterministic rasterizer; osmesa: the paper's GL path (llvmpipe)",
