@@ -246,6 +246,20 @@ BodyMapOptions FloatOptions(uint32_t resolution) {
   return o;
 }
 
+// Float32 options (or unorm16 depth and `compact_normals` when `compact`) in the dense layout with
+// `layers` depth layers: the gap tests read texels by their dense index.
+BodyMapOptions DenseGapOptions(uint32_t resolution, uint8_t layers, bool compact = false,
+                               NormalEncoding compact_normals = NormalEncoding::kOct16) {
+  BodyMapOptions o = FloatOptions(resolution);
+  if (compact) {
+    o.depth_encoding = DepthEncoding::kUnorm16;
+    o.normal_encoding = compact_normals;
+  }
+  o.layout = BodyMapLayout::kDense;
+  o.layers = layers;
+  return o;
+}
+
 BodyMapPose BakeOrDie(const Mesh& m, const BodyMapOptions& o, BodyMapPoseStats* stats = nullptr) {
   BodyMapPose pose;
   const Status status = BakeBodyMapPose(m.positions, m.triangles, o, &pose, stats);
@@ -1442,13 +1456,7 @@ TEST(BodyMapBaker, GapLayerHoldsTheAirBetweenAPlateAndABlock) {
   AddSplitBox(&mesh, plate_lo, plate_hi);
   for (const bool compact : {false, true}) {
     SCOPED_TRACE(compact ? "unorm16 + oct16" : "float32");
-    BodyMapOptions o = FloatOptions(200);
-    if (compact) {
-      o.depth_encoding = DepthEncoding::kUnorm16;
-      o.normal_encoding = NormalEncoding::kOct16;
-    }
-    o.layout = BodyMapLayout::kDense;
-    o.layers = 3;
+    BodyMapOptions o = DenseGapOptions(200, 3, compact);
     BodyMapPoseStats stats;
     const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
     ASSERT_EQ(pose.layers, 3);
@@ -1506,10 +1514,8 @@ TEST(BodyMapBaker, GapLayersKeepTheThickestGapsInDepthOrder) {
   const auto in_y = [](Vec3d p) { return p.y > -0.10 && p.y < 0.10; };
   for (const int layers : {2, 3, 4}) {
     SCOPED_TRACE(testing::Message() << "layers " << int(layers));
-    BodyMapOptions o = FloatOptions(160);
+    BodyMapOptions o = DenseGapOptions(160, static_cast<uint8_t>(layers));
     o.epsilon = static_cast<float>(eps);
-    o.layout = BodyMapLayout::kDense;
-    o.layers = static_cast<uint8_t>(layers);
     BodyMapPoseStats stats;
     const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
     size_t both = 0;
@@ -1558,10 +1564,8 @@ TEST(BodyMapBaker, OpenOrInconsistentSurfacesGiveNoGap) {
   for (size_t t = mesh.triangles.size() - 36; t < mesh.triangles.size(); t += 3) {
     std::swap(mesh.triangles[t + 1], mesh.triangles[t + 2]);
   }
-  BodyMapOptions o = FloatOptions(160);
+  BodyMapOptions o = DenseGapOptions(160, 2);
   o.epsilon = 0.f;
-  o.layout = BodyMapLayout::kDense;
-  o.layers = 2;
   BodyMapPoseStats stats;
   const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
   size_t plate = 0, sheet = 0;
@@ -1600,10 +1604,8 @@ TEST(BodyMapBaker, GapsThinnerThanTheMinimumAreNotStored) {
   AddPortableBox(&mesh, -0.20, -0.20, -0.10, 0.20, 0.20, 0.00);
   AddPortableBox(&mesh, -0.15, -0.15, 0.00005, -0.02, 0.15, 0.02);
   AddPortableBox(&mesh, 0.02, -0.15, 0.0002, 0.15, 0.15, 0.02);
-  BodyMapOptions o = FloatOptions(160);
+  BodyMapOptions o = DenseGapOptions(160, 2);
   o.epsilon = 0.f;
-  o.layout = BodyMapLayout::kDense;
-  o.layers = 2;
   BodyMapPoseStats stats;
   const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
   const GapCheck check = ExpectGaps(
@@ -1722,13 +1724,7 @@ TEST(BodyMapBaker, Unorm16GapsAreStrictlyNestedAfterQuantisation) {
 TEST(BodyMapBaker, GapLayersOnCurvedClosedMeshesAreNested) {
   const Mesh scene = GapScene();
   for (const bool compact : {false, true}) {
-    BodyMapOptions o = FloatOptions(256);
-    if (compact) {
-      o.depth_encoding = DepthEncoding::kUnorm16;
-      o.normal_encoding = NormalEncoding::kRgb8;
-    }
-    o.layout = BodyMapLayout::kDense;
-    o.layers = 4;
+    BodyMapOptions o = DenseGapOptions(256, 4, compact, NormalEncoding::kRgb8);
     BodyMapPoseStats stats;
     const BodyMapPose pose = BakeOrDie(scene, o, &stats);
     EXPECT_EQ(ExpectStrictlyNested(pose), stats.gap_texels);
@@ -1757,13 +1753,7 @@ TEST(BodyMapBaker, RowSpansCarryEveryGapLayer) {
   const Mesh scene = GapScene();
   for (const bool compact : {false, true}) {
     SCOPED_TRACE(compact ? "unorm16 + oct16" : "float32");
-    BodyMapOptions o = FloatOptions(256);
-    if (compact) {
-      o.depth_encoding = DepthEncoding::kUnorm16;
-      o.normal_encoding = NormalEncoding::kOct16;
-    }
-    o.layers = 3;
-    o.layout = BodyMapLayout::kDense;
+    BodyMapOptions o = DenseGapOptions(256, 3, compact);
     BodyMapPoseStats dense_stats, spans_stats, slab_stats;
     const BodyMapPose dense = BakeOrDie(scene, o, &dense_stats);
     o.layout = BodyMapLayout::kRowSpans;
@@ -1812,9 +1802,7 @@ TEST(BodyMapBaker, RowSpansCarryEveryGapLayer) {
 TEST(BodyMapBaker, OsMesaSlabGetsTheCpuGaps) {
   if (!OsMesaRendererAvailable()) GTEST_SKIP() << "OSMesa renderer not available in this build";
   const Mesh scene = GapScene();
-  BodyMapOptions o = FloatOptions(256);
-  o.layout = BodyMapLayout::kDense;
-  o.layers = 3;
+  BodyMapOptions o = DenseGapOptions(256, 3);
   BodyMapPoseStats cpu_stats, gl_stats;
   const BodyMapPose cpu = BakeOrDie(scene, o, &cpu_stats);
   o.renderer = MapRenderer::kOsMesa;

@@ -4,7 +4,9 @@
 // re-encodes in the current one, which must decode and re-encode to itself.
 // Each input is decoded twice: as it is (the header and checksum checks), and with its two
 // checksums recomputed, so that mutations reach the payload decoder and ValidateAsset instead
-// of stopping at the CRC.
+// of stopping at the CRC. Every body-map pose of a decoded asset is also built into the runtime
+// collider (which checks what the validator leaves to it, e.g. the depth order of air gaps) and
+// queried once: a file the loader accepts must not crash the runtime either.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "drape/formats/asset_file.h"
+#include "drape/runtime/body_map_collider.h"
 
 namespace {
 
@@ -19,6 +22,15 @@ void DecodeAndCheck(const uint8_t* data, size_t size) {
   drape::CharacterAsset asset;
   const drape::Status status = drape::DecodeAsset({data, size}, "fuzz", &asset);
   if (status.ok()) {
+    for (const drape::BodyMapPose& pose : asset.body_maps.poses) {
+      drape::BodyMapCollider collider;
+      if (collider.Build(pose).ok()) {
+        const drape::Float3 lo = collider.bounds_min(), hi = collider.bounds_max();
+        const drape::Float3 mid{0.5f * (lo.x + hi.x), 0.5f * (lo.y + hi.y), 0.5f * (lo.z + hi.z)};
+        (void)collider.Query({lo.x - 0.01f, mid.y, hi.z + 0.01f}, {hi.x + 0.01f, mid.y, lo.z});
+        (void)collider.IsInside(mid);
+      }
+    }
     std::vector<uint8_t> again;
     if (!drape::EncodeAsset(asset, &again).ok()) std::abort();
     const uint32_t version = static_cast<uint32_t>(data[8]) | static_cast<uint32_t>(data[9]) << 8 |
