@@ -3,7 +3,7 @@
 # (tests/fuzz/corpus/<name>/). New inputs go to a scratch copy, not the repository.
 #   scripts/fuzz.sh [SECONDS_PER_TARGET]   (default 60)
 # By default the run is reproducible: a fixed seed (DRAPE_FUZZ_SEED, default 1) and a fixed
-# number of inputs (DRAPE_FUZZ_RUNS, default 1e6, about a minute per target here), capped at
+# number of inputs (DRAPE_FUZZ_RUNS, default 1e6, one to two minutes per target here), capped at
 # twice SECONDS_PER_TARGET. A slower machine then tests a prefix of the same inputs, so the test
 # command cannot turn red by luck; every crash found is added to the corpus as a regression.
 # DRAPE_FUZZ_SEED=0 DRAPE_FUZZ_RUNS=-1 explores with a random seed for SECONDS_PER_TARGET.
