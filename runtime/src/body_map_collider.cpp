@@ -960,7 +960,8 @@ int BodyMapCollider::TexelIntervals(uint32_t i, uint32_t j, Interval* intervals)
   return count + 1;
 }
 
-BodyMapCollider::Interval BodyMapCollider::IntervalAt(uint32_t i, uint32_t j, float z) const {
+BodyMapCollider::Interval BodyMapCollider::IntervalAmongGaps(uint32_t i, uint32_t j,
+                                                             float z) const {
   Interval intervals[kMaxBodyMapLayers];
   const int count = TexelIntervals(i, j, intervals);
   for (int k = 0; k < count; ++k) {

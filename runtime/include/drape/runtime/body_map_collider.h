@@ -256,8 +256,16 @@ class BodyMapCollider {
   // Up to kMaxBodyMapLayers intervals of texel (i, j), from the top; returns their number (0 for
   // background).
   int TexelIntervals(uint32_t i, uint32_t j, Interval* intervals) const;
-  // The interval holding z at texel (i, j); the slab itself when no interval does.
-  Interval IntervalAt(uint32_t i, uint32_t j, float z) const;
+  // The interval holding z at texel (i, j); the slab itself when no interval does. Without gap
+  // layers it is the slab, read inline (the walk's contact path asks for every contact).
+  Interval IntervalAt(uint32_t i, uint32_t j, float z) const {
+    if (gap_layers_ == 0) {
+      const Slab& s = slabs_[static_cast<size_t>(j) * width_ + i];
+      return {s.top, s.bottom, kFrontSlot, kBackSlot};
+    }
+    return IntervalAmongGaps(i, j, z);
+  }
+  Interval IntervalAmongGaps(uint32_t i, uint32_t j, float z) const;
   Float3 SlotNormal(uint32_t i, uint32_t j, int slot) const;
   // One texel's gaps while Build decodes them (absent gaps: top = -inf, bottom = +inf).
   struct GapTexel {
