@@ -181,11 +181,23 @@ struct BodyMapWalk {
 
   // An entry at a cell's start point that the previous cell did not contain: a side wall, or the
   // top/bottom face of the clip box when this is the clipped start.
-  bool HitAtStart(float s, int ci, int cj, float top, float bottom) {
+  // `top_slot` / `bottom_slot` name the surfaces bounding the entered interval (the slab's own by
+  // default; a gap's boundary in a texel with gaps).
+  bool HitAtStart(float s, int ci, int cj, float top, float bottom,
+                  int top_slot = BodyMapCollider::kFrontSlot,
+                  int bottom_slot = BodyMapCollider::kBackSlot) {
     if (s == 0.f && start_on_z_face) {
-      return z1 < z0 ? Hit(s, kEntryFront, ci, cj, top) : Hit(s, kEntryBack, ci, cj, bottom);
+      return z1 < z0 ? HitSurface(s, kEntryFront, ci, cj, top, top_slot)
+                     : HitSurface(s, kEntryBack, ci, cj, bottom, bottom_slot);
     }
     return Hit(s, kEntrySideWall, ci, cj, Z(s));
+  }
+
+  // The s in [s_enter, s_exit] where z, linear from z_enter to z_exit over the piece, reaches
+  // `surface`; the caller has checked from the end values that it does (so no near-zero divide).
+  static float CrossingS(float surface, float z_enter, float z_exit, float s_enter, float s_exit) {
+    const float r = (surface - z_enter) / (z_exit - z_enter);
+    return std::min(std::max(s_enter + r * (s_exit - s_enter), s_enter), s_exit);
   }
 
   // Nearest depth: texel (i, j), constant slab, z linear in s -> one linear solve. (ci, cj) is
@@ -213,14 +225,12 @@ struct BodyMapWalk {
     // segments never divide by a near-zero difference), and clamp to the texel's interval.
     if (z_enter > slab.top) {  // also every background texel (top = -inf)
       if (z_exit <= slab.top) {
-        const float r = (slab.top - z_enter) / (z_exit - z_enter);
-        const float s = std::min(std::max(s_enter + r * (s_exit - s_enter), s_enter), s_exit);
-        return Hit(s, kEntryFront, ci, cj, slab.top);
+        return Hit(CrossingS(slab.top, z_enter, z_exit, s_enter, s_exit), kEntryFront, ci, cj,
+                   slab.top);
       }
     } else if (z_exit >= slab.bottom) {  // below the back surface at entry
-      const float r = (slab.bottom - z_enter) / (z_exit - z_enter);
-      const float s = std::min(std::max(s_enter + r * (s_exit - s_enter), s_enter), s_exit);
-      return Hit(s, kEntryBack, ci, cj, slab.bottom);
+      return Hit(CrossingS(slab.bottom, z_enter, z_exit, s_enter, s_exit), kEntryBack, ci, cj,
+                 slab.bottom);
     }
     inside_prev = false;
     return false;
@@ -239,17 +249,13 @@ struct BodyMapWalk {
       if (z_enter <= in[k].top && z_enter >= in[k].bottom) at = k;
     }
     if (at >= 0 && !inside_prev) {
-      if (s_enter == 0.f && start_on_z_face) {
-        return z1 < z0 ? HitSurface(s_enter, kEntryFront, ci, cj, in[at].top, in[at].top_slot)
-                       : HitSurface(s_enter, kEntryBack, ci, cj, in[at].bottom, in[at].bottom_slot);
-      }
-      return Hit(s_enter, kEntrySideWall, ci, cj, Z(s_enter));
+      return HitAtStart(s_enter, ci, cj, in[at].top, in[at].bottom, in[at].top_slot,
+                        in[at].bottom_slot);
     }
     if (at >= 0 && z_exit <= in[at].top && z_exit >= in[at].bottom) return false;  // stays in
     // The next interval below (moving down) or above (moving up) the entry point.
     const auto solve = [&](float surface) {
-      const float r = (surface - z_enter) / (z_exit - z_enter);
-      return std::min(std::max(s_enter + r * (s_exit - s_enter), s_enter), s_exit);
+      return CrossingS(surface, z_enter, z_exit, s_enter, s_exit);
     };
     if (z_exit < z_enter) {
       int next = 0;
