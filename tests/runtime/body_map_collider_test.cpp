@@ -60,9 +60,10 @@ struct GridSpec {
   float depth_range = 1.f;
 };
 
-// An empty pose of the grid with its arrays sized for `layers` layers in the given encodings.
+// An empty pose of the grid with its arrays sized, in the given encodings, for every texel plus
+// `gap_entries` gap-layer entries (body_map_data.h: (layers - 1) * gap_texels.size()).
 BodyMapPose EmptyPose(const GridSpec& g, DepthEncoding depth_encoding,
-                      NormalEncoding normal_encoding, uint8_t layers = 1) {
+                      NormalEncoding normal_encoding, size_t gap_entries = 0) {
   BodyMapPose pose;
   pose.width = g.width;
   pose.height = g.height;
@@ -73,14 +74,13 @@ BodyMapPose EmptyPose(const GridSpec& g, DepthEncoding depth_encoding,
   pose.depth_range = g.depth_range;
   pose.depth_encoding = depth_encoding;
   pose.normal_encoding = normal_encoding;
-  pose.layers = layers;
-  const size_t n = static_cast<size_t>(g.width) * g.height * layers;
+  const size_t entries = static_cast<size_t>(g.width) * g.height + gap_entries;
   for (int view = 0; view < 2; ++view) {
-    if (depth_encoding == DepthEncoding::kFloat32) pose.depth_f32[view].resize(n);
-    if (depth_encoding == DepthEncoding::kUnorm16) pose.depth_u16[view].resize(n);
-    if (normal_encoding == NormalEncoding::kFloat32) pose.normal_f32[view].resize(3 * n);
-    if (normal_encoding == NormalEncoding::kOct16) pose.normal_oct16[view].resize(2 * n);
-    if (normal_encoding == NormalEncoding::kRgb8) pose.normal_rgb8[view].resize(3 * n);
+    if (depth_encoding == DepthEncoding::kFloat32) pose.depth_f32[view].resize(entries);
+    if (depth_encoding == DepthEncoding::kUnorm16) pose.depth_u16[view].resize(entries);
+    if (normal_encoding == NormalEncoding::kFloat32) pose.normal_f32[view].resize(3 * entries);
+    if (normal_encoding == NormalEncoding::kOct16) pose.normal_oct16[view].resize(2 * entries);
+    if (normal_encoding == NormalEncoding::kRgb8) pose.normal_rgb8[view].resize(3 * entries);
   }
   return pose;
 }
@@ -1203,17 +1203,9 @@ BodyMapPose PackLayered(uint8_t layers, const std::vector<ZBox>& boxes, const Ga
                         NormalEncoding normal_encoding = NormalEncoding::kFloat32) {
   const GridSpec g = SphereGrid();
   const size_t n = static_cast<size_t>(g.width) * g.height;
-  BodyMapPose pose = EmptyPose(g, depth_encoding, normal_encoding);
+  BodyMapPose pose = EmptyPose(g, depth_encoding, normal_encoding, (layers - 1u) * gaps.size());
   pose.layers = layers;
   for (const auto& [texel, list] : gaps) pose.gap_texels.push_back(static_cast<uint32_t>(texel));
-  const size_t entries = n + (layers - 1u) * gaps.size();
-  for (int view = 0; view < 2; ++view) {
-    if (depth_encoding == DepthEncoding::kFloat32) pose.depth_f32[view].resize(entries);
-    if (depth_encoding == DepthEncoding::kUnorm16) pose.depth_u16[view].resize(entries);
-    if (normal_encoding == NormalEncoding::kFloat32) pose.normal_f32[view].resize(3 * entries);
-    if (normal_encoding == NormalEncoding::kOct16) pose.normal_oct16[view].resize(2 * entries);
-    if (normal_encoding == NormalEncoding::kRgb8) pose.normal_rgb8[view].resize(3 * entries);
-  }
   const double back_plane = static_cast<double>(g.front_z) - g.depth_range;
   for (uint32_t j = 0; j < g.height; ++j) {
     for (uint32_t i = 0; i < g.width; ++i) {
