@@ -927,6 +927,21 @@ TEST(BodyMapBaker, CpuBakesAreByteIdentical) {
 
 // The two layouts of one bake: the same arrays once expanded, the same texels read, and the
 // runtime colliders built from them answer every texel and `segments` random queries bit for bit.
+// `spans` expanded to the dense layout holds exactly `dense`'s arrays and gap list.
+void ExpandsToTheSameArrays(const BodyMapPose& spans, const BodyMapPose& dense) {
+  BodyMapPose expanded;
+  const Status status = ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &expanded);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(expanded.gap_texels, dense.gap_texels);
+  for (int view = 0; view < 2; ++view) {
+    EXPECT_EQ(expanded.depth_f32[view], dense.depth_f32[view]);
+    EXPECT_EQ(expanded.depth_u16[view], dense.depth_u16[view]);
+    EXPECT_EQ(expanded.normal_f32[view], dense.normal_f32[view]);
+    EXPECT_EQ(expanded.normal_oct16[view], dense.normal_oct16[view]);
+    EXPECT_EQ(expanded.normal_rgb8[view], dense.normal_rgb8[view]);
+  }
+}
+
 void ExpectLayoutsEquivalent(const BodyMapPose& dense, const BodyMapPose& spans, int segments) {
   ASSERT_EQ(dense.layout, BodyMapLayout::kDense);
   ASSERT_EQ(spans.layout, BodyMapLayout::kRowSpans);
@@ -936,15 +951,7 @@ void ExpectLayoutsEquivalent(const BodyMapPose& dense, const BodyMapPose& spans,
   EXPECT_EQ(Bits(spans.origin_y), Bits(dense.origin_y));
   EXPECT_EQ(Bits(spans.front_z), Bits(dense.front_z));
   EXPECT_EQ(Bits(spans.depth_range), Bits(dense.depth_range));
-  BodyMapPose expanded;
-  ASSERT_TRUE(ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &expanded).ok());
-  for (int view = 0; view < 2; ++view) {
-    EXPECT_EQ(expanded.depth_f32[view], dense.depth_f32[view]);
-    EXPECT_EQ(expanded.depth_u16[view], dense.depth_u16[view]);
-    EXPECT_EQ(expanded.normal_f32[view], dense.normal_f32[view]);
-    EXPECT_EQ(expanded.normal_oct16[view], dense.normal_oct16[view]);
-    EXPECT_EQ(expanded.normal_rgb8[view], dense.normal_rgb8[view]);
-  }
+  ExpandsToTheSameArrays(spans, dense);
   size_t texel_mismatches = 0;
   for (uint32_t j = 0; j < dense.height; ++j) {
     for (uint32_t i = 0; i < dense.width; ++i) {
@@ -1772,16 +1779,7 @@ TEST(BodyMapBaker, RowSpansCarryEveryGapLayer) {
     EXPECT_EQ(listed, spans_stats.gap_texels);
     EXPECT_EQ(spans_stats.bytes, per_texel * (spans_stats.stored_texels + 2 * listed) +
                                      SpanTableBytes(spans) + 4 * listed);
-    BodyMapPose expanded;
-    const Status status = ConvertBodyMapLayout(spans, BodyMapLayout::kDense, &expanded);
-    ASSERT_TRUE(status.ok()) << status.message();
-    EXPECT_EQ(expanded.gap_texels, dense.gap_texels);
-    for (int view = 0; view < 2; ++view) {
-      EXPECT_EQ(expanded.depth_f32[view], dense.depth_f32[view]);
-      EXPECT_EQ(expanded.depth_u16[view], dense.depth_u16[view]);
-      EXPECT_EQ(expanded.normal_f32[view], dense.normal_f32[view]);
-      EXPECT_EQ(expanded.normal_oct16[view], dense.normal_oct16[view]);
-    }
+    ExpandsToTheSameArrays(spans, dense);
     size_t mismatches = 0;
     for (uint32_t j = 0; j < dense.height; ++j) {
       for (uint32_t i = 0; i < dense.width; ++i) {

@@ -821,6 +821,21 @@ TEST(BodyMapLayers, ConvertKeepsEveryLayerBothWays) {
   }
 }
 
+// `bytes` (a file holding a BodyMapPose of class version `pose_version`) under a format
+// `format_version` header, checksums fixed: refused as corrupt, naming both versions, no pose.
+void ExpectPoseVersionRefused(std::vector<uint8_t> bytes, uint32_t format_version,
+                              uint32_t pose_version) {
+  bytes[8] = static_cast<uint8_t>(format_version);
+  FixChecksums(bytes);
+  CharacterAsset out;
+  const std::string name = "v" + std::to_string(format_version) + ".drape";
+  const Status s = DecodeAsset(bytes, name, &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(), name + ": BodyMapPose version " + std::to_string(pose_version) +
+                             " in a format version " + std::to_string(format_version) + " file");
+  EXPECT_TRUE(out.body_maps.poses.empty());
+}
+
 // Files of format versions 1 and 2 load with one layer; a BodyMapPose version 3 cannot be in
 // them.
 TEST(BodyMapLayers, OlderFormatsLoadWithOneLayerAndCannotHoldLayers) {
@@ -833,14 +848,7 @@ TEST(BodyMapLayers, OlderFormatsLoadWithOneLayerAndCannotHoldLayers) {
   ASSERT_TRUE(DecodeAsset(Encode(v2), "v3.drape", &again).ok());
   EXPECT_EQ(AssetToJson(again), AssetToJson(v2));
   // A version 3 pose under a format version 2 header.
-  std::vector<uint8_t> bytes = Encode(LayeredAsset());
-  bytes[8] = 2;
-  FixChecksums(bytes);
-  CharacterAsset out;
-  const Status s = DecodeAsset(bytes, "v2.drape", &out);
-  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_EQ(s.message(), "v2.drape: BodyMapPose version 3 in a format version 2 file");
-  EXPECT_TRUE(out.body_maps.poses.empty());
+  ExpectPoseVersionRefused(Encode(LayeredAsset()), 2, 3);
 }
 
 // A format version holds exactly its own BodyMapPose version. SmallAsset's pose rewritten as
@@ -876,13 +884,7 @@ TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
   ASSERT_TRUE(read.ok()) << read.message();
   EXPECT_EQ(v2.body_maps.poses[0].layers, 1);
   EXPECT_EQ(AssetToJson(v2), AssetToJson(small));
-  bytes[8] = 3;
-  FixChecksums(bytes);
-  CharacterAsset out;
-  const Status s = DecodeAsset(bytes, "v3.drape", &out);
-  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_EQ(s.message(), "v3.drape: BodyMapPose version 2 in a format version 3 file");
-  EXPECT_TRUE(out.body_maps.poses.empty());
+  ExpectPoseVersionRefused(bytes, 3, 2);
 }
 
 TEST(BodyMapLayers, EveryTruncationOfALayeredFileFailsCleanly) {
