@@ -180,6 +180,10 @@ std::vector<QuerySet> MakeQuerySets(std::span<const Float3> positions,
       Offset(s.point, inward, -lead(rng), p0);
       Offset(s.point, inward, thickness + lead(rng), p1);
       if (reference.Inside(p0) || reference.Inside(p1)) continue;
+      // `lead` is measured along the motion from this part only: on blocky meshes that can put
+      // the start within a few millimetres of a neighbouring part, inside every proxy's
+      // inflation, where "started inside and left" is the runtime's contract, not a miss.
+      if (reference.Distance(p0) < options.start_clearance) continue;
       add(sets[2], p0, p1);
     }
   }
@@ -192,7 +196,7 @@ std::vector<QuerySet> MakeQuerySets(std::span<const Float3> positions,
       const SurfaceSample s = sampler.Draw(rng);
       double p0[3];
       Offset(s.point, s.normal, height(rng), p0);
-      if (reference.Inside(p0)) continue;
+      if (reference.Inside(p0) || reference.Distance(p0) < options.start_clearance) continue;
       double inward[3] = {-s.normal[0], -s.normal[1], -s.normal[2]}, d[3];
       TiltedDirection(inward, 1.2, rng, d);
       double p1[3];

@@ -29,9 +29,10 @@ struct QuerySetOptions {
   float thin_thickness = 0.04f;  // metres: a part is thin when crossing it inward is shorter
   float fast_length = 0.10f;     // metres: the longest fast segment (one step)
   float inside_depth = 0.02f;    // metres: deepest starting point of the started-inside set
-  // metres: the moving sets (thin_crossing, fast) start at least this far outside the surface,
-  // beyond every method's inflation in the sweep (epsilon, delta <= 10 mm) and a texel: a motion
-  // that starts inside a proxy and leaves it is, by the runtime's contract, no contact.
+  // metres: the moving sets (thin_crossing, fast) start outside the surface and at least this
+  // far from every part of it (the mesh distance), beyond every method's inflation in the sweep
+  // (epsilon, delta <= 10 mm) and a texel: a motion that starts inside a proxy and leaves it is,
+  // by the runtime's contract, no contact.
   float start_clearance = 0.015f;
 };
 
