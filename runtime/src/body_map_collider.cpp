@@ -8,6 +8,10 @@
 #include <new>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace drape {
 namespace {
 
@@ -1320,6 +1324,260 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
   }
 }
 
+uint8_t BodyMapCollider::CollideOne(Float3 from, Float3* position, Float3* velocity,
+                                    const ResponseParams& params) const {
+  if (!IsFinite(from) || !IsFinite(*position) || !IsFinite(*velocity)) {
+    return kCollisionInvalidInput;
+  }
+  const ContactQuery q = Query(from, *position);
+  if (!q.contact) return kCollisionNone;
+  ApplyResponse(q, params, position, velocity);
+  return static_cast<uint8_t>(kCollisionContact | q.flags);
+}
+
+uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions,
+                                       Float3* velocities, uint8_t* flags, size_t count,
+                                       const ResponseParams& params) const {
+  uint32_t contacts = 0;
+  size_t k = 0;
+#if defined(__SSE2__)
+  if (sampling_ == DepthSampling::kNearest && stats_.valid_texels != 0) {
+    // Where the particles move a texel or more per step the four-lane path answers few lanes
+    // and its work is wasted: after a group it answered fewer than two of, the next
+    // kScalarGroups groups go one by one. Either path gives the same bits.
+    constexpr int kScalarGroups = 4;
+    int scalar_groups = 0;
+    for (; k + 4 <= count; k += 4) {
+      uint32_t answered = 0;
+      if (scalar_groups > 0) {
+        --scalar_groups;
+      } else {
+        answered =
+            CollideFourInOneTexel(previous + k, positions + k, velocities + k, flags + k, params);
+        if (std::popcount(answered) < 2) scalar_groups = kScalarGroups;
+      }
+      for (uint32_t lane = 0; lane < 4; ++lane) {
+        if (!(answered & (1u << lane))) {
+          flags[k + lane] =
+              CollideOne(previous[k + lane], &positions[k + lane], &velocities[k + lane], params);
+        }
+        contacts += flags[k + lane] & kCollisionContact;
+      }
+    }
+  }
+#endif
+  for (; k < count; ++k) {
+    flags[k] = CollideOne(previous[k], &positions[k], &velocities[k], params);
+    contacts += flags[k] & kCollisionContact;
+  }
+  return contacts;
+}
+
+#if defined(__SSE2__)
+namespace {
+
+// Four particles' coordinates, one lane each.
+struct Lanes3 {
+  __m128 x, y, z;
+};
+
+// Four consecutive Float3 (48 packed bytes) as lanes: three loads and a transpose.
+Lanes3 LoadLanes(const Float3* p) {
+  const float* f = &p[0].x;
+  const __m128 a = _mm_loadu_ps(f);      // x0 y0 z0 x1
+  const __m128 b = _mm_loadu_ps(f + 4);  // y1 z1 x2 y2
+  const __m128 c = _mm_loadu_ps(f + 8);  // z2 x3 y3 z3
+  const __m128 b2c1 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2));
+  const __m128 a1b0 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1));
+  const __m128 b3c2 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3));
+  const __m128 a2b1 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2));
+  const __m128 c0c3 = _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0));
+  return {_mm_shuffle_ps(a, b2c1, _MM_SHUFFLE(2, 0, 3, 0)),
+          _mm_shuffle_ps(a1b0, b3c2, _MM_SHUFFLE(2, 0, 2, 0)),
+          _mm_shuffle_ps(a2b1, c0c3, _MM_SHUFFLE(2, 0, 2, 0))};
+}
+
+// Lane by lane, what the scalar expressions give (IEEE single precision per lane; the operand
+// order of min and max follows std::min / std::max, which return the first argument on ties).
+inline __m128 SelectLanes(__m128 mask, __m128 a, __m128 b) {
+  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+inline __m128 StdMin(__m128 a, __m128 b) { return _mm_min_ps(b, a); }  // b < a ? b : a
+inline __m128 StdMax(__m128 a, __m128 b) { return _mm_max_ps(b, a); }  // a < b ? b : a
+inline __m128 AbsLanes(__m128 v) { return _mm_andnot_ps(_mm_set1_ps(-0.f), v); }
+
+// BodyMapWalk::Along.
+inline __m128 AlongLanes(__m128 a, __m128 b, __m128 s) {
+  const __m128 d = _mm_sub_ps(b, a);
+  const __m128 from_a = _mm_add_ps(a, _mm_mul_ps(d, s));
+  const __m128 from_b = _mm_sub_ps(b, _mm_mul_ps(d, _mm_sub_ps(_mm_set1_ps(1.f), s)));
+  return SelectLanes(_mm_cmplt_ps(s, _mm_set1_ps(0.5f)), from_a, from_b);
+}
+
+// DecodeOct16 of four codes.
+Lanes3 DecodeOct16Lanes(const uint16_t (&qa)[4], const uint16_t (&qb)[4]) {
+  const __m128 one = _mm_set1_ps(1.f);
+  const __m128 scale = _mm_set1_ps(2.f / 65535.f);
+  __m128 x = _mm_sub_ps(_mm_mul_ps(_mm_setr_ps(qa[0], qa[1], qa[2], qa[3]), scale), one);
+  __m128 y = _mm_sub_ps(_mm_mul_ps(_mm_setr_ps(qb[0], qb[1], qb[2], qb[3]), scale), one);
+  const __m128 z = _mm_sub_ps(_mm_sub_ps(one, AbsLanes(x)), AbsLanes(y));
+  const __m128 minus_one = _mm_set1_ps(-1.f), zero = _mm_setzero_ps();
+  const __m128 sign_x = SelectLanes(_mm_cmpge_ps(x, zero), one, minus_one);
+  const __m128 sign_y = SelectLanes(_mm_cmpge_ps(y, zero), one, minus_one);
+  const __m128 fold = _mm_cmplt_ps(z, zero);
+  const __m128 unfolded_x = _mm_mul_ps(_mm_sub_ps(one, AbsLanes(y)), sign_x);
+  const __m128 unfolded_y = _mm_mul_ps(_mm_sub_ps(one, AbsLanes(x)), sign_y);
+  x = SelectLanes(fold, unfolded_x, x);
+  y = SelectLanes(fold, unfolded_y, y);
+  // NormalizeOr(n, +z).
+  const __m128 length =
+      _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)), _mm_mul_ps(z, z)));
+  const __m128 usable = _mm_cmpgt_ps(length, _mm_set1_ps(1e-20f));
+  const __m128 inverse = _mm_div_ps(one, length);
+  return {SelectLanes(usable, _mm_mul_ps(x, inverse), zero),
+          SelectLanes(usable, _mm_mul_ps(y, inverse), zero),
+          SelectLanes(usable, _mm_mul_ps(z, inverse), one)};
+}
+
+}  // namespace
+
+uint32_t BodyMapCollider::CollideFourInOneTexel(const Float3* previous, Float3* positions,
+                                                Float3* velocities, uint8_t* flags,
+                                                const ResponseParams& params) const {
+  const Lanes3 p0 = LoadLanes(previous), p1 = LoadLanes(positions), v = LoadLanes(velocities);
+  // Finite input (a sum holding a NaN or an infinity is not finite; an overflowing one only
+  // sends the lane to CollideOne).
+  const __m128 sum =
+      _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(p0.x, p0.y), _mm_add_ps(p0.z, p1.x)),
+                            _mm_add_ps(_mm_add_ps(p1.y, p1.z), _mm_add_ps(v.x, v.y))),
+                 v.z);
+  const __m128 zero = _mm_setzero_ps();
+  __m128 answerable = _mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero);
+  // QuerySingleTexel's conditions: both ends on the grid in one texel, z in the clip box.
+  const __m128 origin_x = _mm_set1_ps(origin_x_), origin_y = _mm_set1_ps(origin_y_);
+  const __m128 inverse = _mm_set1_ps(inv_texel_size_);
+  const __m128 u0 = _mm_mul_ps(_mm_sub_ps(p0.x, origin_x), inverse);
+  const __m128 v0 = _mm_mul_ps(_mm_sub_ps(p0.y, origin_y), inverse);
+  const __m128 u1 = _mm_mul_ps(_mm_sub_ps(p1.x, origin_x), inverse);
+  const __m128 v1 = _mm_mul_ps(_mm_sub_ps(p1.y, origin_y), inverse);
+  const __m128 width = _mm_set1_ps(width_f_), height = _mm_set1_ps(height_f_);
+  const auto on_grid = [&](__m128 u, __m128 limit) {
+    return _mm_and_ps(_mm_cmpge_ps(u, zero), _mm_cmplt_ps(u, limit));
+  };
+  answerable = _mm_and_ps(answerable, _mm_and_ps(on_grid(u0, width), on_grid(v0, height)));
+  answerable = _mm_and_ps(answerable, _mm_and_ps(on_grid(u1, width), on_grid(v1, height)));
+  // Truncation as in the scalar path (off-grid lanes convert to 0x80000000 and are not used).
+  const __m128i i0 = _mm_cvttps_epi32(u0), j0 = _mm_cvttps_epi32(v0);
+  const __m128i same = _mm_and_si128(_mm_cmpeq_epi32(i0, _mm_cvttps_epi32(u1)),
+                                     _mm_cmpeq_epi32(j0, _mm_cvttps_epi32(v1)));
+  answerable = _mm_and_ps(answerable, _mm_castsi128_ps(same));
+  // The clip box's z range is bounds_min_.z .. bounds_max_.z (floats).
+  const __m128 z_lo = _mm_set1_ps(bounds_min_.z), z_hi = _mm_set1_ps(bounds_max_.z);
+  answerable =
+      _mm_and_ps(answerable, _mm_and_ps(_mm_cmpge_ps(p0.z, z_lo), _mm_cmple_ps(p0.z, z_hi)));
+  answerable =
+      _mm_and_ps(answerable, _mm_and_ps(_mm_cmpge_ps(p1.z, z_lo), _mm_cmple_ps(p1.z, z_hi)));
+  uint32_t lanes = static_cast<uint32_t>(_mm_movemask_ps(answerable));
+  if (lanes == 0) return 0;
+
+  // The lanes' slabs (texel 0 for the others, never used).
+  alignas(16) int32_t i[4], j[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(i), i0);
+  _mm_store_si128(reinterpret_cast<__m128i*>(j), j0);
+  size_t texel[4];
+  float top_of[4], bottom_of[4];
+  for (int lane = 0; lane < 4; ++lane) {
+    const bool used = (lanes >> lane) & 1u;
+    texel[lane] = used ? static_cast<size_t>(j[lane]) * width_ + static_cast<size_t>(i[lane]) : 0;
+    top_of[lane] = slabs_[texel[lane]].top;
+    bottom_of[lane] = slabs_[texel[lane]].bottom;
+  }
+  if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
+    for (int lane = 0; lane < 4; ++lane) {
+      if (((lanes >> lane) & 1u) &&
+          GapBase(static_cast<uint32_t>(i[lane]), static_cast<uint32_t>(j[lane])) >= 0) {
+        lanes &= ~(1u << lane);
+      }
+    }
+  }
+  if (lanes == 0) return 0;
+  const __m128 top = _mm_loadu_ps(top_of), bottom = _mm_loadu_ps(bottom_of);
+
+  // QuerySingleTexel's answer: an entry through the surface the motion comes from, or the
+  // push-out of a motion that starts and ends inside; nothing on background.
+  const __m128 valid = _mm_cmpge_ps(top, bottom);
+  const __m128 inside_start = _mm_and_ps(_mm_cmple_ps(p0.z, top), _mm_cmpge_ps(p0.z, bottom));
+  const __m128 inside_end = _mm_and_ps(_mm_cmple_ps(p1.z, top), _mm_cmpge_ps(p1.z, bottom));
+  const __m128 from_front = _mm_cmpgt_ps(p0.z, top);
+  const __m128 crosses =
+      SelectLanes(from_front, _mm_cmple_ps(p1.z, top), _mm_cmpge_ps(p1.z, bottom));
+  const __m128 entry = _mm_and_ps(valid, _mm_andnot_ps(inside_start, crosses));
+  const __m128 push_out = _mm_and_ps(valid, _mm_and_ps(inside_start, inside_end));
+  const uint32_t contact_lanes =
+      static_cast<uint32_t>(_mm_movemask_ps(_mm_or_ps(entry, push_out))) & lanes;
+
+  const __m128 surface = SelectLanes(from_front, top, bottom);
+  const __m128 s =
+      StdMin(StdMax(_mm_div_ps(_mm_sub_ps(surface, p0.z), _mm_sub_ps(p1.z, p0.z)), zero),
+             _mm_set1_ps(1.f));
+  const __m128 push_back =
+      _mm_cmplt_ps(_mm_sub_ps(p1.z, bottom), _mm_sub_ps(top, p1.z));  // nearer the back
+  const Lanes3 point = {SelectLanes(push_out, p1.x, AlongLanes(p0.x, p1.x, s)),
+                        SelectLanes(push_out, p1.y, AlongLanes(p0.y, p1.y, s)),
+                        SelectLanes(push_out, SelectLanes(push_back, bottom, top), surface)};
+  const uint32_t back_lanes = static_cast<uint32_t>(
+      _mm_movemask_ps(SelectLanes(push_out, push_back, _mm_andnot_ps(from_front, valid))));
+  uint16_t qa[4] = {0, 0, 0, 0}, qb[4] = {0, 0, 0, 0};
+  for (int lane = 0; lane < 4; ++lane) {
+    const TexelNormals& n = normals_[texel[lane]];
+    const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
+    qa[lane] = q[0];
+    qb[lane] = q[1];
+  }
+  const Lanes3 normal = DecodeOct16Lanes(qa, qb);
+
+  // ApplyResponse: the position on the surface plus the separation; the velocity only where it
+  // points into the body.
+  const __m128 separation = _mm_set1_ps(params.separation);
+  const Lanes3 position = {_mm_add_ps(point.x, _mm_mul_ps(normal.x, separation)),
+                           _mm_add_ps(point.y, _mm_mul_ps(normal.y, separation)),
+                           _mm_add_ps(point.z, _mm_mul_ps(normal.z, separation))};
+  const __m128 vn = _mm_add_ps(_mm_add_ps(_mm_mul_ps(v.x, normal.x), _mm_mul_ps(v.y, normal.y)),
+                               _mm_mul_ps(v.z, normal.z));
+  const __m128 keep = _mm_set1_ps(1.f - params.friction);
+  const __m128 restitution = _mm_set1_ps(params.restitution);
+  const __m128 into = _mm_cmplt_ps(vn, zero);
+  const auto respond = [&](__m128 velocity, __m128 n) {
+    const __m128 normal_part = _mm_mul_ps(n, vn);
+    const __m128 changed = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(velocity, normal_part), keep),
+                                      _mm_mul_ps(normal_part, restitution));
+    return SelectLanes(into, changed, velocity);
+  };
+  const Lanes3 velocity = {respond(v.x, normal.x), respond(v.y, normal.y), respond(v.z, normal.z)};
+  const uint32_t push_lanes = static_cast<uint32_t>(_mm_movemask_ps(push_out));
+
+  alignas(16) float out[6][4];
+  _mm_store_ps(out[0], position.x);
+  _mm_store_ps(out[1], position.y);
+  _mm_store_ps(out[2], position.z);
+  _mm_store_ps(out[3], velocity.x);
+  _mm_store_ps(out[4], velocity.y);
+  _mm_store_ps(out[5], velocity.z);
+  for (int lane = 0; lane < 4; ++lane) {
+    if (!((lanes >> lane) & 1u)) continue;
+    if (!((contact_lanes >> lane) & 1u)) {
+      flags[lane] = kCollisionNone;
+      continue;
+    }
+    positions[lane] = Float3{out[0][lane], out[1][lane], out[2][lane]};
+    velocities[lane] = Float3{out[3][lane], out[4][lane], out[5][lane]};
+    flags[lane] = static_cast<uint8_t>(kCollisionContact |
+                                       ((push_lanes >> lane) & 1u ? kCollisionStartedInside : 0));
+  }
+  return lanes;
+}
+#endif
+
 Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span<Float3> positions,
                                      std::span<Float3> velocities, std::span<uint8_t> flags,
                                      const ResponseParams& params, uint32_t* contact_count) const {
@@ -1340,27 +1598,18 @@ Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span
   if (empty()) {
     return Status(StatusCode::kInvalidState, "BodyMapCollider::CollideBatch: collider not built");
   }
+  // Chunks through CollideRange, for the reason InsideBatch gives. Each particle's answer
+  // depends on that particle alone, so the chunking does not change a bit.
   const int64_t count = static_cast<int64_t>(n);
+  constexpr int64_t kChunk = 4096;
+  const int64_t chunks = (count + kChunk - 1) / kChunk;
   uint32_t contacts = 0;  // an integer sum: the same at any thread count
-#pragma omp parallel for schedule(static) reduction(+ : contacts) if (count > 4096)
-  for (int64_t k = 0; k < count; ++k) {
-    const Float3 from = previous[k];
-    Float3 position = positions[k];
-    Float3 velocity = velocities[k];
-    if (!IsFinite(from) || !IsFinite(position) || !IsFinite(velocity)) {
-      flags[k] = kCollisionInvalidInput;
-      continue;
-    }
-    const ContactQuery q = Query(from, position);
-    if (!q.contact) {
-      flags[k] = kCollisionNone;
-      continue;
-    }
-    ApplyResponse(q, params, &position, &velocity);
-    positions[k] = position;
-    velocities[k] = velocity;
-    flags[k] = static_cast<uint8_t>(kCollisionContact | q.flags);
-    ++contacts;
+#pragma omp parallel for schedule(static) reduction(+ : contacts) if (chunks > 1)
+  for (int64_t chunk = 0; chunk < chunks; ++chunk) {
+    const size_t begin = static_cast<size_t>(chunk * kChunk);
+    const size_t end = std::min(static_cast<size_t>(count), begin + static_cast<size_t>(kChunk));
+    contacts += CollideRange(previous.data() + begin, positions.data() + begin,
+                             velocities.data() + begin, flags.data() + begin, end - begin, params);
   }
   if (contact_count != nullptr) *contact_count = contacts;
   return Status::Ok();

@@ -9,7 +9,8 @@
 //                                        Query, 1 thread, on particles 2 mm in front of the
 //                                        surface, half of them moving through it; sampling 0
 //                                        nearest, 1 bilinear; motion 0: 0.1-0.5 texels
-//                                        sideways, 1: 1-2 texels
+//                                        sideways, 1: 1-2 texels, 2: up to 0.02 texels
+//                                        (cloth resting on the body)
 //  BM_CollideBatch/<shape>/<N>/<threads>/<motion>
 //                                        the same segments through CollideBatch (+ response)
 //  BM_SegmentLength/<texels>/<sampling>  Query on horizontal segments of 1..256 texels at a
@@ -156,13 +157,14 @@ std::vector<Float3> SheetPoints(int shape, bool shuffled) {
 
 // Particles 2 mm in front of the surface, in sheet order over the figure (a 512 x 512 grid over
 // its box, background points dropped), each moving sideways by 0.1-0.5 texels (motion 0, a
-// resting or sliding cloth) or 1-2 texels (motion 1); every other one also moves 4 mm towards
-// -z, ending 2 mm inside (half free, half colliding).
+// sliding cloth), 1-2 texels (motion 1) or up to 0.02 texels (motion 2, a resting cloth); every
+// other one also moves 4 mm towards -z, ending 2 mm inside (half free, half colliding).
 void SheetSegments(int shape, float texel, int motion, std::vector<Float3>* from,
                    std::vector<Float3>* to) {
   std::mt19937 rng(2);
   std::uniform_real_distribution<float> angle(0.f, 6.2831853f);
-  std::uniform_real_distribution<float> length(motion == 0 ? 0.1f : 1.f, motion == 0 ? 0.5f : 2.f);
+  constexpr float kLength[3][2] = {{0.1f, 0.5f}, {1.f, 2.f}, {0.f, 0.02f}};  // texels
+  std::uniform_real_distribution<float> length(kLength[motion][0], kLength[motion][1]);
   from->clear();
   to->clear();
   const float x_lo = shape == 0 ? -0.3f : -0.7f, x_hi = -x_lo;
@@ -237,7 +239,7 @@ void BM_Continuous(benchmark::State& state) {
       static_cast<double>(contacts) / static_cast<double>(from.size() * state.iterations());
   SetPerParticle(state, from.size());
 }
-BENCHMARK(BM_Continuous)->ArgsProduct({{0, 1}, {512, 1024}, {0, 1}, {0, 1}});
+BENCHMARK(BM_Continuous)->ArgsProduct({{0, 1}, {512, 1024}, {0, 1}, {0, 1, 2}});
 
 void BM_CollideBatch(benchmark::State& state) {
   const int shape = static_cast<int>(state.range(0));
@@ -262,7 +264,7 @@ void BM_CollideBatch(benchmark::State& state) {
   omp_set_num_threads(omp_get_num_procs());
   SetPerParticle(state, from.size());
 }
-BENCHMARK(BM_CollideBatch)->ArgsProduct({{0, 1}, {512, 1024}, {1, 2}, {0, 1}})->UseRealTime();
+BENCHMARK(BM_CollideBatch)->ArgsProduct({{0, 1}, {512, 1024}, {1, 2}, {0, 1, 2}})->UseRealTime();
 
 // Horizontal segments of a fixed length in texels, random start over the figure's box and a
 // random depth inside its z range: the walk runs until the first entry or the end.

@@ -35,6 +35,14 @@ struct BodyMapColliderTestAccess {
   static bool ClearlyFree(const BodyMapCollider& c, Float3 p0, Float3 p1) {
     return c.ClearlyFree(p0, p1, c.ToTexels(p0, p1));
   }
+#if defined(__SSE2__)
+  // CollideBatch's four-particle path alone (which lanes it answers is not visible through
+  // the batch).
+  static uint32_t CollideFour(const BodyMapCollider& c, const Float3* previous, Float3* positions,
+                              Float3* velocities, uint8_t* flags, const ResponseParams& params) {
+    return c.CollideFourInOneTexel(previous, positions, velocities, flags, params);
+  }
+#endif
 };
 
 namespace {
@@ -1516,6 +1524,140 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
   EXPECT_NEAR(lower[0], 0.75f * 0.075f + 0.25f * 0.05f, 1e-6);
   EXPECT_FALSE(blended.IsInside({-0.05f, 0.01f, 0.08f}));
   EXPECT_TRUE(blended.IsInside({-0.05f, 0.01f, 0.115f}));
+}
+
+// CollideBatch answers every particle as Query and ApplyResponse do, bit for bit, whichever of
+// its paths (four particles at once in one texel, or one by one) takes the particle: resting and
+// sliding motions, points, starts inside, background, motions off the grid or beyond the clip
+// box in z, longer motions, texels with gaps, and non-finite input in any of the three arrays.
+TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
+  const BodyMapCollider bodies[4] = {
+      BuildOrDie(MakePose(SphereGrid(), Sphere)), BuildOrDie(MakePose(BoxGrid(), Box)),
+      BuildOrDie(MakePose(SphereGrid(), ThinSlab)), BuildOrDie(LayeredPose(3, kStack))};
+  ResponseParams params;
+  params.friction = 0.3f;
+  params.restitution = 0.25f;
+  params.separation = 2e-4f;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  for (int body = 0; body < 4; ++body) {
+    SCOPED_TRACE(::testing::Message() << "body " << body);
+    const BodyMapCollider& c = bodies[body];
+    const Float3 lo = c.bounds_min(), hi = c.bounds_max();
+    const float texel = c.texel_size();
+    const auto point = [&](float pad) {
+      return Float3{lo.x - pad + unit(rng) * (hi.x - lo.x + 2.f * pad),
+                    lo.y - pad + unit(rng) * (hi.y - lo.y + 2.f * pad),
+                    lo.z - pad + unit(rng) * (hi.z - lo.z + 2.f * pad)};
+    };
+    constexpr size_t kCount = 40001;  // not a multiple of four: the one-by-one tail runs too
+    std::vector<Float3> previous(kCount), positions(kCount), velocities(kCount);
+    for (size_t k = 0; k < kCount; ++k) {
+      Float3 p0 = point(0.01f), p1 = p0;
+      switch (k % 8) {
+        case 0:  // a point (a particle at rest)
+          break;
+        case 1:  // resting on the surface: a hundredth of a texel, through it along z
+        case 2:  // sliding: under half a texel
+          p1 = p0 + Float3{(unit(rng) - 0.5f) * (k % 8 == 1 ? 0.02f : 0.8f) * texel,
+                           (unit(rng) - 0.5f) * (k % 8 == 1 ? 0.02f : 0.8f) * texel,
+                           (unit(rng) - 0.5f) * 0.05f};
+          break;
+        case 3:  // a few texels
+          p1 = p0 + Float3{(unit(rng) - 0.5f) * 6.f * texel, (unit(rng) - 0.5f) * 6.f * texel,
+                           (unit(rng) - 0.5f) * 0.02f};
+          break;
+        case 4:  // beyond the clip box in z, or off the grid
+          p0.z = unit(rng) < 0.5f ? hi.z + 0.01f : lo.z - 0.01f;
+          p1 = unit(rng) < 0.5f ? Float3{p0.x, p0.y, 0.f} : point(0.3f);
+          break;
+        case 5: {  // starting or ending exactly on a surface value of the texel's slab
+          const float u = (p0.x - c.origin_x()) / texel, v = (p0.y - c.origin_y()) / texel;
+          float top = 0.f, bottom = 0.f;
+          if (u >= 0.f && v >= 0.f &&
+              c.TexelSlab(static_cast<uint32_t>(u), static_cast<uint32_t>(v), &top, &bottom)) {
+            p0.z = unit(rng) < 0.5f ? top : bottom;
+            p1 = Float3{p0.x, p0.y, p0.z + (unit(rng) - 0.5f) * 0.01f};
+          }
+          break;
+        }
+        case 6: {  // non-finite input in one coordinate of one of the three arrays
+          const float bad = unit(rng) < 0.5f ? nan : (unit(rng) < 0.5f ? inf : -inf);
+          float* target[3] = {&p0.x, &p1.z, nullptr};
+          const int which = static_cast<int>(unit(rng) * 3.f) % 3;
+          if (target[which] != nullptr) *target[which] = bad;
+          break;
+        }
+        default:  // long, across the box
+          p1 = point(0.1f);
+          break;
+      }
+      previous[k] = p0;
+      positions[k] = p1;
+      velocities[k] = RandomPoint(rng, -1.f, 1.f, -1.f, 1.f);
+      if (k % 8 == 6 && k % 24 == 22) velocities[k].y = nan;
+    }
+    // The reference: one particle at a time through the documented contract.
+    std::vector<Float3> want_positions = positions, want_velocities = velocities;
+    std::vector<uint8_t> want_flags(kCount);
+    uint32_t want_contacts = 0;
+    for (size_t k = 0; k < kCount; ++k) {
+      if (!IsFinite(previous[k]) || !IsFinite(positions[k]) || !IsFinite(velocities[k])) {
+        want_flags[k] = kCollisionInvalidInput;
+        continue;
+      }
+      const ContactQuery q = c.Query(previous[k], positions[k]);
+      if (!q.contact) {
+        want_flags[k] = kCollisionNone;
+        continue;
+      }
+      ApplyResponse(q, params, &want_positions[k], &want_velocities[k]);
+      want_flags[k] = static_cast<uint8_t>(kCollisionContact | q.flags);
+      ++want_contacts;
+    }
+    EXPECT_GT(want_contacts, kCount / 10);
+    for (int threads : {1, 2}) {
+      SCOPED_TRACE(::testing::Message() << threads << " thread(s)");
+      const int saved_threads = omp_get_max_threads();
+      omp_set_num_threads(threads);
+      std::vector<Float3> got_positions = positions, got_velocities = velocities;
+      std::vector<uint8_t> got_flags(kCount, 0xee);
+      uint32_t got_contacts = 0;
+      const Status status =
+          c.CollideBatch(previous, got_positions, got_velocities, got_flags, params, &got_contacts);
+      omp_set_num_threads(saved_threads);
+      ASSERT_TRUE(status.ok()) << status.message();
+      EXPECT_EQ(got_contacts, want_contacts);
+      int differing = 0;
+      for (size_t k = 0; k < kCount && differing < 10; ++k) {
+        const bool same = got_flags[k] == want_flags[k] &&
+                          std::memcmp(&got_positions[k], &want_positions[k], sizeof(Float3)) == 0 &&
+                          std::memcmp(&got_velocities[k], &want_velocities[k], sizeof(Float3)) == 0;
+        if (!same) {
+          ++differing;
+          ADD_FAILURE() << "particle " << k << " (kind " << k % 8 << "): flags "
+                        << int(got_flags[k]) << " want " << int(want_flags[k]);
+        }
+      }
+    }
+#if defined(__SSE2__)
+    // The four-particle path must carry a real share of these particles: resting and sliding
+    // motions, points and surface starts in one texel.
+    size_t answered = 0;
+    std::vector<Float3> scratch_positions = positions, scratch_velocities = velocities;
+    std::vector<uint8_t> scratch_flags(kCount);
+    for (size_t k = 0; k + 4 <= kCount; k += 4) {
+      const uint32_t lanes =
+          BodyMapColliderTestAccess::CollideFour(c, &previous[k], &scratch_positions[k],
+                                                 &scratch_velocities[k], &scratch_flags[k], params);
+      answered += static_cast<size_t>(std::popcount(lanes));
+    }
+    // (The thin slab's 2 mm clip box sends most motions to the walk.)
+    EXPECT_GT(answered, kCount / (body == 2 ? 40 : 5));
+#endif
+  }
 }
 
 }  // namespace drape

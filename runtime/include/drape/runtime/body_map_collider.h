@@ -305,6 +305,18 @@ class BodyMapCollider {
   static constexpr int kFreeTestMaxTexels = 9;  // texels (or blocks) ClearlyFree reads at most
   bool IsInsideBilinear(Float3 p) const;
   void InsideRange(const Float3* points, uint8_t* inside, size_t count) const;  // kNearest
+  // CollideBatch for one particle: the flags it writes; position and velocity respond in place.
+  uint8_t CollideOne(Float3 from, Float3* position, Float3* velocity,
+                     const ResponseParams& params) const;
+  // CollideBatch over count particles on one thread; returns the number of contacts.
+  uint32_t CollideRange(const Float3* previous, Float3* positions, Float3* velocities,
+                        uint8_t* flags, size_t count, const ResponseParams& params) const;
+  // CollideBatch for four particles at once (SSE2, kNearest, a non-empty map), for the lanes
+  // whose motion QuerySingleTexel answers: writes their flags, positions and velocities bit for
+  // bit as CollideOne would and returns their lane mask (bit l = particle l); the other lanes
+  // are untouched.
+  uint32_t CollideFourInOneTexel(const Float3* previous, Float3* positions, Float3* velocities,
+                                 uint8_t* flags, const ResponseParams& params) const;
   // top/bottom at texel coordinates (u, v) >= 0 inside the grid, in half-texel cell (ci, cj) =
   // (floor 2u, floor 2v): bilinear in an eligible block, else the nearest texel.
   void SampleSlab(int ci, int cj, float u, float v, float* top, float* bottom) const;
