@@ -509,6 +509,10 @@ void BodyMapCollider::Clear() {
     clip_lo_[k] = 0.0;
     clip_hi_[k] = -1.0;
   }
+  for (int k = 0; k < 2; ++k) {
+    clip_lo_float_[k] = 0.f;
+    clip_hi_float_[k] = -1.f;
+  }
   blocks_w_ = blocks_h_ = 0;
   stats_ = BodyMapStats{};
   slabs_.clear();
@@ -852,6 +856,15 @@ void BodyMapCollider::Finish() {
     clip_hi_[1] = origin_y_ + (static_cast<double>(j_hi) + 1.0) * s;
     clip_lo_[2] = z_lo;
     clip_hi_[2] = z_hi;
+  }
+  // The same box in x and y for float coordinates: the least float >= lo and the greatest
+  // float <= hi, so that x >= clip_lo_float_[0] exactly when x >= clip_lo_[0].
+  for (int k = 0; k < 2; ++k) {
+    float lo = static_cast<float>(clip_lo_[k]), hi = static_cast<float>(clip_hi_[k]);
+    if (static_cast<double>(lo) < clip_lo_[k]) lo = std::nextafter(lo, kInf);
+    if (static_cast<double>(hi) > clip_hi_[k]) hi = std::nextafter(hi, -kInf);
+    clip_lo_float_[k] = lo;
+    clip_hi_float_[k] = hi;
   }
 
   // Bilinear eligibility per 2x2 block (lower corner texel (i, j)).
@@ -1353,7 +1366,7 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
         --scalar_groups;
       } else {
         answered =
-            CollideFourInOneTexel(previous + k, positions + k, velocities + k, flags + k, params);
+            CollideFourShortMotions(previous + k, positions + k, velocities + k, flags + k, params);
         if (std::popcount(answered) < 2) scalar_groups = kScalarGroups;
       }
       for (uint32_t lane = 0; lane < 4; ++lane) {
@@ -1439,11 +1452,41 @@ Lanes3 DecodeOct16Lanes(const uint16_t (&qa)[4], const uint16_t (&qb)[4]) {
           SelectLanes(usable, _mm_mul_ps(z, inverse), one)};
 }
 
+// One walk visit (BodyMapWalk::VisitTexel without gaps) of four lanes' texels over
+// [s_enter, s_exit], z from z_enter to z_exit, `inside` at the entry point: where each lane
+// enters the texel's slab first, if it does.
+struct LaneVisit {
+  __m128 wall, front, back;  // masks: entered through a side wall, the front, the back surface
+  __m128 s, z;               // the entry parameter and the entry's z (the surface, or z_enter)
+  __m128 inside_after;       // no entry and inside at s_exit
+};
+
+LaneVisit VisitLanes(__m128 top, __m128 bottom, __m128 s_enter, __m128 s_exit, __m128 z_enter,
+                     __m128 z_exit, __m128 inside) {
+  LaneVisit visit;
+  const __m128 in_enter = _mm_and_ps(_mm_cmple_ps(z_enter, top), _mm_cmpge_ps(z_enter, bottom));
+  const __m128 above = _mm_cmpgt_ps(z_enter, top);  // also every background texel (top = -inf)
+  visit.wall = _mm_andnot_ps(inside, in_enter);
+  visit.front = _mm_andnot_ps(in_enter, _mm_and_ps(above, _mm_cmple_ps(z_exit, top)));
+  visit.back = _mm_andnot_ps(in_enter, _mm_andnot_ps(above, _mm_cmpge_ps(z_exit, bottom)));
+  // CrossingS(surface, z_enter, z_exit, s_enter, s_exit).
+  const __m128 surface = SelectLanes(above, top, bottom);
+  const __m128 r = _mm_div_ps(_mm_sub_ps(surface, z_enter), _mm_sub_ps(z_exit, z_enter));
+  const __m128 crossing = StdMin(
+      StdMax(_mm_add_ps(s_enter, _mm_mul_ps(r, _mm_sub_ps(s_exit, s_enter))), s_enter), s_exit);
+  visit.s = SelectLanes(visit.wall, s_enter, crossing);
+  visit.z = SelectLanes(visit.wall, z_enter, surface);
+  visit.inside_after =
+      _mm_and_ps(_mm_and_ps(inside, in_enter),
+                 _mm_and_ps(_mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom)));
+  return visit;
+}
+
 }  // namespace
 
-uint32_t BodyMapCollider::CollideFourInOneTexel(const Float3* previous, Float3* positions,
-                                                Float3* velocities, uint8_t* flags,
-                                                const ResponseParams& params) const {
+uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3* positions,
+                                                  Float3* velocities, uint8_t* flags,
+                                                  const ResponseParams& params) const {
   const Lanes3 p0 = LoadLanes(previous), p1 = LoadLanes(positions), v = LoadLanes(velocities);
   // Finite input (a sum holding a NaN or an infinity is not finite; an overflowing one only
   // sends the lane to CollideOne).
@@ -1451,9 +1494,9 @@ uint32_t BodyMapCollider::CollideFourInOneTexel(const Float3* previous, Float3* 
       _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(p0.x, p0.y), _mm_add_ps(p0.z, p1.x)),
                             _mm_add_ps(_mm_add_ps(p1.y, p1.z), _mm_add_ps(v.x, v.y))),
                  v.z);
-  const __m128 zero = _mm_setzero_ps();
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
   __m128 answerable = _mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero);
-  // QuerySingleTexel's conditions: both ends on the grid in one texel, z in the clip box.
+  // Both ends on the grid (ToTexels' expressions) and in the clip box's z range.
   const __m128 origin_x = _mm_set1_ps(origin_x_), origin_y = _mm_set1_ps(origin_y_);
   const __m128 inverse = _mm_set1_ps(inv_texel_size_);
   const __m128 u0 = _mm_mul_ps(_mm_sub_ps(p0.x, origin_x), inverse);
@@ -1461,75 +1504,134 @@ uint32_t BodyMapCollider::CollideFourInOneTexel(const Float3* previous, Float3* 
   const __m128 u1 = _mm_mul_ps(_mm_sub_ps(p1.x, origin_x), inverse);
   const __m128 v1 = _mm_mul_ps(_mm_sub_ps(p1.y, origin_y), inverse);
   const __m128 width = _mm_set1_ps(width_f_), height = _mm_set1_ps(height_f_);
+  const auto within = [](__m128 x, __m128 lo, __m128 hi) {
+    return _mm_and_ps(_mm_cmpge_ps(x, lo), _mm_cmple_ps(x, hi));
+  };
   const auto on_grid = [&](__m128 u, __m128 limit) {
     return _mm_and_ps(_mm_cmpge_ps(u, zero), _mm_cmplt_ps(u, limit));
   };
   answerable = _mm_and_ps(answerable, _mm_and_ps(on_grid(u0, width), on_grid(v0, height)));
   answerable = _mm_and_ps(answerable, _mm_and_ps(on_grid(u1, width), on_grid(v1, height)));
-  // Truncation as in the scalar path (off-grid lanes convert to 0x80000000 and are not used).
-  const __m128i i0 = _mm_cvttps_epi32(u0), j0 = _mm_cvttps_epi32(v0);
-  const __m128i same = _mm_and_si128(_mm_cmpeq_epi32(i0, _mm_cvttps_epi32(u1)),
-                                     _mm_cmpeq_epi32(j0, _mm_cvttps_epi32(v1)));
-  answerable = _mm_and_ps(answerable, _mm_castsi128_ps(same));
-  // The clip box's z range is bounds_min_.z .. bounds_max_.z (floats).
   const __m128 z_lo = _mm_set1_ps(bounds_min_.z), z_hi = _mm_set1_ps(bounds_max_.z);
   answerable =
-      _mm_and_ps(answerable, _mm_and_ps(_mm_cmpge_ps(p0.z, z_lo), _mm_cmple_ps(p0.z, z_hi)));
-  answerable =
-      _mm_and_ps(answerable, _mm_and_ps(_mm_cmpge_ps(p1.z, z_lo), _mm_cmple_ps(p1.z, z_hi)));
+      _mm_and_ps(answerable, _mm_and_ps(within(p0.z, z_lo, z_hi), within(p1.z, z_lo, z_hi)));
+  const __m128 x_lo = _mm_set1_ps(clip_lo_float_[0]), x_hi = _mm_set1_ps(clip_hi_float_[0]);
+  const __m128 y_lo = _mm_set1_ps(clip_lo_float_[1]), y_hi = _mm_set1_ps(clip_hi_float_[1]);
+  // The texels (truncation as in the scalar path; off-grid lanes are not used): one texel, or
+  // two across one edge (the walk's one-crossing path: two visits split at s_cross).
+  const __m128i i0 = _mm_cvttps_epi32(u0), j0 = _mm_cvttps_epi32(v0);
+  const __m128i i1 = _mm_cvttps_epi32(u1), j1 = _mm_cvttps_epi32(v1);
+  const __m128i same_i = _mm_cmpeq_epi32(i0, i1), same_j = _mm_cmpeq_epi32(j0, j1);
+  const __m128i di = _mm_sub_epi32(i1, i0), dj = _mm_sub_epi32(j1, j0);
+  const __m128i minus_one_i = _mm_set1_epi32(-1), one_i = _mm_set1_epi32(1);
+  const __m128i step_i = _mm_or_si128(_mm_cmpeq_epi32(di, one_i), _mm_cmpeq_epi32(di, minus_one_i));
+  const __m128i step_j = _mm_or_si128(_mm_cmpeq_epi32(dj, one_i), _mm_cmpeq_epi32(dj, minus_one_i));
+  const __m128 in_one = _mm_castsi128_ps(_mm_and_si128(same_i, same_j));
+  const __m128 across_i = _mm_castsi128_ps(_mm_and_si128(step_i, same_j));
+  const __m128 across_j = _mm_castsi128_ps(_mm_and_si128(same_i, step_j));
+  const __m128 two = _mm_or_ps(across_i, across_j);
+  // A motion across an edge is walked only when it needs no clipping: both ends inside the clip
+  // box in x and y too (in one valid texel they are; a background texel holds nothing).
+  answerable = _mm_and_ps(
+      answerable,
+      _mm_or_ps(
+          in_one,
+          _mm_and_ps(two,
+                     _mm_and_ps(_mm_and_ps(within(p0.x, x_lo, x_hi), within(p1.x, x_lo, x_hi)),
+                                _mm_and_ps(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))))));
   uint32_t lanes = static_cast<uint32_t>(_mm_movemask_ps(answerable));
   if (lanes == 0) return 0;
 
-  // The lanes' slabs (texel 0 for the others, never used).
-  alignas(16) int32_t i[4], j[4];
-  _mm_store_si128(reinterpret_cast<__m128i*>(i), i0);
-  _mm_store_si128(reinterpret_cast<__m128i*>(j), j0);
-  size_t texel[4];
-  float top_of[4], bottom_of[4];
+  // The lanes' slabs: A holds p0, B holds p1 (texel 0 for unused lanes, never used).
+  alignas(16) int32_t ia[4], ja[4], ib[4], jb[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(ia), i0);
+  _mm_store_si128(reinterpret_cast<__m128i*>(ja), j0);
+  _mm_store_si128(reinterpret_cast<__m128i*>(ib), i1);
+  _mm_store_si128(reinterpret_cast<__m128i*>(jb), j1);
+  size_t texel_a[4], texel_b[4];
+  alignas(16) float top_a[4], bottom_a[4], top_b[4], bottom_b[4];
   for (int lane = 0; lane < 4; ++lane) {
     const bool used = (lanes >> lane) & 1u;
-    texel[lane] = used ? static_cast<size_t>(j[lane]) * width_ + static_cast<size_t>(i[lane]) : 0;
-    top_of[lane] = slabs_[texel[lane]].top;
-    bottom_of[lane] = slabs_[texel[lane]].bottom;
+    texel_a[lane] =
+        used ? static_cast<size_t>(ja[lane]) * width_ + static_cast<size_t>(ia[lane]) : 0;
+    texel_b[lane] =
+        used ? static_cast<size_t>(jb[lane]) * width_ + static_cast<size_t>(ib[lane]) : 0;
+    top_a[lane] = slabs_[texel_a[lane]].top;
+    bottom_a[lane] = slabs_[texel_a[lane]].bottom;
+    top_b[lane] = slabs_[texel_b[lane]].top;
+    bottom_b[lane] = slabs_[texel_b[lane]].bottom;
   }
   if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
     for (int lane = 0; lane < 4; ++lane) {
       if (((lanes >> lane) & 1u) &&
-          GapBase(static_cast<uint32_t>(i[lane]), static_cast<uint32_t>(j[lane])) >= 0) {
+          (GapBase(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane])) >= 0 ||
+           GapBase(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane])) >= 0)) {
         lanes &= ~(1u << lane);
       }
     }
   }
   if (lanes == 0) return 0;
-  const __m128 top = _mm_loadu_ps(top_of), bottom = _mm_loadu_ps(bottom_of);
+  const __m128 slab_a_top = _mm_load_ps(top_a), slab_a_bottom = _mm_load_ps(bottom_a);
+  const __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
 
-  // QuerySingleTexel's answer: an entry through the surface the motion comes from, or the
-  // push-out of a motion that starts and ends inside; nothing on background.
-  const __m128 valid = _mm_cmpge_ps(top, bottom);
-  const __m128 inside_start = _mm_and_ps(_mm_cmple_ps(p0.z, top), _mm_cmpge_ps(p0.z, bottom));
-  const __m128 inside_end = _mm_and_ps(_mm_cmple_ps(p1.z, top), _mm_cmpge_ps(p1.z, bottom));
-  const __m128 from_front = _mm_cmpgt_ps(p0.z, top);
-  const __m128 crosses =
-      SelectLanes(from_front, _mm_cmple_ps(p1.z, top), _mm_cmpge_ps(p1.z, bottom));
-  const __m128 entry = _mm_and_ps(valid, _mm_andnot_ps(inside_start, crosses));
-  const __m128 push_out = _mm_and_ps(valid, _mm_and_ps(inside_start, inside_end));
-  const uint32_t contact_lanes =
-      static_cast<uint32_t>(_mm_movemask_ps(_mm_or_ps(entry, push_out))) & lanes;
+  // The walk (BodyMapWalk::Run<1>): the crossing parameter of the edge, A over [0, s_cross],
+  // then B over [s_cross, 1]. One texel: A over [0, 1], and B (the same texel) adds nothing.
+  // SafeInverse, then the one-crossing path's min(max((edge - g0) * inverse, 0), 1).
+  const auto crossing = [&](__m128i a, __m128i b, __m128 g0, __m128 g1) {
+    const __m128 inverse_d = StdMin(
+        StdMax(_mm_div_ps(one, _mm_sub_ps(g1, g0)), _mm_set1_ps(-1e30f)), _mm_set1_ps(1e30f));
+    const __m128i edge = _mm_or_si128(_mm_and_si128(_mm_cmpgt_epi32(b, a), b),
+                                      _mm_andnot_si128(_mm_cmpgt_epi32(b, a), a));
+    return StdMin(StdMax(_mm_mul_ps(_mm_sub_ps(_mm_cvtepi32_ps(edge), g0), inverse_d), zero), one);
+  };
+  const __m128 s_cross = SelectLanes(across_i, crossing(i0, i1, u0, u1),
+                                     SelectLanes(across_j, crossing(j0, j1, v0, v1), one));
+  const __m128 z_cross = AlongLanes(p0.z, p1.z, s_cross);
+  const __m128 start_inside =
+      _mm_and_ps(_mm_cmple_ps(p0.z, slab_a_top), _mm_cmpge_ps(p0.z, slab_a_bottom));
+  const LaneVisit in_a =
+      VisitLanes(slab_a_top, slab_a_bottom, zero, s_cross, p0.z, z_cross, start_inside);
+  const __m128 hit_a = _mm_or_ps(in_a.front, in_a.back);  // no wall at s = 0 without clipping
+  const LaneVisit in_b =
+      VisitLanes(slab_b_top, slab_b_bottom, s_cross, one, z_cross, p1.z, in_a.inside_after);
+  const __m128 hit_b =
+      _mm_andnot_ps(hit_a, _mm_and_ps(two, _mm_or_ps(in_b.wall, _mm_or_ps(in_b.front, in_b.back))));
+  const __m128 wall = _mm_and_ps(hit_b, in_b.wall);
+  // No entry and p1 inside (IsInside(p1): texel B's slab): pushed out along z.
+  const __m128 inside_end =
+      _mm_and_ps(_mm_cmple_ps(p1.z, slab_b_top), _mm_cmpge_ps(p1.z, slab_b_bottom));
+  const __m128 push_out = _mm_andnot_ps(_mm_or_ps(hit_a, hit_b), inside_end);
+  const __m128 contact = _mm_or_ps(_mm_or_ps(hit_a, hit_b), push_out);
+  const uint32_t contact_lanes = static_cast<uint32_t>(_mm_movemask_ps(contact)) & lanes;
 
-  const __m128 surface = SelectLanes(from_front, top, bottom);
-  const __m128 s =
-      StdMin(StdMax(_mm_div_ps(_mm_sub_ps(surface, p0.z), _mm_sub_ps(p1.z, p0.z)), zero),
-             _mm_set1_ps(1.f));
+  // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3
+  // texel (WalkInto), or p1 moved to the nearer surface of its slab.
+  const __m128 s_hit = SelectLanes(hit_a, in_a.s, in_b.s);
+  const __m128 z_hit = SelectLanes(hit_a, in_a.z, in_b.z);
+  const __m128 dx = _mm_sub_ps(p1.x, p0.x), dy = _mm_sub_ps(p1.y, p0.y);
+  const __m128 back_off =
+      _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_),
+                 _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy))));
+  const __m128 hit_x = AlongLanes(p0.x, p1.x, s_hit), hit_y = AlongLanes(p0.y, p1.y, s_hit);
   const __m128 push_back =
-      _mm_cmplt_ps(_mm_sub_ps(p1.z, bottom), _mm_sub_ps(top, p1.z));  // nearer the back
-  const Lanes3 point = {SelectLanes(push_out, p1.x, AlongLanes(p0.x, p1.x, s)),
-                        SelectLanes(push_out, p1.y, AlongLanes(p0.y, p1.y, s)),
-                        SelectLanes(push_out, SelectLanes(push_back, bottom, top), surface)};
-  const uint32_t back_lanes = static_cast<uint32_t>(
-      _mm_movemask_ps(SelectLanes(push_out, push_back, _mm_andnot_ps(from_front, valid))));
+      _mm_cmplt_ps(_mm_sub_ps(p1.z, slab_b_bottom), _mm_sub_ps(slab_b_top, p1.z));
+  const Lanes3 point = {
+      SelectLanes(push_out, p1.x,
+                  SelectLanes(wall, _mm_sub_ps(hit_x, _mm_mul_ps(dx, back_off)), hit_x)),
+      SelectLanes(push_out, p1.y,
+                  SelectLanes(wall, _mm_sub_ps(hit_y, _mm_mul_ps(dy, back_off)), hit_y)),
+      SelectLanes(push_out, SelectLanes(push_back, slab_b_bottom, slab_b_top), z_hit)};
+  // The normal: the entered surface's; at a side wall the nearer surface of B's slab; for the
+  // push-out the surface p1 goes to.
+  const __m128 wall_back =
+      _mm_cmplt_ps(_mm_sub_ps(z_hit, slab_b_bottom), _mm_sub_ps(slab_b_top, z_hit));
+  const __m128 use_back = SelectLanes(
+      push_out, push_back, SelectLanes(wall, wall_back, SelectLanes(hit_a, in_a.back, in_b.back)));
+  const uint32_t back_lanes = static_cast<uint32_t>(_mm_movemask_ps(use_back));
+  const uint32_t from_a = static_cast<uint32_t>(_mm_movemask_ps(hit_a));
   uint16_t qa[4] = {0, 0, 0, 0}, qb[4] = {0, 0, 0, 0};
   for (int lane = 0; lane < 4; ++lane) {
-    const TexelNormals& n = normals_[texel[lane]];
+    const TexelNormals& n = normals_[(from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane]];
     const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
     qa[lane] = q[0];
     qb[lane] = q[1];
@@ -1554,7 +1656,9 @@ uint32_t BodyMapCollider::CollideFourInOneTexel(const Float3* previous, Float3* 
     return SelectLanes(into, changed, velocity);
   };
   const Lanes3 velocity = {respond(v.x, normal.x), respond(v.y, normal.y), respond(v.z, normal.z)};
-  const uint32_t push_lanes = static_cast<uint32_t>(_mm_movemask_ps(push_out));
+  const uint32_t wall_lanes = static_cast<uint32_t>(_mm_movemask_ps(wall));
+  const uint32_t started_inside_lanes =
+      static_cast<uint32_t>(_mm_movemask_ps(_mm_and_ps(push_out, start_inside)));
 
   alignas(16) float out[6][4];
   _mm_store_ps(out[0], position.x);
@@ -1571,8 +1675,10 @@ uint32_t BodyMapCollider::CollideFourInOneTexel(const Float3* previous, Float3* 
     }
     positions[lane] = Float3{out[0][lane], out[1][lane], out[2][lane]};
     velocities[lane] = Float3{out[3][lane], out[4][lane], out[5][lane]};
-    flags[lane] = static_cast<uint8_t>(kCollisionContact |
-                                       ((push_lanes >> lane) & 1u ? kCollisionStartedInside : 0));
+    const uint8_t kind = (wall_lanes >> lane) & 1u             ? kCollisionSideWall
+                         : (started_inside_lanes >> lane) & 1u ? kCollisionStartedInside
+                                                               : kCollisionNone;
+    flags[lane] = static_cast<uint8_t>(kCollisionContact | kind);
   }
   return lanes;
 }

@@ -40,7 +40,7 @@ struct BodyMapColliderTestAccess {
   // the batch).
   static uint32_t CollideFour(const BodyMapCollider& c, const Float3* previous, Float3* positions,
                               Float3* velocities, uint8_t* flags, const ResponseParams& params) {
-    return c.CollideFourInOneTexel(previous, positions, velocities, flags, params);
+    return c.CollideFourShortMotions(previous, positions, velocities, flags, params);
   }
 #endif
 };
@@ -1527,9 +1527,10 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
 }
 
 // CollideBatch answers every particle as Query and ApplyResponse do, bit for bit, whichever of
-// its paths (four particles at once in one texel, or one by one) takes the particle: resting and
-// sliding motions, points, starts inside, background, motions off the grid or beyond the clip
-// box in z, longer motions, texels with gaps, and non-finite input in any of the three arrays.
+// its paths (four particles at once when they stay in one texel or cross one edge, or one by
+// one) takes the particle: resting and sliding motions, points, starts inside, background,
+// motions off the grid or beyond the clip box, longer motions, texels with gaps, and non-finite
+// input in any of the three arrays.
 TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   const BodyMapCollider bodies[4] = {
       BuildOrDie(MakePose(SphereGrid(), Sphere)), BuildOrDie(MakePose(BoxGrid(), Box)),
@@ -1542,6 +1543,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   const float inf = std::numeric_limits<float>::infinity();
   std::mt19937 rng(20261123);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
+  size_t answered_walls = 0, answered_inside = 0, answered_entries = 0;  // four-lane path
   for (int body = 0; body < 4; ++body) {
     SCOPED_TRACE(::testing::Message() << "body " << body);
     const BodyMapCollider& c = bodies[body];
@@ -1559,10 +1561,22 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
       switch (k % 8) {
         case 0:  // a point (a particle at rest)
           break;
-        case 1:  // resting on the surface: a hundredth of a texel, through it along z
-        case 2:  // sliding: under half a texel
-          p1 = p0 + Float3{(unit(rng) - 0.5f) * (k % 8 == 1 ? 0.02f : 0.8f) * texel,
-                           (unit(rng) - 0.5f) * (k % 8 == 1 ? 0.02f : 0.8f) * texel,
+        case 1: {  // cloth on the surface: from up to 2 mm above the front or below the back
+                   // surface, a hundredth of a texel or up to 0.6 texel sideways, into it
+          const float u = (p0.x - c.origin_x()) / texel, v = (p0.y - c.origin_y()) / texel;
+          float top = 0.f, bottom = 0.f;
+          if (u >= 0.f && v >= 0.f &&
+              c.TexelSlab(static_cast<uint32_t>(u), static_cast<uint32_t>(v), &top, &bottom)) {
+            const bool front = unit(rng) < 0.7f;
+            p0.z = front ? top + 0.002f * unit(rng) : bottom - 0.002f * unit(rng);
+            const float reach = (unit(rng) < 0.3f ? 0.02f : 1.2f) * texel;
+            p1 = p0 + Float3{(unit(rng) - 0.5f) * reach, (unit(rng) - 0.5f) * reach,
+                             (front ? -1.f : 1.f) * 0.004f * unit(rng)};
+          }
+          break;
+        }
+        case 2:  // sliding: under half a texel, along z through a surface
+          p1 = p0 + Float3{(unit(rng) - 0.5f) * 0.8f * texel, (unit(rng) - 0.5f) * 0.8f * texel,
                            (unit(rng) - 0.5f) * 0.05f};
           break;
         case 3:  // a few texels
@@ -1643,8 +1657,8 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
       }
     }
 #if defined(__SSE2__)
-    // The four-particle path must carry a real share of these particles: resting and sliding
-    // motions, points and surface starts in one texel.
+    // The four-particle path must carry a real share of these particles: points, resting and
+    // sliding motions, surface starts, in one texel or across one texel edge.
     size_t answered = 0;
     std::vector<Float3> scratch_positions = positions, scratch_velocities = velocities;
     std::vector<uint8_t> scratch_flags(kCount);
@@ -1653,11 +1667,25 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
           BodyMapColliderTestAccess::CollideFour(c, &previous[k], &scratch_positions[k],
                                                  &scratch_velocities[k], &scratch_flags[k], params);
       answered += static_cast<size_t>(std::popcount(lanes));
+      for (int lane = 0; lane < 4; ++lane) {
+        if (!((lanes >> lane) & 1u)) continue;
+        const uint8_t f = scratch_flags[k + static_cast<size_t>(lane)];
+        answered_walls += (f & kCollisionSideWall) != 0;
+        answered_inside += (f & kCollisionStartedInside) != 0;
+        answered_entries += f == kCollisionContact;
+      }
     }
+
     // (The thin slab's 2 mm clip box sends most motions to the walk.)
     EXPECT_GT(answered, kCount / (body == 2 ? 40 : 5));
 #endif
   }
+#if defined(__SSE2__)
+  // ... and every kind of contact it can give: side walls, surface entries, push-outs.
+  EXPECT_GT(answered_walls, 200u);
+  EXPECT_GT(answered_entries, 2000u);
+  EXPECT_GT(answered_inside, 10000u);
+#endif
 }
 
 }  // namespace drape

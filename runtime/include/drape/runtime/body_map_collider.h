@@ -313,11 +313,12 @@ class BodyMapCollider {
   uint32_t CollideRange(const Float3* previous, Float3* positions, Float3* velocities,
                         uint8_t* flags, size_t count, const ResponseParams& params) const;
   // CollideBatch for four particles at once (SSE2, kNearest, a non-empty map), for the lanes
-  // whose motion QuerySingleTexel answers: writes their flags, positions and velocities bit for
-  // bit as CollideOne would and returns their lane mask (bit l = particle l); the other lanes
-  // are untouched.
-  uint32_t CollideFourInOneTexel(const Float3* previous, Float3* positions, Float3* velocities,
-                                 uint8_t* flags, const ResponseParams& params) const;
+  // whose motion stays in one texel or crosses one texel edge, with both ends in the clip box
+  // and no gaps in either texel: writes their flags, positions and velocities bit for bit as
+  // CollideOne would and returns their lane mask (bit l = particle l); the other lanes are
+  // untouched.
+  uint32_t CollideFourShortMotions(const Float3* previous, Float3* positions, Float3* velocities,
+                                   uint8_t* flags, const ResponseParams& params) const;
   // top/bottom at texel coordinates (u, v) >= 0 inside the grid, in half-texel cell (ci, cj) =
   // (floor 2u, floor 2v): bilinear in an eligible block, else the nearest texel.
   void SampleSlab(int ci, int cj, float u, float v, float* top, float* bottom) const;
@@ -337,6 +338,7 @@ class BodyMapCollider {
   float time_ = 0.f;
   Float3 bounds_min_{1.f, 1.f, 1.f}, bounds_max_{-1.f, -1.f, -1.f};
   double clip_lo_[3] = {0.0, 0.0, 0.0}, clip_hi_[3] = {-1.0, -1.0, -1.0};  // Liang-Barsky box
+  float clip_lo_float_[2] = {0.f, 0.f}, clip_hi_float_[2] = {-1.f, -1.f};  // its x, y in float
   uint32_t blocks_w_ = 0, blocks_h_ = 0;
   BodyMapStats stats_;
   std::vector<Slab> slabs_;            // width*height, row-major
