@@ -1584,18 +1584,26 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
                                       _mm_andnot_si128(_mm_cmpgt_epi32(b, a), a));
     return StdMin(StdMax(_mm_mul_ps(_mm_sub_ps(_mm_cvtepi32_ps(edge), g0), inverse_d), zero), one);
   };
-  const __m128 s_cross = SelectLanes(across_i, crossing(i0, i1, u0, u1),
-                                     SelectLanes(across_j, crossing(j0, j1, v0, v1), one));
-  const __m128 z_cross = AlongLanes(p0.z, p1.z, s_cross);
+  // Groups without a lane across an edge (points, resting cloth) skip the second visit.
+  const uint32_t two_lanes = static_cast<uint32_t>(_mm_movemask_ps(two)) & lanes;
+  __m128 s_cross = one, z_cross = p1.z;  // Z(1) = z1 exactly
+  if (two_lanes != 0) {
+    s_cross = SelectLanes(across_i, crossing(i0, i1, u0, u1),
+                          SelectLanes(across_j, crossing(j0, j1, v0, v1), one));
+    z_cross = AlongLanes(p0.z, p1.z, s_cross);
+  }
   const __m128 start_inside =
       _mm_and_ps(_mm_cmple_ps(p0.z, slab_a_top), _mm_cmpge_ps(p0.z, slab_a_bottom));
   const LaneVisit in_a =
       VisitLanes(slab_a_top, slab_a_bottom, zero, s_cross, p0.z, z_cross, start_inside);
   const __m128 hit_a = _mm_or_ps(in_a.front, in_a.back);  // no wall at s = 0 without clipping
-  const LaneVisit in_b =
-      VisitLanes(slab_b_top, slab_b_bottom, s_cross, one, z_cross, p1.z, in_a.inside_after);
-  const __m128 hit_b =
-      _mm_andnot_ps(hit_a, _mm_and_ps(two, _mm_or_ps(in_b.wall, _mm_or_ps(in_b.front, in_b.back))));
+  LaneVisit in_b = in_a;                                  // unused without a lane across an edge
+  __m128 hit_b = zero;
+  if (two_lanes != 0) {
+    in_b = VisitLanes(slab_b_top, slab_b_bottom, s_cross, one, z_cross, p1.z, in_a.inside_after);
+    hit_b = _mm_andnot_ps(hit_a,
+                          _mm_and_ps(two, _mm_or_ps(in_b.wall, _mm_or_ps(in_b.front, in_b.back))));
+  }
   const __m128 wall = _mm_and_ps(hit_b, in_b.wall);
   // No entry and p1 inside (IsInside(p1): texel B's slab): pushed out along z.
   const __m128 inside_end =
@@ -1609,9 +1617,11 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 s_hit = SelectLanes(hit_a, in_a.s, in_b.s);
   const __m128 z_hit = SelectLanes(hit_a, in_a.z, in_b.z);
   const __m128 dx = _mm_sub_ps(p1.x, p0.x), dy = _mm_sub_ps(p1.y, p0.y);
-  const __m128 back_off =
-      _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_),
-                 _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy))));
+  __m128 back_off = zero;
+  if (_mm_movemask_ps(wall) != 0) {
+    back_off = _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_),
+                          _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy))));
+  }
   const __m128 hit_x = AlongLanes(p0.x, p1.x, s_hit), hit_y = AlongLanes(p0.y, p1.y, s_hit);
   const __m128 push_back =
       _mm_cmplt_ps(_mm_sub_ps(p1.z, slab_b_bottom), _mm_sub_ps(slab_b_top, p1.z));
