@@ -1617,19 +1617,23 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 s_hit = SelectLanes(hit_a, in_a.s, in_b.s);
   const __m128 z_hit = SelectLanes(hit_a, in_a.z, in_b.z);
   const __m128 dx = _mm_sub_ps(p1.x, p0.x), dy = _mm_sub_ps(p1.y, p0.y);
-  __m128 back_off = zero;
+  // WalkInto steps back only when the motion's length in x and y is > 0. A lane crossing an
+  // edge moves at least a float step of u, so its length never underflows; the test keeps the
+  // two paths the same operation by operation all the same.
+  __m128 back_off = zero, stepped_back = zero;
   if (_mm_movemask_ps(wall) != 0) {
-    back_off = _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_),
-                          _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy))));
+    const __m128 length = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)));
+    back_off = _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_), length);
+    stepped_back = _mm_and_ps(wall, _mm_cmpgt_ps(length, zero));
   }
   const __m128 hit_x = AlongLanes(p0.x, p1.x, s_hit), hit_y = AlongLanes(p0.y, p1.y, s_hit);
   const __m128 push_back =
       _mm_cmplt_ps(_mm_sub_ps(p1.z, slab_b_bottom), _mm_sub_ps(slab_b_top, p1.z));
   const Lanes3 point = {
       SelectLanes(push_out, p1.x,
-                  SelectLanes(wall, _mm_sub_ps(hit_x, _mm_mul_ps(dx, back_off)), hit_x)),
+                  SelectLanes(stepped_back, _mm_sub_ps(hit_x, _mm_mul_ps(dx, back_off)), hit_x)),
       SelectLanes(push_out, p1.y,
-                  SelectLanes(wall, _mm_sub_ps(hit_y, _mm_mul_ps(dy, back_off)), hit_y)),
+                  SelectLanes(stepped_back, _mm_sub_ps(hit_y, _mm_mul_ps(dy, back_off)), hit_y)),
       SelectLanes(push_out, SelectLanes(push_back, slab_b_bottom, slab_b_top), z_hit)};
   // The normal: the entered surface's; at a side wall the nearer surface of B's slab; for the
   // push-out the surface p1 goes to.
