@@ -8,9 +8,7 @@
 #include <new>
 #include <string>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "sse_lanes.h"
 
 namespace drape {
 namespace {
@@ -1410,14 +1408,10 @@ Lanes3 LoadLanes(const Float3* p) {
           _mm_shuffle_ps(a2b1, c0c3, _MM_SHUFFLE(2, 0, 2, 0))};
 }
 
-// Lane by lane, what the scalar expressions give (IEEE single precision per lane; the operand
-// order of min and max follows std::min / std::max, which return the first argument on ties).
-inline __m128 SelectLanes(__m128 mask, __m128 a, __m128 b) {
-  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
-}
-inline __m128 StdMin(__m128 a, __m128 b) { return _mm_min_ps(b, a); }  // b < a ? b : a
-inline __m128 StdMax(__m128 a, __m128 b) { return _mm_max_ps(b, a); }  // a < b ? b : a
-inline __m128 AbsLanes(__m128 v) { return _mm_andnot_ps(_mm_set1_ps(-0.f), v); }
+using detail::AbsLanes;
+using detail::SelectLanes;
+using detail::StdMax;
+using detail::StdMin;
 
 // BodyMapWalk::Along.
 inline __m128 AlongLanes(__m128 a, __m128 b, __m128 s) {
@@ -1618,8 +1612,8 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 z_hit = SelectLanes(hit_a, in_a.z, in_b.z);
   const __m128 dx = _mm_sub_ps(p1.x, p0.x), dy = _mm_sub_ps(p1.y, p0.y);
   // WalkInto steps back only when the motion's length in x and y is > 0. A lane crossing an
-  // edge moves at least a float step of u, so its length never underflows; the test keeps the
-  // two paths the same operation by operation all the same.
+  // edge moves at least a float step of u, so its length never underflows; the lanes test it
+  // anyway, so that they stay the walk's operations one for one.
   __m128 back_off = zero, stepped_back = zero;
   if (_mm_movemask_ps(wall) != 0) {
     const __m128 length = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)));

@@ -11,9 +11,7 @@
 #include <string>
 #include <utility>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "sse_lanes.h"
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
 #include <immintrin.h>
 #endif
@@ -972,9 +970,6 @@ inline __m128 ValueSse(const PlaneSoa& s, uint32_t i, __m128 px, __m128 py, __m1
   v = _mm_add_ps(v, _mm_mul_ps(_mm_loadu_ps(s.nz + i), pz));
   return _mm_sub_ps(v, _mm_loadu_ps(s.d + i));
 }
-inline __m128 Select(__m128 mask, __m128 a, __m128 b) {
-  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
-}
 inline float HorizontalMax(__m128 v) {
   alignas(16) float l[4];
   _mm_store_ps(l, v);
@@ -1043,8 +1038,8 @@ ClipResult ClipSse(const PlaneSoa& s, Float3 a, Float3 b) {
     const __m128 t = _mm_div_ps(fa, _mm_sub_ps(fa, fb));
     const __m128 entering = _mm_cmpgt_ps(fa, zero);
     const __m128 leaving = _mm_andnot_ps(entering, _mm_cmpgt_ps(fb, zero));
-    t_in = _mm_max_ps(Select(entering, t, t_in), t_in);
-    t_out = _mm_min_ps(Select(leaving, t, t_out), t_out);
+    t_in = _mm_max_ps(detail::SelectLanes(entering, t, t_in), t_in);
+    t_out = _mm_min_ps(detail::SelectLanes(leaving, t, t_out), t_out);
   }
   return {HorizontalMax(t_in), HorizontalMin(t_out)};
 }
