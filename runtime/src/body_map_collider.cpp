@@ -1189,10 +1189,7 @@ ContactQuery BodyMapCollider::QueryWalk(Float3 p0, Float3 p1) const {
   return result;
 }
 
-void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
-  ContactQuery& result = *out;
-  result.inside_end = IsInside(p1);
-
+bool BodyMapCollider::ClipMotion(Float3 p0, Float3 p1, ClippedMotion* out) const {
   // Liang-Barsky in double (no overflow for any finite float input).
   const double a[3] = {p0.x, p0.y, p0.z};
   const double d[3] = {static_cast<double>(p1.x) - p0.x, static_cast<double>(p1.y) - p0.y,
@@ -1208,7 +1205,7 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
   // Both ends in the box is the common case near the body: nothing to clip, no divisions.
   for (int k = 0; k < 3 && !(p0_in_box && p1_in_box); ++k) {
     if (d[k] == 0.0) {
-      if (a[k] < clip_lo_[k] || a[k] > clip_hi_[k]) return;
+      if (a[k] < clip_lo_[k] || a[k] > clip_hi_[k]) return false;
       continue;
     }
     double t_lo = (clip_lo_[k] - a[k]) / d[k];
@@ -1223,7 +1220,7 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
       end_axis = k;
     }
   }
-  if (t_start > t_end) return;
+  if (t_start > t_end) return false;
   // A clipped end: on the clipping plane exactly in its axis, and clamped into the box in the
   // others (for |p1 - p0| beyond ~1e9 m the double product loses metres; the clamp keeps the walk
   // bounded by the box whatever the input).
@@ -1242,14 +1239,27 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
   };
   // Unclipped ends are used as they are, so the walk reads exactly the texels IsInside reads.
   // (t_end can round to 1 for an end far outside the box: such an end is still clamped.)
-  const Float3 q0 = t_start == 0.0 && p0_in_box ? p0 : clipped(t_start, start_axis, true);
-  const Float3 q1 = t_end == 1.0 && p1_in_box ? p1 : clipped(t_end, end_axis, false);
+  out->q0 = t_start == 0.0 && p0_in_box ? p0 : clipped(t_start, start_axis, true);
+  out->q1 = t_end == 1.0 && p1_in_box ? p1 : clipped(t_end, end_axis, false);
+  out->t_start = t_start;
+  out->t_end = t_end;
+  out->start_on_z_face = t_start > 0.0 && start_axis == 2;
+  return true;
+}
+
+void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
+  ContactQuery& result = *out;
+  result.inside_end = IsInside(p1);
+  ClippedMotion clip;
+  if (!ClipMotion(p0, p1, &clip)) return;
+  const Float3 q0 = clip.q0, q1 = clip.q1;
+  const double t_start = clip.t_start, t_end = clip.t_end;
   const bool start_inside = t_start == 0.0 && IsInside(p0);
 
   BodyMapWalk walk(*this, (q0.x - origin_x_) * inv_texel_size_,
                    (q0.y - origin_y_) * inv_texel_size_, (q1.x - origin_x_) * inv_texel_size_,
                    (q1.y - origin_y_) * inv_texel_size_, q0.z, q1.z,
-                   /*starts_on_z_face=*/t_start > 0.0 && start_axis == 2,
+                   /*starts_on_z_face=*/clip.start_on_z_face,
                    /*starts_inside=*/start_inside);
   if (sampling_ == DepthSampling::kNearest) {
     walk.Run<1>();
@@ -1349,38 +1359,58 @@ uint8_t BodyMapCollider::CollideOne(Float3 from, Float3* position, Float3* veloc
 uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions,
                                        Float3* velocities, uint8_t* flags, size_t count,
                                        const ResponseParams& params) const {
-  uint32_t contacts = 0;
   size_t k = 0;
 #if defined(__SSE2__)
   if (sampling_ == DepthSampling::kNearest && stats_.valid_texels != 0) {
-    // Where the particles move a texel or more per step the four-lane path answers few lanes
-    // and its work is wasted: after a group it answered fewer than two of, the next
-    // kScalarGroups groups go one by one. Either path gives the same bits.
+    // Groups of four consecutive particles go through the short-motion lanes first; the
+    // particles they do not answer queue for the walking lanes, four at a time, and what those
+    // do not answer goes one by one. Where particles move a texel or more per step the short
+    // lanes answer few and their work is wasted: after a group they answered fewer than two
+    // of, the next kScalarGroups groups queue directly. Every path gives the same bits.
     constexpr int kScalarGroups = 4;
-    int scalar_groups = 0;
+    int skip_short = 0;
+    uint32_t queued[4];
+    uint32_t queued_count = 0;
+    const auto walk_queued = [&] {
+      for (uint32_t lane = queued_count; lane < 4; ++lane) queued[lane] = queued[0];
+      const uint32_t answered = CollideFourWalks(queued, (1u << queued_count) - 1u, previous,
+                                                 positions, velocities, flags, params);
+      for (uint32_t lane = 0; lane < queued_count; ++lane) {
+        if (!(answered & (1u << lane))) {
+          const uint32_t q = queued[lane];
+          flags[q] = CollideOne(previous[q], &positions[q], &velocities[q], params);
+        }
+      }
+      queued_count = 0;
+    };
     for (; k + 4 <= count; k += 4) {
-      uint32_t answered = 0;
-      if (scalar_groups > 0) {
-        --scalar_groups;
+      uint32_t answered = 0, walk_candidates = 0xf;
+      if (skip_short > 0) {
+        --skip_short;
       } else {
-        answered =
-            CollideFourShortMotions(previous + k, positions + k, velocities + k, flags + k, params);
-        if (std::popcount(answered) < 2) scalar_groups = kScalarGroups;
+        answered = CollideFourShortMotions(previous + k, positions + k, velocities + k, flags + k,
+                                           params, &walk_candidates);
+        if (std::popcount(walk_candidates & ~answered) >= 2) skip_short = kScalarGroups;
       }
       for (uint32_t lane = 0; lane < 4; ++lane) {
-        if (!(answered & (1u << lane))) {
+        if (answered & (1u << lane)) continue;
+        if (!(walk_candidates & (1u << lane))) {  // needs clipping, or invalid: no lane takes it
           flags[k + lane] =
               CollideOne(previous[k + lane], &positions[k + lane], &velocities[k + lane], params);
+          continue;
         }
-        contacts += flags[k + lane] & kCollisionContact;
+        queued[queued_count++] = static_cast<uint32_t>(k + lane);
+        if (queued_count == 4) walk_queued();
       }
     }
+    if (queued_count != 0) walk_queued();
   }
 #endif
   for (; k < count; ++k) {
     flags[k] = CollideOne(previous[k], &positions[k], &velocities[k], params);
-    contacts += flags[k] & kCollisionContact;
   }
+  uint32_t contacts = 0;
+  for (size_t i = 0; i < count; ++i) contacts += flags[i] & kCollisionContact;
   return contacts;
 }
 
@@ -1422,7 +1452,8 @@ inline __m128 AlongLanes(__m128 a, __m128 b, __m128 s) {
 }
 
 // DecodeOct16 of four codes.
-Lanes3 DecodeOct16Lanes(const uint16_t (&qa)[4], const uint16_t (&qb)[4]) {
+[[gnu::always_inline]] inline Lanes3 DecodeOct16Lanes(const uint16_t (&qa)[4],
+                                                      const uint16_t (&qb)[4]) {
   const __m128 one = _mm_set1_ps(1.f);
   const __m128 scale = _mm_set1_ps(2.f / 65535.f);
   __m128 x = _mm_sub_ps(_mm_mul_ps(_mm_setr_ps(qa[0], qa[1], qa[2], qa[3]), scale), one);
@@ -1476,11 +1507,64 @@ LaneVisit VisitLanes(__m128 top, __m128 bottom, __m128 s_enter, __m128 s_exit, _
   return visit;
 }
 
+constexpr uint32_t kConsecutiveLanes[4] = {0, 1, 2, 3};
+
+// The lanes' answers, written to element index[l] of the arrays for each lane l in `lanes`:
+// ApplyResponse (collision_types.h) at `point` with `normal` for the lanes in contact, and the
+// flags CollideOne gives. `v` holds the lanes' velocities.
+[[gnu::always_inline]] inline void WriteLaneAnswers(
+    const uint32_t (&index)[4], uint32_t lanes, uint32_t contact_lanes, uint32_t wall_lanes,
+    uint32_t started_inside_lanes, const Lanes3& point, const Lanes3& normal, const Lanes3& v,
+    const ResponseParams& params, Float3* positions, Float3* velocities, uint8_t* flags) {
+  // The position on the surface plus the separation; the velocity only where it points into
+  // the body.
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 separation = _mm_set1_ps(params.separation);
+  const Lanes3 position = {_mm_add_ps(point.x, _mm_mul_ps(normal.x, separation)),
+                           _mm_add_ps(point.y, _mm_mul_ps(normal.y, separation)),
+                           _mm_add_ps(point.z, _mm_mul_ps(normal.z, separation))};
+  const __m128 vn = _mm_add_ps(_mm_add_ps(_mm_mul_ps(v.x, normal.x), _mm_mul_ps(v.y, normal.y)),
+                               _mm_mul_ps(v.z, normal.z));
+  const __m128 keep = _mm_set1_ps(1.f - params.friction);
+  const __m128 restitution = _mm_set1_ps(params.restitution);
+  const __m128 into = _mm_cmplt_ps(vn, zero);
+  const auto respond = [&](__m128 velocity, __m128 n) {
+    const __m128 normal_part = _mm_mul_ps(n, vn);
+    const __m128 changed = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(velocity, normal_part), keep),
+                                      _mm_mul_ps(normal_part, restitution));
+    return SelectLanes(into, changed, velocity);
+  };
+  const Lanes3 velocity = {respond(v.x, normal.x), respond(v.y, normal.y), respond(v.z, normal.z)};
+
+  alignas(16) float out[6][4];
+  _mm_store_ps(out[0], position.x);
+  _mm_store_ps(out[1], position.y);
+  _mm_store_ps(out[2], position.z);
+  _mm_store_ps(out[3], velocity.x);
+  _mm_store_ps(out[4], velocity.y);
+  _mm_store_ps(out[5], velocity.z);
+  for (int lane = 0; lane < 4; ++lane) {
+    if (!((lanes >> lane) & 1u)) continue;
+    const uint32_t k = index[lane];
+    if (!((contact_lanes >> lane) & 1u)) {
+      flags[k] = kCollisionNone;
+      continue;
+    }
+    positions[k] = Float3{out[0][lane], out[1][lane], out[2][lane]};
+    velocities[k] = Float3{out[3][lane], out[4][lane], out[5][lane]};
+    const uint8_t kind = (wall_lanes >> lane) & 1u             ? kCollisionSideWall
+                         : (started_inside_lanes >> lane) & 1u ? kCollisionStartedInside
+                                                               : kCollisionNone;
+    flags[k] = static_cast<uint8_t>(kCollisionContact | kind);
+  }
+}
+
 }  // namespace
 
 uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3* positions,
                                                   Float3* velocities, uint8_t* flags,
-                                                  const ResponseParams& params) const {
+                                                  const ResponseParams& params,
+                                                  uint32_t* walk_candidates) const {
   const Lanes3 p0 = LoadLanes(previous), p1 = LoadLanes(positions), v = LoadLanes(velocities);
   // Finite input (a sum holding a NaN or an infinity is not finite; an overflowing one only
   // sends the lane to CollideOne).
@@ -1526,13 +1610,11 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 two = _mm_or_ps(across_i, across_j);
   // A motion across an edge is walked only when it needs no clipping: both ends inside the clip
   // box in x and y too (in one valid texel they are; a background texel holds nothing).
-  answerable = _mm_and_ps(
-      answerable,
-      _mm_or_ps(
-          in_one,
-          _mm_and_ps(two,
-                     _mm_and_ps(_mm_and_ps(within(p0.x, x_lo, x_hi), within(p1.x, x_lo, x_hi)),
-                                _mm_and_ps(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))))));
+  const __m128 in_box = _mm_and_ps(
+      answerable, _mm_and_ps(_mm_and_ps(within(p0.x, x_lo, x_hi), within(p1.x, x_lo, x_hi)),
+                             _mm_and_ps(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))));
+  *walk_candidates = static_cast<uint32_t>(_mm_movemask_ps(in_box));
+  answerable = _mm_or_ps(_mm_and_ps(answerable, in_one), _mm_and_ps(in_box, two));
   uint32_t lanes = static_cast<uint32_t>(_mm_movemask_ps(answerable));
   if (lanes == 0) return 0;
 
@@ -1605,6 +1687,12 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 push_out = _mm_andnot_ps(_mm_or_ps(hit_a, hit_b), inside_end);
   const __m128 contact = _mm_or_ps(_mm_or_ps(hit_a, hit_b), push_out);
   const uint32_t contact_lanes = static_cast<uint32_t>(_mm_movemask_ps(contact)) & lanes;
+  if (contact_lanes == 0) {  // points and motions in air
+    for (int lane = 0; lane < 4; ++lane) {
+      if ((lanes >> lane) & 1u) flags[lane] = kCollisionNone;
+    }
+    return lanes;
+  }
 
   // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3
   // texel (WalkInto), or p1 moved to the nearer surface of its slab.
@@ -1645,50 +1733,345 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
     qb[lane] = q[1];
   }
   const Lanes3 normal = DecodeOct16Lanes(qa, qb);
-
-  // ApplyResponse: the position on the surface plus the separation; the velocity only where it
-  // points into the body.
-  const __m128 separation = _mm_set1_ps(params.separation);
-  const Lanes3 position = {_mm_add_ps(point.x, _mm_mul_ps(normal.x, separation)),
-                           _mm_add_ps(point.y, _mm_mul_ps(normal.y, separation)),
-                           _mm_add_ps(point.z, _mm_mul_ps(normal.z, separation))};
-  const __m128 vn = _mm_add_ps(_mm_add_ps(_mm_mul_ps(v.x, normal.x), _mm_mul_ps(v.y, normal.y)),
-                               _mm_mul_ps(v.z, normal.z));
-  const __m128 keep = _mm_set1_ps(1.f - params.friction);
-  const __m128 restitution = _mm_set1_ps(params.restitution);
-  const __m128 into = _mm_cmplt_ps(vn, zero);
-  const auto respond = [&](__m128 velocity, __m128 n) {
-    const __m128 normal_part = _mm_mul_ps(n, vn);
-    const __m128 changed = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(velocity, normal_part), keep),
-                                      _mm_mul_ps(normal_part, restitution));
-    return SelectLanes(into, changed, velocity);
-  };
-  const Lanes3 velocity = {respond(v.x, normal.x), respond(v.y, normal.y), respond(v.z, normal.z)};
   const uint32_t wall_lanes = static_cast<uint32_t>(_mm_movemask_ps(wall));
   const uint32_t started_inside_lanes =
       static_cast<uint32_t>(_mm_movemask_ps(_mm_and_ps(push_out, start_inside)));
-
-  alignas(16) float out[6][4];
-  _mm_store_ps(out[0], position.x);
-  _mm_store_ps(out[1], position.y);
-  _mm_store_ps(out[2], position.z);
-  _mm_store_ps(out[3], velocity.x);
-  _mm_store_ps(out[4], velocity.y);
-  _mm_store_ps(out[5], velocity.z);
-  for (int lane = 0; lane < 4; ++lane) {
-    if (!((lanes >> lane) & 1u)) continue;
-    if (!((contact_lanes >> lane) & 1u)) {
-      flags[lane] = kCollisionNone;
-      continue;
-    }
-    positions[lane] = Float3{out[0][lane], out[1][lane], out[2][lane]};
-    velocities[lane] = Float3{out[3][lane], out[4][lane], out[5][lane]};
-    const uint8_t kind = (wall_lanes >> lane) & 1u             ? kCollisionSideWall
-                         : (started_inside_lanes >> lane) & 1u ? kCollisionStartedInside
-                                                               : kCollisionNone;
-    flags[lane] = static_cast<uint8_t>(kCollisionContact | kind);
-  }
+  WriteLaneAnswers(kConsecutiveLanes, lanes, contact_lanes, wall_lanes, started_inside_lanes, point,
+                   normal, v, params, positions, velocities, flags);
   return lanes;
+}
+
+uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t lanes,
+                                           const Float3* previous, Float3* positions,
+                                           Float3* velocities, uint8_t* flags,
+                                           const ResponseParams& params) const {
+  const auto gather = [&](const Float3* a) {
+    const Float3 &a0 = a[index[0]], &a1 = a[index[1]], &a2 = a[index[2]], &a3 = a[index[3]];
+    return Lanes3{_mm_setr_ps(a0.x, a1.x, a2.x, a3.x), _mm_setr_ps(a0.y, a1.y, a2.y, a3.y),
+                  _mm_setr_ps(a0.z, a1.z, a2.z, a3.z)};
+  };
+  const Lanes3 p0 = gather(previous), p1 = gather(positions), v = gather(velocities);
+  // Finite input, as CollideFourShortMotions checks it.
+  const __m128 sum =
+      _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(p0.x, p0.y), _mm_add_ps(p0.z, p1.x)),
+                            _mm_add_ps(_mm_add_ps(p1.y, p1.z), _mm_add_ps(v.x, v.y))),
+                 v.z);
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f), inf = _mm_set1_ps(kInf);
+  lanes &= static_cast<uint32_t>(_mm_movemask_ps(_mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero)));
+  if (lanes == 0) return 0;
+  // Ends in the clip box (its x and y as the nearest inside floats: the double test's answer).
+  const auto within = [](__m128 x, __m128 lo, __m128 hi) {
+    return _mm_and_ps(_mm_cmpge_ps(x, lo), _mm_cmple_ps(x, hi));
+  };
+  const __m128 x_lo = _mm_set1_ps(clip_lo_float_[0]), x_hi = _mm_set1_ps(clip_hi_float_[0]);
+  const __m128 y_lo = _mm_set1_ps(clip_lo_float_[1]), y_hi = _mm_set1_ps(clip_hi_float_[1]);
+  const __m128 z_lo = _mm_set1_ps(bounds_min_.z), z_hi = _mm_set1_ps(bounds_max_.z);
+  const auto in_box = [&](const Lanes3& p) {
+    return _mm_and_ps(_mm_and_ps(within(p.x, x_lo, x_hi), within(p.y, y_lo, y_hi)),
+                      within(p.z, z_lo, z_hi));
+  };
+  const __m128 p1_in_box = in_box(p1);
+  // The walked segment q0 -> q1: the motion itself, or clipped to the box (ClipMotion, one lane
+  // at a time: motions from outside the box are a few percent).
+  Lanes3 q0 = p0, q1 = p1;
+  const uint32_t clipped_lanes =
+      lanes & ~static_cast<uint32_t>(_mm_movemask_ps(_mm_and_ps(in_box(p0), p1_in_box)));
+  uint32_t start_clipped = 0, start_on_z_face = 0, answered_misses = 0;
+  if (clipped_lanes != 0) {
+    alignas(16) float ends[6][4];
+    _mm_store_ps(ends[0], q0.x);
+    _mm_store_ps(ends[1], q0.y);
+    _mm_store_ps(ends[2], q0.z);
+    _mm_store_ps(ends[3], q1.x);
+    _mm_store_ps(ends[4], q1.y);
+    _mm_store_ps(ends[5], q1.z);
+    for (int lane = 0; lane < 4; ++lane) {
+      if (!((clipped_lanes >> lane) & 1u)) continue;
+      ClippedMotion clip;
+      if (!ClipMotion(previous[index[lane]], positions[index[lane]], &clip)) {
+        flags[index[lane]] = kCollisionNone;  // misses the box: no contact, ends outside
+        answered_misses |= 1u << lane;
+        continue;
+      }
+      const float q[6] = {clip.q0.x, clip.q0.y, clip.q0.z, clip.q1.x, clip.q1.y, clip.q1.z};
+      for (int k = 0; k < 6; ++k) ends[k][lane] = q[k];
+      start_clipped |= static_cast<uint32_t>(clip.t_start > 0.0) << lane;
+      start_on_z_face |= static_cast<uint32_t>(clip.start_on_z_face) << lane;
+    }
+    lanes &= ~answered_misses;
+    q0 = {_mm_load_ps(ends[0]), _mm_load_ps(ends[1]), _mm_load_ps(ends[2])};
+    q1 = {_mm_load_ps(ends[3]), _mm_load_ps(ends[4]), _mm_load_ps(ends[5])};
+  }
+  // Both walked ends on the grid (the box can reach a texel beyond it).
+  const __m128 origin_x = _mm_set1_ps(origin_x_), origin_y = _mm_set1_ps(origin_y_);
+  const __m128 inverse = _mm_set1_ps(inv_texel_size_);
+  const __m128 u0 = _mm_mul_ps(_mm_sub_ps(q0.x, origin_x), inverse);
+  const __m128 v0 = _mm_mul_ps(_mm_sub_ps(q0.y, origin_y), inverse);
+  const __m128 u1 = _mm_mul_ps(_mm_sub_ps(q1.x, origin_x), inverse);
+  const __m128 v1 = _mm_mul_ps(_mm_sub_ps(q1.y, origin_y), inverse);
+  const __m128 width = _mm_set1_ps(width_f_), height = _mm_set1_ps(height_f_);
+  const auto on_grid = [&](__m128 u, __m128 limit) {
+    return _mm_and_ps(_mm_cmpge_ps(u, zero), _mm_cmplt_ps(u, limit));
+  };
+  lanes &= static_cast<uint32_t>(
+      _mm_movemask_ps(_mm_and_ps(_mm_and_ps(on_grid(u0, width), on_grid(v0, height)),
+                                 _mm_and_ps(on_grid(u1, width), on_grid(v1, height)))));
+  if (lanes == 0) return answered_misses;
+  // The end texels (truncation is the floor on the grid) and the texel edges between them.
+  const __m128i i0 = _mm_cvttps_epi32(u0), j0 = _mm_cvttps_epi32(v0);
+  const __m128i i1 = _mm_cvttps_epi32(u1), j1 = _mm_cvttps_epi32(v1);
+  const __m128i di = _mm_sub_epi32(i1, i0), dj = _mm_sub_epi32(j1, j0);
+  const auto abs_i = [](__m128i x) {
+    const __m128i sign = _mm_srai_epi32(x, 31);
+    return _mm_sub_epi32(_mm_xor_si128(x, sign), sign);
+  };
+  __m128i left_i = abs_i(di), left_j = abs_i(dj);
+
+  // Texel indices (row-major) of the start and of the end. With p1 in the box the end is p1's
+  // texel, whose slab answers IsInside(p1); beyond the box p1 is outside.
+  alignas(16) int32_t ia[4], ja[4], ib[4], jb[4], start[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(ia), i0);
+  _mm_store_si128(reinterpret_cast<__m128i*>(ja), j0);
+  _mm_store_si128(reinterpret_cast<__m128i*>(ib), i1);
+  _mm_store_si128(reinterpret_cast<__m128i*>(jb), j1);
+  alignas(16) float top_b[4], bottom_b[4];
+  int32_t texel_b[4];
+  const uint32_t p1_in_box_lanes = static_cast<uint32_t>(_mm_movemask_ps(p1_in_box));
+  for (int lane = 0; lane < 4; ++lane) {
+    const bool used = (lanes >> lane) & 1u;
+    start[lane] = used ? ja[lane] * static_cast<int32_t>(width_) + ia[lane] : 0;
+    texel_b[lane] = used ? jb[lane] * static_cast<int32_t>(width_) + ib[lane] : 0;
+    top_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].top;
+    bottom_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].bottom;
+    if (used && gap_layers_ != 0 && ((p1_in_box_lanes >> lane) & 1u) &&
+        GapBase(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane])) >= 0) {
+      lanes &= ~(1u << lane);
+    }
+  }
+  if (lanes == 0) return answered_misses;
+  const __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
+
+  // The walk (BodyMapWalk::Run<1>, WalkCells with cells of one texel). Each step moves to the
+  // neighbour across the edge the segment crosses first, both on an exact corner; the crossing
+  // parameters are (edge - g0) * SafeInverse(g1 - g0), +inf on an axis with no edge left. Run's
+  // path for at most one edge per axis clamps them to [0, 1] (so a corner both reach at s = 1
+  // is one step): the lanes clamp where it applies, which is only the first crossing.
+  const auto safe_inverse = [&](__m128 d) {
+    return StdMin(StdMax(_mm_div_ps(one, d), _mm_set1_ps(-1e30f)), _mm_set1_ps(1e30f));
+  };
+  const __m128 inv_du = safe_inverse(_mm_sub_ps(u1, u0)), inv_dv = safe_inverse(_mm_sub_ps(v1, v0));
+  const __m128i zero_i = _mm_setzero_si128(), one_i = _mm_set1_epi32(1);
+  const __m128i up_i = _mm_cmpgt_epi32(di, zero_i), down_i = _mm_cmplt_epi32(di, zero_i);
+  const __m128i up_j = _mm_cmpgt_epi32(dj, zero_i), down_j = _mm_cmplt_epi32(dj, zero_i);
+  const __m128i step_i = _mm_sub_epi32(down_i, up_i);  // +1, -1 or 0
+  const __m128i step_j = _mm_sub_epi32(down_j, up_j);
+  const __m128i width_i = _mm_set1_epi32(static_cast<int32_t>(width_));
+  const __m128i step_row = _mm_or_si128(_mm_and_si128(up_j, width_i),
+                                        _mm_and_si128(down_j, _mm_sub_epi32(zero_i, width_i)));
+  const __m128 step_u = _mm_cvtepi32_ps(step_i), step_v = _mm_cvtepi32_ps(step_j);
+  // Per axis: the next edge the segment leaves through, as a float (exact; i + 1 moving up, i
+  // moving down), its crossing `next`, and the crossing of the edge after it, so that a step
+  // only selects (the crossing's arithmetic stays off the loop's dependency chain).
+  __m128 edge_u = _mm_cvtepi32_ps(_mm_sub_epi32(i0, up_i));
+  __m128 edge_v = _mm_cvtepi32_ps(_mm_sub_epi32(j0, up_j));
+  const auto crossing = [&](__m128 edge, __m128 g0, __m128 inv, __m128i left, __m128i more) {
+    return SelectLanes(_mm_castsi128_ps(_mm_cmpgt_epi32(left, more)),
+                       _mm_mul_ps(_mm_sub_ps(edge, g0), inv), inf);
+  };
+  const __m128 clamped = _mm_castsi128_ps(_mm_and_si128(
+      _mm_cmplt_epi32(left_i, _mm_set1_epi32(2)), _mm_cmplt_epi32(left_j, _mm_set1_epi32(2))));
+  const auto lane_mask = [](uint32_t bits) {
+    const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
+    return _mm_castsi128_ps(
+        _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<int32_t>(bits)), bit), bit));
+  };
+  __m128 active = lane_mask(lanes);
+  const auto first_crossing = [&](__m128 edge, __m128 g0, __m128 inv, __m128i left) {
+    const __m128 s = crossing(edge, g0, inv, left, zero_i);
+    // Lanes that are not walked never step (their texel stays a valid index).
+    return SelectLanes(active, SelectLanes(clamped, StdMin(StdMax(s, zero), one), s), inf);
+  };
+  __m128 next_u = first_crossing(edge_u, u0, inv_du, left_i);
+  __m128 next_v = first_crossing(edge_v, v0, inv_dv, left_j);
+  __m128 after_u = crossing(_mm_add_ps(edge_u, step_u), u0, inv_du, left_i, one_i);
+  __m128 after_v = crossing(_mm_add_ps(edge_v, step_v), v0, inv_dv, left_j, one_i);
+
+  // Texel by texel (BodyMapWalk::VisitTexel without gaps): the first entry of each lane. The
+  // loop only finds the texel of the entry and keeps what VisitLanes needs to place it, so that
+  // its division runs once, after the loop. A lane keeps stepping after its entry (along its own
+  // segment, so over valid texels) until every lane is done; only `active` lanes record.
+  const auto load_slabs = [&](const int32_t(&at)[4], __m128* top, __m128* bottom) {
+    // Two slabs per 16 bytes: (top, bottom) of lanes 0, 1 and of lanes 2, 3.
+    const auto slab = [&](int lane) {
+      return reinterpret_cast<const __m64*>(&slabs_[static_cast<size_t>(at[lane])]);
+    };
+    const __m128 slabs01 = _mm_loadh_pi(_mm_loadl_pi(zero, slab(0)), slab(1));
+    const __m128 slabs23 = _mm_loadh_pi(_mm_loadl_pi(zero, slab(2)), slab(3));
+    *top = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(2, 0, 2, 0));
+    *bottom = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(3, 1, 3, 1));
+  };
+  __m128 top, bottom;
+  load_slabs(start, &top, &bottom);
+  // IsInside(p0) when the walk starts at p0 (the walk starts inside when p0 is); a clipped start
+  // is outside.
+  const __m128 start_inside = _mm_andnot_ps(
+      lane_mask(start_clipped), _mm_and_ps(_mm_cmple_ps(q0.z, top), _mm_cmpge_ps(q0.z, bottom)));
+  __m128 inside = start_inside;
+  __m128i texel = _mm_load_si128(reinterpret_cast<const __m128i*>(start));
+  __m128i cell_i = i0, cell_j = j0;  // for the gap test
+  // BodyMapWalk::Z, with the difference z1 - z0 computed once (the same bits).
+  const __m128 dz = _mm_sub_ps(q1.z, q0.z), half = _mm_set1_ps(0.5f);
+  const auto z_at = [&](__m128 s) {
+    return SelectLanes(_mm_cmplt_ps(s, half), _mm_add_ps(q0.z, _mm_mul_ps(dz, s)),
+                       _mm_sub_ps(q1.z, _mm_mul_ps(dz, _mm_sub_ps(one, s))));
+  };
+  __m128 s_enter = zero, z_enter = z_at(zero);
+  // At the entered texel: the piece [s_enter, s_exit], its z, the slab, a side-wall entry.
+  __m128 hit = zero, hit_s_enter = zero, hit_s_exit = zero, hit_z_enter = zero;
+  __m128 hit_z_exit = zero, hit_top = zero, hit_bottom = zero, hit_wall = zero;
+  __m128i hit_texel = _mm_setzero_si128();
+  alignas(16) int32_t at[4], at_i[4], at_j[4];
+  for (int walked = 1;; ++walked) {
+    const __m128 next = StdMin(next_u, next_v);
+    const __m128 s_exit = StdMin(StdMax(next, s_enter), one);
+    const __m128 z_exit = z_at(s_exit);
+    if (walked > 1) {
+      _mm_store_si128(reinterpret_cast<__m128i*>(at), texel);
+      load_slabs(at, &top, &bottom);
+    }
+    if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals one by one
+      const uint32_t walking = static_cast<uint32_t>(_mm_movemask_ps(active));
+      _mm_store_si128(reinterpret_cast<__m128i*>(at_i), cell_i);
+      _mm_store_si128(reinterpret_cast<__m128i*>(at_j), cell_j);
+      for (int lane = 0; lane < 4; ++lane) {
+        if (((walking >> lane) & 1u) &&
+            GapBase(static_cast<uint32_t>(at_i[lane]), static_cast<uint32_t>(at_j[lane])) >= 0) {
+          lanes &= ~(1u << lane);
+        }
+      }
+      active = _mm_and_ps(active, lane_mask(lanes));
+    }
+    // VisitLanes' tests: inside at entry, or reaching the slab from above or below.
+    const __m128 in_enter = _mm_and_ps(_mm_cmple_ps(z_enter, top), _mm_cmpge_ps(z_enter, bottom));
+    const __m128 above = _mm_cmpgt_ps(z_enter, top);  // also every background texel
+    const __m128 wall = _mm_andnot_ps(inside, in_enter);
+    const __m128 reaches =
+        SelectLanes(above, _mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom));
+    const __m128 entered = _mm_and_ps(active, _mm_or_ps(wall, _mm_andnot_ps(in_enter, reaches)));
+    if (_mm_movemask_ps(entered) != 0) {
+      hit = _mm_or_ps(hit, entered);
+      hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
+      hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
+      hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
+      hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
+      hit_top = SelectLanes(entered, top, hit_top);
+      hit_bottom = SelectLanes(entered, bottom, hit_bottom);
+      hit_wall = SelectLanes(entered, wall, hit_wall);
+      const __m128i entered_i = _mm_castps_si128(entered);
+      hit_texel =
+          _mm_or_si128(_mm_and_si128(entered_i, texel), _mm_andnot_si128(entered_i, hit_texel));
+    }
+    inside = _mm_and_ps(_mm_and_ps(inside, in_enter),
+                        _mm_and_ps(_mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom)));
+    const __m128 going = _mm_cmplt_ps(next, inf);  // an edge left to cross
+    active = _mm_and_ps(_mm_andnot_ps(entered, active), going);
+    if (_mm_movemask_ps(active) == 0) break;
+    if (walked == kMaxLaneWalkTexels) {  // still walking: long through air, one by one
+      lanes &= ~static_cast<uint32_t>(_mm_movemask_ps(active));
+      break;
+    }
+    // Step across the edge(s) reached at `next`.
+    const __m128 across_u = _mm_and_ps(going, _mm_cmpeq_ps(next_u, next));
+    const __m128 across_v = _mm_and_ps(going, _mm_cmpeq_ps(next_v, next));
+    const __m128i across_u_i = _mm_castps_si128(across_u), across_v_i = _mm_castps_si128(across_v);
+    next_u = SelectLanes(across_u, after_u, next_u);
+    next_v = SelectLanes(across_v, after_v, next_v);
+    texel = _mm_add_epi32(texel, _mm_add_epi32(_mm_and_si128(across_u_i, step_i),
+                                               _mm_and_si128(across_v_i, step_row)));
+    if (gap_layers_ != 0) {
+      cell_i = _mm_add_epi32(cell_i, _mm_and_si128(across_u_i, step_i));
+      cell_j = _mm_add_epi32(cell_j, _mm_and_si128(across_v_i, step_j));
+    }
+    left_i = _mm_add_epi32(left_i, across_u_i);  // a mask is -1
+    left_j = _mm_add_epi32(left_j, across_v_i);
+    edge_u = _mm_add_ps(edge_u, _mm_and_ps(across_u, step_u));
+    edge_v = _mm_add_ps(edge_v, _mm_and_ps(across_v, step_v));
+    after_u = SelectLanes(across_u, crossing(_mm_add_ps(edge_u, step_u), u0, inv_du, left_i, one_i),
+                          after_u);
+    after_v = SelectLanes(across_v, crossing(_mm_add_ps(edge_v, step_v), v0, inv_dv, left_j, one_i),
+                          after_v);
+    s_enter = s_exit;
+    z_enter = z_exit;
+  }
+  if (lanes == 0) return answered_misses;
+  // The entry in its texel: VisitLanes again on the kept piece (a side-wall entry is one where
+  // the walk was not inside at the texel's entry point).
+  const LaneVisit entry =
+      VisitLanes(hit_top, hit_bottom, hit_s_enter, hit_s_exit, hit_z_enter, hit_z_exit,
+                 _mm_andnot_ps(hit_wall, _mm_castsi128_ps(_mm_set1_epi32(-1))));
+  // A side-wall entry at the clipped start on the box's top or bottom face is through that face:
+  // the front surface moving down, the back moving up (BodyMapWalk::HitAtStart).
+  const __m128 z_face =
+      _mm_and_ps(_mm_and_ps(hit_wall, lane_mask(start_on_z_face)), _mm_cmpeq_ps(hit_s_enter, zero));
+  const __m128 moving_down = _mm_cmplt_ps(q1.z, q0.z);
+  const __m128 hit_s = entry.s;
+  const __m128 hit_z = SelectLanes(z_face, SelectLanes(moving_down, hit_top, hit_bottom), entry.z);
+  const __m128 hit_back = SelectLanes(z_face, _mm_andnot_ps(moving_down, z_face), entry.back);
+  hit_wall = _mm_andnot_ps(z_face, hit_wall);
+
+  // The answer (WalkInto): the entry point on the segment, stepped back across a side wall by
+  // 1e-3 texel, with the entered surface's normal (at a wall, the nearer surface of the entered
+  // texel's slab); with no entry and p1 inside, p1 pushed out along z to the nearer surface of
+  // its slab.
+  const __m128 inside_end = _mm_and_ps(
+      p1_in_box, _mm_and_ps(_mm_cmple_ps(p1.z, slab_b_top), _mm_cmpge_ps(p1.z, slab_b_bottom)));
+  const __m128 push_out = _mm_andnot_ps(hit, inside_end);
+  const uint32_t contact_lanes =
+      static_cast<uint32_t>(_mm_movemask_ps(_mm_or_ps(hit, push_out))) & lanes;
+  if (contact_lanes == 0) {  // through air (most long motions in free space)
+    for (int lane = 0; lane < 4; ++lane) {
+      if ((lanes >> lane) & 1u) flags[index[lane]] = kCollisionNone;
+    }
+    return lanes | answered_misses;
+  }
+  const __m128 dx = _mm_sub_ps(q1.x, q0.x), dy = _mm_sub_ps(q1.y, q0.y);
+  const __m128 wall = _mm_and_ps(hit, hit_wall);
+  __m128 back_off = zero, stepped_back = zero;
+  if (_mm_movemask_ps(wall) != 0) {
+    const __m128 length = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)));
+    back_off = _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_), length);
+    stepped_back = _mm_and_ps(wall, _mm_cmpgt_ps(length, zero));
+  }
+  const __m128 hit_x = AlongLanes(q0.x, q1.x, hit_s), hit_y = AlongLanes(q0.y, q1.y, hit_s);
+  const __m128 push_back =
+      _mm_cmplt_ps(_mm_sub_ps(p1.z, slab_b_bottom), _mm_sub_ps(slab_b_top, p1.z));
+  const Lanes3 point = {
+      SelectLanes(push_out, p1.x,
+                  SelectLanes(stepped_back, _mm_sub_ps(hit_x, _mm_mul_ps(dx, back_off)), hit_x)),
+      SelectLanes(push_out, p1.y,
+                  SelectLanes(stepped_back, _mm_sub_ps(hit_y, _mm_mul_ps(dy, back_off)), hit_y)),
+      SelectLanes(push_out, SelectLanes(push_back, slab_b_bottom, slab_b_top), hit_z)};
+  const __m128 wall_back = _mm_cmplt_ps(_mm_sub_ps(hit_z, hit_bottom), _mm_sub_ps(hit_top, hit_z));
+  const __m128 use_back = SelectLanes(push_out, push_back, SelectLanes(wall, wall_back, hit_back));
+  const uint32_t back_lanes = static_cast<uint32_t>(_mm_movemask_ps(use_back));
+  const uint32_t push_lanes = static_cast<uint32_t>(_mm_movemask_ps(push_out));
+  alignas(16) int32_t entered_texel[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(entered_texel), hit_texel);
+  uint16_t qa[4] = {0, 0, 0, 0}, qb[4] = {0, 0, 0, 0};
+  for (int lane = 0; lane < 4; ++lane) {
+    const int32_t t = (push_lanes >> lane) & 1u ? texel_b[lane] : entered_texel[lane];
+    const TexelNormals& n = normals_[static_cast<size_t>(t)];
+    const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
+    qa[lane] = q[0];
+    qb[lane] = q[1];
+  }
+  const Lanes3 normal = DecodeOct16Lanes(qa, qb);
+  const uint32_t wall_lanes = static_cast<uint32_t>(_mm_movemask_ps(wall));
+  const uint32_t started_inside_lanes =
+      push_lanes & static_cast<uint32_t>(_mm_movemask_ps(start_inside));
+  WriteLaneAnswers(index, lanes, contact_lanes, wall_lanes, started_inside_lanes, point, normal, v,
+                   params, positions, velocities, flags);
+  return lanes | answered_misses;
 }
 #endif
 

@@ -40,7 +40,15 @@ struct BodyMapColliderTestAccess {
   // the batch).
   static uint32_t CollideFour(const BodyMapCollider& c, const Float3* previous, Float3* positions,
                               Float3* velocities, uint8_t* flags, const ResponseParams& params) {
-    return c.CollideFourShortMotions(previous, positions, velocities, flags, params);
+    uint32_t walk_candidates = 0;
+    return c.CollideFourShortMotions(previous, positions, velocities, flags, params,
+                                     &walk_candidates);
+  }
+  // CollideBatch's walking lanes alone, on particles index[l] for l in `lanes`.
+  static uint32_t CollideWalks(const BodyMapCollider& c, const uint32_t (&index)[4], uint32_t lanes,
+                               const Float3* previous, Float3* positions, Float3* velocities,
+                               uint8_t* flags, const ResponseParams& params) {
+    return c.CollideFourWalks(index, lanes, previous, positions, velocities, flags, params);
   }
 #endif
 };
@@ -1544,6 +1552,8 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   std::mt19937 rng(20261123);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
   size_t answered_walls = 0, answered_inside = 0, answered_entries = 0;  // four-lane path
+  size_t walked_answered = 0, walked_walls = 0, walked_inside = 0, walked_entries = 0;
+  size_t walked_clipped_entries = 0, walked_z_face = 0, walked_long = 0;  // walking lanes
   for (int body = 0; body < 4; ++body) {
     SCOPED_TRACE(::testing::Message() << "body " << body);
     const BodyMapCollider& c = bodies[body];
@@ -1594,6 +1604,17 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
               c.TexelSlab(static_cast<uint32_t>(u), static_cast<uint32_t>(v), &top, &bottom)) {
             p0.z = unit(rng) < 0.5f ? top : bottom;
             p1 = Float3{p0.x, p0.y, p0.z + (unit(rng) - 0.5f) * 0.01f};
+          }
+          if (unit(rng) < 0.5f) {  // or ending exactly on one, 1-4 texels sideways
+            const float angle = unit(rng) * 6.2831853f, reach = (1.f + 3.f * unit(rng)) * texel;
+            p1 = p0 + Float3{reach * std::cos(angle), reach * std::sin(angle), 0.f};
+            const float u1 = (p1.x - c.origin_x()) / texel, v1 = (p1.y - c.origin_y()) / texel;
+            if (u1 >= 0.f && v1 >= 0.f &&
+                c.TexelSlab(static_cast<uint32_t>(u1), static_cast<uint32_t>(v1), &top, &bottom)) {
+              const bool front = unit(rng) < 0.5f;
+              p1.z = front ? top : bottom;
+              p0.z = p1.z + (front ? 1.f : -1.f) * 0.001f * unit(rng);
+            }
           }
           break;
         }
@@ -1678,6 +1699,56 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
 
     // (The thin slab's 2 mm clip box sends most motions to the walk.)
     EXPECT_GT(answered, kCount / (body == 2 ? 40 : 5));
+
+    // The walking lanes alone, on groups of four particles spread over the set (and on partial
+    // groups): every lane they answer is the reference bit for bit, and lanes they do not answer
+    // (or that are not in the mask) are untouched.
+    scratch_positions = positions;
+    scratch_velocities = velocities;
+    std::fill(scratch_flags.begin(), scratch_flags.end(), uint8_t{0xee});
+    for (uint32_t k = 0; k + 4 * 997 < kCount; ++k) {
+      const uint32_t index[4] = {k, k + 997, k + 2 * 997, k + 3 * 997};
+      const uint32_t mask = k % 7 == 3 ? 0x5u : (k % 7 == 5 ? 0x2u : 0xfu);
+      const uint32_t lanes = BodyMapColliderTestAccess::CollideWalks(
+          c, index, mask, previous.data(), scratch_positions.data(), scratch_velocities.data(),
+          scratch_flags.data(), params);
+      ASSERT_EQ(lanes & ~mask, 0u);
+      for (int lane = 0; lane < 4; ++lane) {
+        const uint32_t q = index[lane];
+        if (!((lanes >> lane) & 1u)) {
+          ASSERT_EQ(scratch_flags[q], 0xee) << "particle " << q << " not answered but written";
+          continue;
+        }
+        ++walked_answered;
+        const bool same =
+            scratch_flags[q] == want_flags[q] &&
+            std::memcmp(&scratch_positions[q], &want_positions[q], sizeof(Float3)) == 0 &&
+            std::memcmp(&scratch_velocities[q], &want_velocities[q], sizeof(Float3)) == 0;
+        ASSERT_TRUE(same) << "walking lane: particle " << q << " (kind " << q % 8 << "): flags "
+                          << int(scratch_flags[q]) << " want " << int(want_flags[q]);
+        const bool clipped = !(previous[q].z >= lo.z && previous[q].z <= hi.z &&
+                               positions[q].z >= lo.z && positions[q].z <= hi.z);
+        const uint32_t texels =
+            static_cast<uint32_t>(std::abs(std::floor((positions[q].x - c.origin_x()) / texel) -
+                                           std::floor((previous[q].x - c.origin_x()) / texel)) +
+                                  std::abs(std::floor((positions[q].y - c.origin_y()) / texel) -
+                                           std::floor((previous[q].y - c.origin_y()) / texel)));
+        const uint8_t f = want_flags[q];
+        walked_walls += (f & kCollisionSideWall) != 0;
+        walked_inside += (f & kCollisionStartedInside) != 0;
+        walked_entries += f == kCollisionContact;
+        walked_clipped_entries += clipped && f == kCollisionContact;
+        walked_z_face += clipped && f == kCollisionContact && previous[q].x == positions[q].x &&
+                         previous[q].y == positions[q].y;
+        walked_long += texels >= 3 && (f & kCollisionContact) != 0;
+      }
+      // Restore what the lanes wrote, so later groups see the input.
+      for (uint32_t q : index) {
+        scratch_positions[q] = positions[q];
+        scratch_velocities[q] = velocities[q];
+        scratch_flags[q] = 0xee;
+      }
+    }
 #endif
   }
 #if defined(__SSE2__)
@@ -1685,6 +1756,20 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   EXPECT_GT(answered_walls, 200u);
   EXPECT_GT(answered_entries, 2000u);
   EXPECT_GT(answered_inside, 10000u);
+  // ... and the walking lanes: most particles, every kind of contact, entries of motions clipped
+  // to the box (through its top or bottom face among them), contacts three or more texels away.
+  EXPECT_GT(walked_answered, 60000u);
+  EXPECT_GT(walked_walls, 500u);
+  EXPECT_GT(walked_entries, 5000u);
+  EXPECT_GT(walked_inside, 5000u);
+  EXPECT_GT(walked_clipped_entries, 500u);
+  EXPECT_GT(walked_z_face, 500u);
+  EXPECT_GT(walked_long, 500u);
+  std::printf(
+      "walking lanes: %zu answered, %zu walls, %zu entries (%zu clipped, %zu through the "
+      "box's z face), %zu pushed out, %zu contacts >= 3 texels away\n",
+      walked_answered, walked_walls, walked_entries, walked_clipped_entries, walked_z_face,
+      walked_inside, walked_long);
 #endif
 }
 
