@@ -1573,7 +1573,8 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
                             _mm_add_ps(_mm_add_ps(p1.y, p1.z), _mm_add_ps(v.x, v.y))),
                  v.z);
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
-  __m128 answerable = _mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero);
+  const __m128 finite = _mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero);
+  __m128 answerable = finite;
   // Both ends on the grid (ToTexels' expressions) and in the clip box's z range.
   const __m128 origin_x = _mm_set1_ps(origin_x_), origin_y = _mm_set1_ps(origin_y_);
   const __m128 inverse = _mm_set1_ps(inv_texel_size_);
@@ -1615,8 +1616,22 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
                              _mm_and_ps(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))));
   *walk_candidates = static_cast<uint32_t>(_mm_movemask_ps(in_box));
   answerable = _mm_or_ps(_mm_and_ps(answerable, in_one), _mm_and_ps(in_box, two));
+  // A motion that stays at one coordinate outside the clip box never enters it (ClipMotion's
+  // test for a zero extent, exact): no contact. Points away from the body are most of these.
+  const auto fixed_outside = [&](__m128 a, __m128 b, __m128 lo, __m128 hi) {
+    return _mm_andnot_ps(within(a, lo, hi), _mm_cmpeq_ps(a, b));
+  };
+  const uint32_t free_lanes =
+      static_cast<uint32_t>(_mm_movemask_ps(
+          _mm_and_ps(finite, _mm_or_ps(_mm_or_ps(fixed_outside(p0.x, p1.x, x_lo, x_hi),
+                                                 fixed_outside(p0.y, p1.y, y_lo, y_hi)),
+                                       fixed_outside(p0.z, p1.z, z_lo, z_hi))))) &
+      ~static_cast<uint32_t>(_mm_movemask_ps(answerable));
+  for (int lane = 0; lane < 4; ++lane) {
+    if ((free_lanes >> lane) & 1u) flags[lane] = kCollisionNone;
+  }
   uint32_t lanes = static_cast<uint32_t>(_mm_movemask_ps(answerable));
-  if (lanes == 0) return 0;
+  if (lanes == 0) return free_lanes;
 
   // The lanes' slabs: A holds p0, B holds p1 (texel 0 for unused lanes, never used).
   alignas(16) int32_t ia[4], ja[4], ib[4], jb[4];
@@ -1646,7 +1661,7 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
       }
     }
   }
-  if (lanes == 0) return 0;
+  if (lanes == 0) return free_lanes;
   const __m128 slab_a_top = _mm_load_ps(top_a), slab_a_bottom = _mm_load_ps(bottom_a);
   const __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
 
@@ -1691,7 +1706,7 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
     for (int lane = 0; lane < 4; ++lane) {
       if ((lanes >> lane) & 1u) flags[lane] = kCollisionNone;
     }
-    return lanes;
+    return lanes | free_lanes;
   }
 
   // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3
@@ -1738,7 +1753,7 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
       static_cast<uint32_t>(_mm_movemask_ps(_mm_and_ps(push_out, start_inside)));
   WriteLaneAnswers(kConsecutiveLanes, lanes, contact_lanes, wall_lanes, started_inside_lanes, point,
                    normal, v, params, positions, velocities, flags);
-  return lanes;
+  return lanes | free_lanes;
 }
 
 uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t lanes,

@@ -1552,6 +1552,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   std::mt19937 rng(20261123);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
   size_t answered_walls = 0, answered_inside = 0, answered_entries = 0;  // four-lane path
+  size_t answered_outside = 0;
   size_t walked_answered = 0, walked_walls = 0, walked_inside = 0, walked_entries = 0;
   size_t walked_clipped_entries = 0, walked_z_face = 0, walked_long = 0;  // walking lanes
   for (int body = 0; body < 4; ++body) {
@@ -1690,6 +1691,14 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
       answered += static_cast<size_t>(std::popcount(lanes));
       for (int lane = 0; lane < 4; ++lane) {
         if (!((lanes >> lane) & 1u)) continue;
+        const size_t q = k + static_cast<size_t>(lane);
+        ASSERT_TRUE(scratch_flags[q] == want_flags[q] &&
+                    std::memcmp(&scratch_positions[q], &want_positions[q], sizeof(Float3)) == 0 &&
+                    std::memcmp(&scratch_velocities[q], &want_velocities[q], sizeof(Float3)) == 0)
+            << "short-motion lane: particle " << q << " (kind " << q % 8 << ")";
+        answered_outside +=
+            !(previous[q].x >= lo.x && previous[q].x <= hi.x && previous[q].y >= lo.y &&
+              previous[q].y <= hi.y && previous[q].z >= lo.z && previous[q].z <= hi.z);
         const uint8_t f = scratch_flags[k + static_cast<size_t>(lane)];
         answered_walls += (f & kCollisionSideWall) != 0;
         answered_inside += (f & kCollisionStartedInside) != 0;
@@ -1756,6 +1765,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   EXPECT_GT(answered_walls, 200u);
   EXPECT_GT(answered_entries, 2000u);
   EXPECT_GT(answered_inside, 10000u);
+  EXPECT_GT(answered_outside, 1000u);  // points that stay outside the clip box
   // ... and the walking lanes: most particles, every kind of contact, entries of motions clipped
   // to the box (through its top or bottom face among them), contacts three or more texels away.
   EXPECT_GT(walked_answered, 60000u);

@@ -323,7 +323,8 @@ class BodyMapCollider {
                         uint8_t* flags, size_t count, const ResponseParams& params) const;
   // CollideBatch for four particles at once (SSE2, kNearest, a non-empty map), for the lanes
   // whose motion stays in one texel or crosses one texel edge, with both ends in the clip box
-  // and no gaps in either texel: writes their flags, positions and velocities bit for bit as
+  // and no gaps in either texel, and for those whose motion keeps one coordinate outside the
+  // clip box (no contact): writes their flags, positions and velocities bit for bit as
   // CollideOne would and returns their lane mask (bit l = particle l); the other lanes are
   // untouched. *walk_candidates receives the lanes with finite input and both ends in the clip
   // box (on the grid), which CollideFourWalks may answer.
