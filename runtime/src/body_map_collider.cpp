@@ -7,6 +7,7 @@
 #include <limits>
 #include <new>
 #include <string>
+#include <type_traits>
 
 #include "sse_lanes.h"
 
@@ -276,6 +277,47 @@ struct BodyMapWalk {
     }
     inside_prev = false;
     return false;
+  }
+
+  // CollideFourWalks' lanes in texels with gaps (bit l of `lanes`: texel (at_i[l], at_j[l]),
+  // the piece [piece[0][l], piece[1][l]] of the walk from z_ends[0][l] to z_ends[1][l], inside
+  // at its start when bit l of `inside` is set): VisitTexelWithGaps per lane, with the entry
+  // placed as WalkInto places it. Updates bit l of *entered and *inside_after, and of
+  // *entry_lanes with entries[l] on an entry.
+  struct GapEntry {
+    float s, z;            // the entry's parameter on the walked segment and its z
+    bool wall;             // through a side wall (stepped back by the caller)
+    const uint16_t* code;  // oct16 normal of the entered surface (nearer one at a wall)
+  };
+  [[gnu::noinline]] static void VisitGapTexelLanes(
+      const BodyMapCollider& c, uint32_t lanes, const int32_t (&at_i)[4], const int32_t (&at_j)[4],
+      const float (&z_ends)[2][4], uint32_t start_on_z_face, uint32_t inside,
+      const float (&piece)[2][4], GapEntry (&entries)[4], uint32_t* entry_lanes, uint32_t* entered,
+      uint32_t* inside_after) {
+    for (int lane = 0; lane < 4; ++lane) {
+      const uint32_t bit = 1u << lane;
+      if (!(lanes & bit)) continue;
+      BodyMapWalk walk(c, 0.f, 0.f, 0.f, 0.f, z_ends[0][lane], z_ends[1][lane],
+                       (start_on_z_face & bit) != 0, (inside & bit) != 0);
+      const uint32_t i = static_cast<uint32_t>(at_i[lane]), j = static_cast<uint32_t>(at_j[lane]);
+      const bool entry = walk.VisitTexelWithGaps(i, j, static_cast<int>(i), static_cast<int>(j),
+                                                 piece[0][lane], piece[1][lane]);
+      *entered = (*entered & ~bit) | (entry ? bit : 0u);
+      *inside_after = (*inside_after & ~bit) | (walk.inside_prev ? bit : 0u);
+      if (!entry) continue;
+      GapEntry& e = entries[lane];
+      e.s = walk.hit_s;
+      e.z = walk.hit_z;
+      e.wall = walk.hit_side == kEntrySideWall;
+      int slot = walk.hit_slot;
+      if (e.wall) {  // the nearer surface of the entered interval (WalkInto)
+        const BodyMapCollider::Interval interval = c.IntervalAt(i, j, walk.hit_z);
+        slot = walk.hit_z - interval.bottom < interval.top - walk.hit_z ? interval.bottom_slot
+                                                                        : interval.top_slot;
+      }
+      e.code = c.SlotCode(i, j, slot);
+      *entry_lanes |= bit;
+    }
   }
 
   // Bilinear depth: half-texel cell (ci, cj). In an eligible 2x2 block top and bottom are
@@ -994,9 +1036,17 @@ BodyMapCollider::Interval BodyMapCollider::IntervalAmongGaps(uint32_t i, uint32_
 
 Float3 BodyMapCollider::SlotNormal(uint32_t i, uint32_t j, int slot) const {
   if (slot < 2) return TexelNormal(i, j, slot == kBackSlot);
-  const TexelNormals& n = gap_normals_[static_cast<size_t>(GapBase(i, j)) + (slot - 2) / 2];
-  const uint16_t* q = slot % 2 == 1 ? n.back : n.front;
+  const uint16_t* q = SlotCode(i, j, slot);
   return DecodeOct16(q[0], q[1]);
+}
+
+const uint16_t* BodyMapCollider::SlotCode(uint32_t i, uint32_t j, int slot) const {
+  if (slot < 2) {
+    const TexelNormals& n = normals_[static_cast<size_t>(j) * width_ + i];
+    return slot == kBackSlot ? n.back : n.front;
+  }
+  const TexelNormals& n = gap_normals_[static_cast<size_t>(GapBase(i, j)) + (slot - 2) / 2];
+  return slot % 2 == 1 ? n.back : n.front;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1851,6 +1901,9 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   _mm_store_si128(reinterpret_cast<__m128i*>(jb), j1);
   alignas(16) float top_b[4], bottom_b[4];
   int32_t texel_b[4];
+  uint32_t end_in_gap_texel = 0;  // p1's texel has gaps: its answers come from the scalar code
+  uint32_t end_outside = 0;       // ... and p1 lies in a gap
+  int end_slots[4][2];            // ... the slots of p1's interval (top, bottom)
   const uint32_t p1_in_box_lanes = static_cast<uint32_t>(_mm_movemask_ps(p1_in_box));
   for (int lane = 0; lane < 4; ++lane) {
     const bool used = (lanes >> lane) & 1u;
@@ -1860,10 +1913,18 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
     bottom_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].bottom;
     if (used && gap_layers_ != 0 && ((p1_in_box_lanes >> lane) & 1u) &&
         GapBase(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane])) >= 0) {
-      lanes &= ~(1u << lane);
+      // IsInside(p1) and the interval a push-out uses (IntervalAt): p1's interval, or the slab.
+      const Float3& p = positions[index[lane]];
+      const Interval interval =
+          IntervalAt(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]), p.z);
+      top_b[lane] = interval.top;
+      bottom_b[lane] = interval.bottom;
+      end_slots[lane][0] = interval.top_slot;
+      end_slots[lane][1] = interval.bottom_slot;
+      if (!IsInside(p)) end_outside |= 1u << lane;
+      end_in_gap_texel |= 1u << lane;
     }
   }
-  if (lanes == 0) return answered_misses;
   const __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
 
   // The walk (BodyMapWalk::Run<1>, WalkCells with cells of one texel). Each step moves to the
@@ -1929,8 +1990,19 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   load_slabs(start, &top, &bottom);
   // IsInside(p0) when the walk starts at p0 (the walk starts inside when p0 is); a clipped start
   // is outside.
-  const __m128 start_inside = _mm_andnot_ps(
+  __m128 start_inside = _mm_andnot_ps(
       lane_mask(start_clipped), _mm_and_ps(_mm_cmple_ps(q0.z, top), _mm_cmpge_ps(q0.z, bottom)));
+  if (gap_layers_ != 0) {  // IsInside(p0) in a texel with gaps: not in a gap
+    uint32_t inside_bits = static_cast<uint32_t>(_mm_movemask_ps(start_inside));
+    for (int lane = 0; lane < 4; ++lane) {
+      if (((inside_bits >> lane) & 1u) &&
+          GapBase(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane])) >= 0 &&
+          !IsInside(previous[index[lane]])) {
+        inside_bits &= ~(1u << lane);
+      }
+    }
+    start_inside = lane_mask(inside_bits);
+  }
   __m128 inside = start_inside;
   __m128i texel = _mm_load_si128(reinterpret_cast<const __m128i*>(start));
   __m128i cell_i = i0, cell_j = j0;  // for the gap test
@@ -1946,77 +2018,110 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   __m128 hit_z_exit = zero, hit_top = zero, hit_bottom = zero, hit_wall = zero;
   __m128i hit_texel = _mm_setzero_si128();
   alignas(16) int32_t at[4], at_i[4], at_j[4];
-  for (int walked = 1;; ++walked) {
-    const __m128 next = StdMin(next_u, next_v);
-    const __m128 s_exit = StdMin(StdMax(next, s_enter), one);
-    const __m128 z_exit = z_at(s_exit);
-    if (walked > 1) {
-      _mm_store_si128(reinterpret_cast<__m128i*>(at), texel);
-      load_slabs(at, &top, &bottom);
-    }
-    if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals one by one
-      const uint32_t walking = static_cast<uint32_t>(_mm_movemask_ps(active));
-      _mm_store_si128(reinterpret_cast<__m128i*>(at_i), cell_i);
-      _mm_store_si128(reinterpret_cast<__m128i*>(at_j), cell_j);
-      for (int lane = 0; lane < 4; ++lane) {
-        if (((walking >> lane) & 1u) &&
-            GapBase(static_cast<uint32_t>(at_i[lane]), static_cast<uint32_t>(at_j[lane])) >= 0) {
-          lanes &= ~(1u << lane);
+  // Entries in texels with gaps, placed by the walk's own visit.
+  BodyMapWalk::GapEntry gap_entries[4];
+  uint32_t gap_entry_lanes = 0;
+  alignas(16) float z_ends[2][4];
+  if (gap_layers_ != 0) {
+    _mm_store_ps(z_ends[0], q0.z);
+    _mm_store_ps(z_ends[1], q1.z);
+  }
+  const auto walk_texels = [&](auto with_gaps) {
+    constexpr bool kGaps = decltype(with_gaps)::value;
+    for (int walked = 1;; ++walked) {
+      const __m128 next = StdMin(next_u, next_v);
+      const __m128 s_exit = StdMin(StdMax(next, s_enter), one);
+      const __m128 z_exit = z_at(s_exit);
+      if (walked > 1) {
+        _mm_store_si128(reinterpret_cast<__m128i*>(at), texel);
+        load_slabs(at, &top, &bottom);
+      }
+      uint32_t in_gap_texel = 0;  // walking lanes in a texel with gaps
+      if constexpr (kGaps) {
+        const uint32_t walking = static_cast<uint32_t>(_mm_movemask_ps(active));
+        _mm_store_si128(reinterpret_cast<__m128i*>(at_i), cell_i);
+        _mm_store_si128(reinterpret_cast<__m128i*>(at_j), cell_j);
+        for (int lane = 0; lane < 4; ++lane) {
+          if (((walking >> lane) & 1u) &&
+              GapBase(static_cast<uint32_t>(at_i[lane]), static_cast<uint32_t>(at_j[lane])) >= 0) {
+            in_gap_texel |= 1u << lane;
+          }
         }
       }
-      active = _mm_and_ps(active, lane_mask(lanes));
+      // VisitLanes' tests: inside at entry, or reaching the slab from above or below.
+      const __m128 in_enter = _mm_and_ps(_mm_cmple_ps(z_enter, top), _mm_cmpge_ps(z_enter, bottom));
+      const __m128 above = _mm_cmpgt_ps(z_enter, top);  // also every background texel
+      const __m128 wall = _mm_andnot_ps(inside, in_enter);
+      const __m128 reaches =
+          SelectLanes(above, _mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom));
+      __m128 entered = _mm_and_ps(active, _mm_or_ps(wall, _mm_andnot_ps(in_enter, reaches)));
+      __m128 inside_after =
+          _mm_and_ps(_mm_and_ps(inside, in_enter),
+                     _mm_and_ps(_mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom)));
+      if (kGaps && in_gap_texel != 0) [[unlikely]] {
+        // The texel's inside set is several intervals: the walk's own visit, one lane at a time
+        // (out of line, so that the loop keeps its registers).
+        alignas(16) float piece[2][4];
+        _mm_store_ps(piece[0], s_enter);
+        _mm_store_ps(piece[1], s_exit);
+        uint32_t entered_bits = static_cast<uint32_t>(_mm_movemask_ps(entered));
+        uint32_t inside_bits = static_cast<uint32_t>(_mm_movemask_ps(inside_after));
+        BodyMapWalk::VisitGapTexelLanes(*this, in_gap_texel, at_i, at_j, z_ends, start_on_z_face,
+                                        static_cast<uint32_t>(_mm_movemask_ps(inside)), piece,
+                                        gap_entries, &gap_entry_lanes, &entered_bits, &inside_bits);
+        entered = _mm_and_ps(active, lane_mask(entered_bits));
+        inside_after = lane_mask(inside_bits);
+      }
+      if (_mm_movemask_ps(entered) != 0) {
+        hit = _mm_or_ps(hit, entered);
+        hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
+        hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
+        hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
+        hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
+        hit_top = SelectLanes(entered, top, hit_top);
+        hit_bottom = SelectLanes(entered, bottom, hit_bottom);
+        hit_wall = SelectLanes(entered, wall, hit_wall);
+        const __m128i entered_i = _mm_castps_si128(entered);
+        hit_texel =
+            _mm_or_si128(_mm_and_si128(entered_i, texel), _mm_andnot_si128(entered_i, hit_texel));
+      }
+      inside = inside_after;
+      const __m128 going = _mm_cmplt_ps(next, inf);  // an edge left to cross
+      active = _mm_and_ps(_mm_andnot_ps(entered, active), going);
+      if (_mm_movemask_ps(active) == 0) return;
+      if (walked == kMaxLaneWalkTexels) {  // still walking: long through air, one by one
+        lanes &= ~static_cast<uint32_t>(_mm_movemask_ps(active));
+        return;
+      }
+      // Step across the edge(s) reached at `next`.
+      const __m128 across_u = _mm_and_ps(going, _mm_cmpeq_ps(next_u, next));
+      const __m128 across_v = _mm_and_ps(going, _mm_cmpeq_ps(next_v, next));
+      const __m128i across_u_i = _mm_castps_si128(across_u),
+                    across_v_i = _mm_castps_si128(across_v);
+      next_u = SelectLanes(across_u, after_u, next_u);
+      next_v = SelectLanes(across_v, after_v, next_v);
+      texel = _mm_add_epi32(texel, _mm_add_epi32(_mm_and_si128(across_u_i, step_i),
+                                                 _mm_and_si128(across_v_i, step_row)));
+      if constexpr (kGaps) {
+        cell_i = _mm_add_epi32(cell_i, _mm_and_si128(across_u_i, step_i));
+        cell_j = _mm_add_epi32(cell_j, _mm_and_si128(across_v_i, step_j));
+      }
+      left_i = _mm_add_epi32(left_i, across_u_i);  // a mask is -1
+      left_j = _mm_add_epi32(left_j, across_v_i);
+      edge_u = _mm_add_ps(edge_u, _mm_and_ps(across_u, step_u));
+      edge_v = _mm_add_ps(edge_v, _mm_and_ps(across_v, step_v));
+      after_u = SelectLanes(
+          across_u, crossing(_mm_add_ps(edge_u, step_u), u0, inv_du, left_i, one_i), after_u);
+      after_v = SelectLanes(
+          across_v, crossing(_mm_add_ps(edge_v, step_v), v0, inv_dv, left_j, one_i), after_v);
+      s_enter = s_exit;
+      z_enter = z_exit;
     }
-    // VisitLanes' tests: inside at entry, or reaching the slab from above or below.
-    const __m128 in_enter = _mm_and_ps(_mm_cmple_ps(z_enter, top), _mm_cmpge_ps(z_enter, bottom));
-    const __m128 above = _mm_cmpgt_ps(z_enter, top);  // also every background texel
-    const __m128 wall = _mm_andnot_ps(inside, in_enter);
-    const __m128 reaches =
-        SelectLanes(above, _mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom));
-    const __m128 entered = _mm_and_ps(active, _mm_or_ps(wall, _mm_andnot_ps(in_enter, reaches)));
-    if (_mm_movemask_ps(entered) != 0) {
-      hit = _mm_or_ps(hit, entered);
-      hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
-      hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
-      hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
-      hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
-      hit_top = SelectLanes(entered, top, hit_top);
-      hit_bottom = SelectLanes(entered, bottom, hit_bottom);
-      hit_wall = SelectLanes(entered, wall, hit_wall);
-      const __m128i entered_i = _mm_castps_si128(entered);
-      hit_texel =
-          _mm_or_si128(_mm_and_si128(entered_i, texel), _mm_andnot_si128(entered_i, hit_texel));
-    }
-    inside = _mm_and_ps(_mm_and_ps(inside, in_enter),
-                        _mm_and_ps(_mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom)));
-    const __m128 going = _mm_cmplt_ps(next, inf);  // an edge left to cross
-    active = _mm_and_ps(_mm_andnot_ps(entered, active), going);
-    if (_mm_movemask_ps(active) == 0) break;
-    if (walked == kMaxLaneWalkTexels) {  // still walking: long through air, one by one
-      lanes &= ~static_cast<uint32_t>(_mm_movemask_ps(active));
-      break;
-    }
-    // Step across the edge(s) reached at `next`.
-    const __m128 across_u = _mm_and_ps(going, _mm_cmpeq_ps(next_u, next));
-    const __m128 across_v = _mm_and_ps(going, _mm_cmpeq_ps(next_v, next));
-    const __m128i across_u_i = _mm_castps_si128(across_u), across_v_i = _mm_castps_si128(across_v);
-    next_u = SelectLanes(across_u, after_u, next_u);
-    next_v = SelectLanes(across_v, after_v, next_v);
-    texel = _mm_add_epi32(texel, _mm_add_epi32(_mm_and_si128(across_u_i, step_i),
-                                               _mm_and_si128(across_v_i, step_row)));
-    if (gap_layers_ != 0) {
-      cell_i = _mm_add_epi32(cell_i, _mm_and_si128(across_u_i, step_i));
-      cell_j = _mm_add_epi32(cell_j, _mm_and_si128(across_v_i, step_j));
-    }
-    left_i = _mm_add_epi32(left_i, across_u_i);  // a mask is -1
-    left_j = _mm_add_epi32(left_j, across_v_i);
-    edge_u = _mm_add_ps(edge_u, _mm_and_ps(across_u, step_u));
-    edge_v = _mm_add_ps(edge_v, _mm_and_ps(across_v, step_v));
-    after_u = SelectLanes(across_u, crossing(_mm_add_ps(edge_u, step_u), u0, inv_du, left_i, one_i),
-                          after_u);
-    after_v = SelectLanes(across_v, crossing(_mm_add_ps(edge_v, step_v), v0, inv_dv, left_j, one_i),
-                          after_v);
-    s_enter = s_exit;
-    z_enter = z_exit;
+  };
+  if (gap_layers_ != 0) {
+    walk_texels(std::true_type{});
+  } else {
+    walk_texels(std::false_type{});
   }
   if (lanes == 0) return answered_misses;
   // The entry in its texel: VisitLanes again on the kept piece (a side-wall entry is one where
@@ -2029,17 +2134,33 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   const __m128 z_face =
       _mm_and_ps(_mm_and_ps(hit_wall, lane_mask(start_on_z_face)), _mm_cmpeq_ps(hit_s_enter, zero));
   const __m128 moving_down = _mm_cmplt_ps(q1.z, q0.z);
-  const __m128 hit_s = entry.s;
-  const __m128 hit_z = SelectLanes(z_face, SelectLanes(moving_down, hit_top, hit_bottom), entry.z);
+  __m128 hit_s = entry.s;
+  __m128 hit_z = SelectLanes(z_face, SelectLanes(moving_down, hit_top, hit_bottom), entry.z);
   const __m128 hit_back = SelectLanes(z_face, _mm_andnot_ps(moving_down, z_face), entry.back);
   hit_wall = _mm_andnot_ps(z_face, hit_wall);
+  if (gap_entry_lanes != 0) {  // entries the walk's own visit placed
+    alignas(16) float placed[2][4];
+    _mm_store_ps(placed[0], hit_s);
+    _mm_store_ps(placed[1], hit_z);
+    uint32_t wall_bits = static_cast<uint32_t>(_mm_movemask_ps(hit_wall));
+    for (int lane = 0; lane < 4; ++lane) {
+      if (!((gap_entry_lanes >> lane) & 1u)) continue;
+      placed[0][lane] = gap_entries[lane].s;
+      placed[1][lane] = gap_entries[lane].z;
+      wall_bits = (wall_bits & ~(1u << lane)) | (gap_entries[lane].wall ? 1u << lane : 0u);
+    }
+    hit_s = _mm_load_ps(placed[0]);
+    hit_z = _mm_load_ps(placed[1]);
+    hit_wall = lane_mask(wall_bits);
+  }
 
   // The answer (WalkInto): the entry point on the segment, stepped back across a side wall by
   // 1e-3 texel, with the entered surface's normal (at a wall, the nearer surface of the entered
   // texel's slab); with no entry and p1 inside, p1 pushed out along z to the nearer surface of
   // its slab.
-  const __m128 inside_end = _mm_and_ps(
-      p1_in_box, _mm_and_ps(_mm_cmple_ps(p1.z, slab_b_top), _mm_cmpge_ps(p1.z, slab_b_bottom)));
+  const __m128 inside_end = _mm_andnot_ps(
+      lane_mask(end_outside), _mm_and_ps(p1_in_box, _mm_and_ps(_mm_cmple_ps(p1.z, slab_b_top),
+                                                               _mm_cmpge_ps(p1.z, slab_b_bottom))));
   const __m128 push_out = _mm_andnot_ps(hit, inside_end);
   const uint32_t contact_lanes =
       static_cast<uint32_t>(_mm_movemask_ps(_mm_or_ps(hit, push_out))) & lanes;
@@ -2074,9 +2195,15 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   _mm_store_si128(reinterpret_cast<__m128i*>(entered_texel), hit_texel);
   uint16_t qa[4] = {0, 0, 0, 0}, qb[4] = {0, 0, 0, 0};
   for (int lane = 0; lane < 4; ++lane) {
-    const int32_t t = (push_lanes >> lane) & 1u ? texel_b[lane] : entered_texel[lane];
+    const bool pushed = (push_lanes >> lane) & 1u, back = (back_lanes >> lane) & 1u;
+    const int32_t t = pushed ? texel_b[lane] : entered_texel[lane];
     const TexelNormals& n = normals_[static_cast<size_t>(t)];
-    const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
+    const uint16_t* q = back ? n.back : n.front;
+    if (!pushed && ((gap_entry_lanes >> lane) & 1u)) q = gap_entries[lane].code;
+    if (pushed && ((end_in_gap_texel >> lane) & 1u)) {
+      q = SlotCode(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]),
+                   end_slots[lane][back ? 1 : 0]);
+    }
     qa[lane] = q[0];
     qb[lane] = q[1];
   }

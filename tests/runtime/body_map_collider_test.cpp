@@ -1555,6 +1555,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   size_t answered_outside = 0;
   size_t walked_answered = 0, walked_walls = 0, walked_inside = 0, walked_entries = 0;
   size_t walked_clipped_entries = 0, walked_z_face = 0, walked_long = 0;  // walking lanes
+  size_t walked_gap_contacts = 0;
   for (int body = 0; body < 4; ++body) {
     SCOPED_TRACE(::testing::Message() << "body " << body);
     const BodyMapCollider& c = bodies[body];
@@ -1750,6 +1751,16 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
         walked_z_face += clipped && f == kCollisionContact && previous[q].x == positions[q].x &&
                          previous[q].y == positions[q].y;
         walked_long += texels >= 3 && (f & kCollisionContact) != 0;
+        // Contacts where the motion starts or ends in a texel with gaps (the walk's own visit
+        // and IntervalAt answer those inside the lanes).
+        const auto has_gaps = [&](Float3 p) {
+          const float u = (p.x - c.origin_x()) / texel, v = (p.y - c.origin_y()) / texel;
+          float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+          return u >= 0.f && v >= 0.f &&
+                 c.TexelGaps(static_cast<uint32_t>(u), static_cast<uint32_t>(v), upper, lower) > 0;
+        };
+        walked_gap_contacts +=
+            (f & kCollisionContact) != 0 && (has_gaps(previous[q]) || has_gaps(positions[q]));
       }
       // Restore what the lanes wrote, so later groups see the input.
       for (uint32_t q : index) {
@@ -1775,11 +1786,12 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   EXPECT_GT(walked_clipped_entries, 500u);
   EXPECT_GT(walked_z_face, 500u);
   EXPECT_GT(walked_long, 500u);
+  EXPECT_GT(walked_gap_contacts, 500u);
   std::printf(
       "walking lanes: %zu answered, %zu walls, %zu entries (%zu clipped, %zu through the "
-      "box's z face), %zu pushed out, %zu contacts >= 3 texels away\n",
+      "box's z face), %zu pushed out, %zu contacts >= 3 texels away, %zu at texels with gaps\n",
       walked_answered, walked_walls, walked_entries, walked_clipped_entries, walked_z_face,
-      walked_inside, walked_long);
+      walked_inside, walked_long, walked_gap_contacts);
 #endif
 }
 
