@@ -2237,13 +2237,15 @@ Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span
   if (empty()) {
     return Status(StatusCode::kInvalidState, "BodyMapCollider::CollideBatch: collider not built");
   }
-  // Chunks through CollideRange, for the reason InsideBatch gives. Each particle's answer
-  // depends on that particle alone, so the chunking does not change a bit.
+  // Chunks through CollideRange, for the reason InsideBatch gives, taken by the threads as
+  // they finish: a particle's cost runs from a few nanoseconds (free, resting) to hundreds (long
+  // walks), and cloth groups them, so equal shares in order leave a thread idle. Each particle's
+  // answer depends on that particle alone, so the schedule does not change a bit.
   const int64_t count = static_cast<int64_t>(n);
-  constexpr int64_t kChunk = 4096;
+  constexpr int64_t kChunk = 1024;
   const int64_t chunks = (count + kChunk - 1) / kChunk;
   uint32_t contacts = 0;  // an integer sum: the same at any thread count
-#pragma omp parallel for schedule(static) reduction(+ : contacts) if (chunks > 1)
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : contacts) if (chunks > 1)
   for (int64_t chunk = 0; chunk < chunks; ++chunk) {
     const size_t begin = static_cast<size_t>(chunk * kChunk);
     const size_t end = std::min(static_cast<size_t>(count), begin + static_cast<size_t>(kChunk));
