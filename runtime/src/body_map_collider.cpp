@@ -279,47 +279,6 @@ struct BodyMapWalk {
     return false;
   }
 
-  // CollideFourWalks' lanes in texels with gaps (bit l of `lanes`: texel (at_i[l], at_j[l]),
-  // the piece [piece[0][l], piece[1][l]] of the walk from z_ends[0][l] to z_ends[1][l], inside
-  // at its start when bit l of `inside` is set): VisitTexelWithGaps per lane, with the entry
-  // placed as WalkInto places it. Updates bit l of *entered and *inside_after, and of
-  // *entry_lanes with entries[l] on an entry.
-  struct GapEntry {
-    float s, z;            // the entry's parameter on the walked segment and its z
-    bool wall;             // through a side wall (stepped back by the caller)
-    const uint16_t* code;  // oct16 normal of the entered surface (nearer one at a wall)
-  };
-  [[gnu::noinline]] static void VisitGapTexelLanes(
-      const BodyMapCollider& c, uint32_t lanes, const int32_t (&at_i)[4], const int32_t (&at_j)[4],
-      const float (&z_ends)[2][4], uint32_t start_on_z_face, uint32_t inside,
-      const float (&piece)[2][4], GapEntry (&entries)[4], uint32_t* entry_lanes, uint32_t* entered,
-      uint32_t* inside_after) {
-    for (int lane = 0; lane < 4; ++lane) {
-      const uint32_t bit = 1u << lane;
-      if (!(lanes & bit)) continue;
-      BodyMapWalk walk(c, 0.f, 0.f, 0.f, 0.f, z_ends[0][lane], z_ends[1][lane],
-                       (start_on_z_face & bit) != 0, (inside & bit) != 0);
-      const uint32_t i = static_cast<uint32_t>(at_i[lane]), j = static_cast<uint32_t>(at_j[lane]);
-      const bool entry = walk.VisitTexelWithGaps(i, j, static_cast<int>(i), static_cast<int>(j),
-                                                 piece[0][lane], piece[1][lane]);
-      *entered = (*entered & ~bit) | (entry ? bit : 0u);
-      *inside_after = (*inside_after & ~bit) | (walk.inside_prev ? bit : 0u);
-      if (!entry) continue;
-      GapEntry& e = entries[lane];
-      e.s = walk.hit_s;
-      e.z = walk.hit_z;
-      e.wall = walk.hit_side == kEntrySideWall;
-      int slot = walk.hit_slot;
-      if (e.wall) {  // the nearer surface of the entered interval (WalkInto)
-        const BodyMapCollider::Interval interval = c.IntervalAt(i, j, walk.hit_z);
-        slot = walk.hit_z - interval.bottom < interval.top - walk.hit_z ? interval.bottom_slot
-                                                                        : interval.top_slot;
-      }
-      e.code = c.SlotCode(i, j, slot);
-      *entry_lanes |= bit;
-    }
-  }
-
   // Bilinear depth: half-texel cell (ci, cj). In an eligible 2x2 block top and bottom are
   // bilinear, so along the segment z - top and z - bottom are quadratics in s: their roots split
   // the cell into intervals of constant inside/outside, classified at the midpoints (double).
@@ -1490,6 +1449,7 @@ Lanes3 LoadLanes(const Float3* p) {
 
 using detail::AbsLanes;
 using detail::SelectLanes;
+using detail::SelectLanesI;
 using detail::StdMax;
 using detail::StdMin;
 
@@ -1892,6 +1852,72 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   };
   __m128i left_i = abs_i(di), left_j = abs_i(dj);
 
+  const auto lane_mask = [](uint32_t bits) {
+    const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
+    return _mm_castsi128_ps(
+        _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<int32_t>(bits)), bit), bit));
+  };
+  // Texels with gaps (maps.layers > 1): their inside set is the slab less the open gaps, split
+  // into intervals whose surfaces have slots (BodyMapCollider::Interval).
+  const __m128i front_slot = _mm_set1_epi32(kFrontSlot), back_slot = _mm_set1_epi32(kBackSlot);
+  const __m128 all_lanes = _mm_castsi128_ps(_mm_set1_epi32(-1)), minus_inf = _mm_set1_ps(-kInf);
+  // The gaps of four lanes' texels (absent ones: top -inf, bottom +inf, which no z lies strictly
+  // between); returns the lanes (of `lanes`) whose texel has gaps.
+  struct GapLanes {
+    __m128 top[kMaxBodyMapLayers - 1], bottom[kMaxBodyMapLayers - 1];
+  };
+  const auto gather_gaps = [&](const int32_t(&ci)[4], const int32_t(&cj)[4], uint32_t which,
+                               GapLanes* out) {
+    alignas(16) float upper[kMaxBodyMapLayers - 1][4], lower[kMaxBodyMapLayers - 1][4];
+    uint32_t with_gaps = 0;
+    for (int lane = 0; lane < 4; ++lane) {
+      const int64_t base = ((which >> lane) & 1u) ? GapBase(static_cast<uint32_t>(ci[lane]),
+                                                            static_cast<uint32_t>(cj[lane]))
+                                                  : -1;
+      with_gaps |= static_cast<uint32_t>(base >= 0) << lane;
+      for (uint32_t g = 0; g < gap_layers_; ++g) {
+        upper[g][lane] = base >= 0 ? gaps_[static_cast<size_t>(base) + g].top : -kInf;
+        lower[g][lane] = base >= 0 ? gaps_[static_cast<size_t>(base) + g].bottom : kInf;
+      }
+    }
+    for (uint32_t g = 0; g < gap_layers_; ++g) {
+      out->top[g] = _mm_load_ps(upper[g]);
+      out->bottom[g] = _mm_load_ps(lower[g]);
+    }
+    return with_gaps;
+  };
+  // z strictly inside one of the gaps (BodyMapCollider::InGap).
+  const auto in_a_gap = [&](const GapLanes& gaps, __m128 z) {
+    __m128 in = zero;
+    for (uint32_t g = 0; g < gap_layers_; ++g) {
+      in = _mm_or_ps(in, _mm_and_ps(_mm_cmplt_ps(z, gaps.top[g]), _mm_cmpgt_ps(z, gaps.bottom[g])));
+    }
+    return in;
+  };
+  // The interval of the inside set holding z (BodyMapCollider::TexelIntervals): bounded by the
+  // nearest gap boundary or slab surface above and below z.
+  struct IntervalLanes {
+    __m128 top, bottom;
+    __m128i top_slot, bottom_slot;
+  };
+  const auto interval_around = [&](const GapLanes& gaps, __m128 z, __m128 slab_top,
+                                   __m128 slab_bottom) {
+    IntervalLanes in{slab_top, slab_bottom, front_slot, back_slot};
+    for (uint32_t g = 0; g < gap_layers_; ++g) {
+      const __m128 lower_above =
+          _mm_and_ps(_mm_cmpge_ps(gaps.bottom[g], z), _mm_cmplt_ps(gaps.bottom[g], in.top));
+      in.top = SelectLanes(lower_above, gaps.bottom[g], in.top);
+      in.top_slot =
+          SelectLanesI(lower_above, _mm_set1_epi32(3 + 2 * static_cast<int>(g)), in.top_slot);
+      const __m128 upper_below =
+          _mm_and_ps(_mm_cmple_ps(gaps.top[g], z), _mm_cmpgt_ps(gaps.top[g], in.bottom));
+      in.bottom = SelectLanes(upper_below, gaps.top[g], in.bottom);
+      in.bottom_slot =
+          SelectLanesI(upper_below, _mm_set1_epi32(2 + 2 * static_cast<int>(g)), in.bottom_slot);
+    }
+    return in;
+  };
+
   // Texel indices (row-major) of the start and of the end. With p1 in the box the end is p1's
   // texel, whose slab answers IsInside(p1); beyond the box p1 is outside.
   alignas(16) int32_t ia[4], ja[4], ib[4], jb[4], start[4];
@@ -1901,9 +1927,6 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   _mm_store_si128(reinterpret_cast<__m128i*>(jb), j1);
   alignas(16) float top_b[4], bottom_b[4];
   int32_t texel_b[4];
-  uint32_t end_in_gap_texel = 0;  // p1's texel has gaps: its answers come from the scalar code
-  uint32_t end_outside = 0;       // ... and p1 lies in a gap
-  int end_slots[4][2];            // ... the slots of p1's interval (top, bottom)
   const uint32_t p1_in_box_lanes = static_cast<uint32_t>(_mm_movemask_ps(p1_in_box));
   for (int lane = 0; lane < 4; ++lane) {
     const bool used = (lanes >> lane) & 1u;
@@ -1911,21 +1934,25 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
     texel_b[lane] = used ? jb[lane] * static_cast<int32_t>(width_) + ib[lane] : 0;
     top_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].top;
     bottom_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].bottom;
-    if (used && gap_layers_ != 0 && ((p1_in_box_lanes >> lane) & 1u) &&
-        GapBase(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane])) >= 0) {
-      // IsInside(p1) and the interval a push-out uses (IntervalAt): p1's interval, or the slab.
-      const Float3& p = positions[index[lane]];
-      const Interval interval =
-          IntervalAt(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]), p.z);
-      top_b[lane] = interval.top;
-      bottom_b[lane] = interval.bottom;
-      end_slots[lane][0] = interval.top_slot;
-      end_slots[lane][1] = interval.bottom_slot;
-      if (!IsInside(p)) end_outside |= 1u << lane;
-      end_in_gap_texel |= 1u << lane;
+  }
+  __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
+  // With gaps at p1's texel: IsInside(p1) excludes the gaps, and a push-out goes to the nearer
+  // surface of p1's interval (IntervalAt).
+  __m128 end_in_gap = zero;
+  __m128i end_top_slot = front_slot, end_bottom_slot = back_slot;
+  uint32_t end_in_gap_texel = 0;
+  if (gap_layers_ != 0) {
+    GapLanes gaps;
+    end_in_gap_texel = gather_gaps(ib, jb, lanes & p1_in_box_lanes, &gaps);
+    if (end_in_gap_texel != 0) {
+      end_in_gap = in_a_gap(gaps, p1.z);
+      const IntervalLanes around = interval_around(gaps, p1.z, slab_b_top, slab_b_bottom);
+      slab_b_top = around.top;
+      slab_b_bottom = around.bottom;
+      end_top_slot = around.top_slot;
+      end_bottom_slot = around.bottom_slot;
     }
   }
-  const __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
 
   // The walk (BodyMapWalk::Run<1>, WalkCells with cells of one texel). Each step moves to the
   // neighbour across the edge the segment crosses first, both on an exact corner; the crossing
@@ -1956,11 +1983,6 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   };
   const __m128 clamped = _mm_castsi128_ps(_mm_and_si128(
       _mm_cmplt_epi32(left_i, _mm_set1_epi32(2)), _mm_cmplt_epi32(left_j, _mm_set1_epi32(2))));
-  const auto lane_mask = [](uint32_t bits) {
-    const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
-    return _mm_castsi128_ps(
-        _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(static_cast<int32_t>(bits)), bit), bit));
-  };
   __m128 active = lane_mask(lanes);
   const auto first_crossing = [&](__m128 edge, __m128 g0, __m128 inv, __m128i left) {
     const __m128 s = crossing(edge, g0, inv, left, zero_i);
@@ -1993,15 +2015,10 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   __m128 start_inside = _mm_andnot_ps(
       lane_mask(start_clipped), _mm_and_ps(_mm_cmple_ps(q0.z, top), _mm_cmpge_ps(q0.z, bottom)));
   if (gap_layers_ != 0) {  // IsInside(p0) in a texel with gaps: not in a gap
-    uint32_t inside_bits = static_cast<uint32_t>(_mm_movemask_ps(start_inside));
-    for (int lane = 0; lane < 4; ++lane) {
-      if (((inside_bits >> lane) & 1u) &&
-          GapBase(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane])) >= 0 &&
-          !IsInside(previous[index[lane]])) {
-        inside_bits &= ~(1u << lane);
-      }
+    GapLanes gaps;
+    if (gather_gaps(ia, ja, lanes & ~start_clipped, &gaps) != 0) {
+      start_inside = _mm_andnot_ps(in_a_gap(gaps, q0.z), start_inside);
     }
-    start_inside = lane_mask(inside_bits);
   }
   __m128 inside = start_inside;
   __m128i texel = _mm_load_si128(reinterpret_cast<const __m128i*>(start));
@@ -2018,14 +2035,9 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   __m128 hit_z_exit = zero, hit_top = zero, hit_bottom = zero, hit_wall = zero;
   __m128i hit_texel = _mm_setzero_si128();
   alignas(16) int32_t at[4], at_i[4], at_j[4];
-  // Entries in texels with gaps, placed by the walk's own visit.
-  BodyMapWalk::GapEntry gap_entries[4];
-  uint32_t gap_entry_lanes = 0;
-  alignas(16) float z_ends[2][4];
-  if (gap_layers_ != 0) {
-    _mm_store_ps(z_ends[0], q0.z);
-    _mm_store_ps(z_ends[1], q1.z);
-  }
+  // With gaps: the entered surfaces' slots (BodyMapCollider::Interval) and the entered texel.
+  __m128i hit_top_slot = front_slot, hit_bottom_slot = back_slot;
+  __m128i hit_cell_i = _mm_setzero_si128(), hit_cell_j = _mm_setzero_si128();
   const auto walk_texels = [&](auto with_gaps) {
     constexpr bool kGaps = decltype(with_gaps)::value;
     for (int walked = 1;; ++walked) {
@@ -2036,41 +2048,67 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
         _mm_store_si128(reinterpret_cast<__m128i*>(at), texel);
         load_slabs(at, &top, &bottom);
       }
-      uint32_t in_gap_texel = 0;  // walking lanes in a texel with gaps
-      if constexpr (kGaps) {
-        const uint32_t walking = static_cast<uint32_t>(_mm_movemask_ps(active));
-        _mm_store_si128(reinterpret_cast<__m128i*>(at_i), cell_i);
-        _mm_store_si128(reinterpret_cast<__m128i*>(at_j), cell_j);
-        for (int lane = 0; lane < 4; ++lane) {
-          if (((walking >> lane) & 1u) &&
-              GapBase(static_cast<uint32_t>(at_i[lane]), static_cast<uint32_t>(at_j[lane])) >= 0) {
-            in_gap_texel |= 1u << lane;
-          }
-        }
-      }
       // VisitLanes' tests: inside at entry, or reaching the slab from above or below.
-      const __m128 in_enter = _mm_and_ps(_mm_cmple_ps(z_enter, top), _mm_cmpge_ps(z_enter, bottom));
+      __m128 in_enter = _mm_and_ps(_mm_cmple_ps(z_enter, top), _mm_cmpge_ps(z_enter, bottom));
       const __m128 above = _mm_cmpgt_ps(z_enter, top);  // also every background texel
-      const __m128 wall = _mm_andnot_ps(inside, in_enter);
+      __m128 wall = _mm_andnot_ps(inside, in_enter);
       const __m128 reaches =
           SelectLanes(above, _mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom));
       __m128 entered = _mm_and_ps(active, _mm_or_ps(wall, _mm_andnot_ps(in_enter, reaches)));
       __m128 inside_after =
           _mm_and_ps(_mm_and_ps(inside, in_enter),
                      _mm_and_ps(_mm_cmple_ps(z_exit, top), _mm_cmpge_ps(z_exit, bottom)));
-      if (kGaps && in_gap_texel != 0) [[unlikely]] {
-        // The texel's inside set is several intervals: the walk's own visit, one lane at a time
-        // (out of line, so that the loop keeps its registers).
-        alignas(16) float piece[2][4];
-        _mm_store_ps(piece[0], s_enter);
-        _mm_store_ps(piece[1], s_exit);
-        uint32_t entered_bits = static_cast<uint32_t>(_mm_movemask_ps(entered));
-        uint32_t inside_bits = static_cast<uint32_t>(_mm_movemask_ps(inside_after));
-        BodyMapWalk::VisitGapTexelLanes(*this, in_gap_texel, at_i, at_j, z_ends, start_on_z_face,
-                                        static_cast<uint32_t>(_mm_movemask_ps(inside)), piece,
-                                        gap_entries, &gap_entry_lanes, &entered_bits, &inside_bits);
-        entered = _mm_and_ps(active, lane_mask(entered_bits));
-        inside_after = lane_mask(inside_bits);
+      // What the answer needs of the entered texel: VisitLanes' top and bottom (the entered
+      // interval, or the surface reached), and with gaps the surfaces' slots.
+      __m128 kept_top = top, kept_bottom = bottom;
+      __m128i top_slot = front_slot, bottom_slot = back_slot;
+      if constexpr (kGaps) {
+        _mm_store_si128(reinterpret_cast<__m128i*>(at_i), cell_i);
+        _mm_store_si128(reinterpret_cast<__m128i*>(at_j), cell_j);
+        GapLanes gaps;
+        if (gather_gaps(at_i, at_j, static_cast<uint32_t>(_mm_movemask_ps(active)), &gaps) != 0)
+            [[unlikely]] {
+          // BodyMapWalk::VisitTexelWithGaps: the inside set is the slab less the open gaps,
+          // z is monotone along the piece, so the first entry is into the interval holding
+          // z_enter (a side wall) or into the next interval in the direction of motion.
+          in_enter = _mm_andnot_ps(in_a_gap(gaps, z_enter), in_enter);
+          wall = _mm_andnot_ps(inside, in_enter);
+          const IntervalLanes around = interval_around(gaps, z_enter, top, bottom);
+          const __m128 stays = _mm_and_ps(
+              _mm_and_ps(inside, in_enter),
+              _mm_and_ps(_mm_cmple_ps(z_exit, around.top), _mm_cmpge_ps(z_exit, around.bottom)));
+          const __m128 search = _mm_andnot_ps(_mm_or_ps(wall, stays), all_lanes);
+          // The nearest interval top below z_enter and bottom above it.
+          __m128 below = SelectLanes(_mm_cmplt_ps(top, z_enter), top, minus_inf);
+          __m128i below_slot = front_slot;
+          __m128 over = SelectLanes(_mm_cmpgt_ps(bottom, z_enter), bottom, inf);
+          __m128i over_slot = back_slot;
+          for (uint32_t g = 0; g < gap_layers_; ++g) {
+            const __m128 lower = gaps.bottom[g], upper = gaps.top[g];
+            const __m128 lower_below =
+                _mm_and_ps(_mm_cmplt_ps(lower, z_enter), _mm_cmpgt_ps(lower, below));
+            below = SelectLanes(lower_below, lower, below);
+            below_slot =
+                SelectLanesI(lower_below, _mm_set1_epi32(3 + 2 * static_cast<int>(g)), below_slot);
+            const __m128 upper_over =
+                _mm_and_ps(_mm_cmpgt_ps(upper, z_enter), _mm_cmplt_ps(upper, over));
+            over = SelectLanes(upper_over, upper, over);
+            over_slot =
+                SelectLanesI(upper_over, _mm_set1_epi32(2 + 2 * static_cast<int>(g)), over_slot);
+          }
+          const __m128 front = _mm_and_ps(
+              search, _mm_and_ps(_mm_cmplt_ps(z_exit, z_enter), _mm_cmple_ps(z_exit, below)));
+          const __m128 back = _mm_and_ps(
+              search, _mm_and_ps(_mm_cmpgt_ps(z_exit, z_enter), _mm_cmpge_ps(z_exit, over)));
+          entered = _mm_and_ps(active, _mm_or_ps(wall, _mm_or_ps(front, back)));
+          inside_after = stays;
+          // VisitLanes recomputes the entry from these: the interval for a wall; the surface
+          // reached as `top` (front) or `bottom` (back), the other bound out of the way.
+          kept_top = SelectLanes(wall, around.top, SelectLanes(front, below, inf));
+          kept_bottom = SelectLanes(wall, around.bottom, SelectLanes(back, over, minus_inf));
+          top_slot = SelectLanesI(wall, around.top_slot, below_slot);
+          bottom_slot = SelectLanesI(wall, around.bottom_slot, over_slot);
+        }
       }
       if (_mm_movemask_ps(entered) != 0) {
         hit = _mm_or_ps(hit, entered);
@@ -2078,9 +2116,15 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
         hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
         hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
         hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
-        hit_top = SelectLanes(entered, top, hit_top);
-        hit_bottom = SelectLanes(entered, bottom, hit_bottom);
+        hit_top = SelectLanes(entered, kept_top, hit_top);
+        hit_bottom = SelectLanes(entered, kept_bottom, hit_bottom);
         hit_wall = SelectLanes(entered, wall, hit_wall);
+        if constexpr (kGaps) {
+          hit_top_slot = SelectLanesI(entered, top_slot, hit_top_slot);
+          hit_bottom_slot = SelectLanesI(entered, bottom_slot, hit_bottom_slot);
+          hit_cell_i = SelectLanesI(entered, cell_i, hit_cell_i);
+          hit_cell_j = SelectLanesI(entered, cell_j, hit_cell_j);
+        }
         const __m128i entered_i = _mm_castps_si128(entered);
         hit_texel =
             _mm_or_si128(_mm_and_si128(entered_i, texel), _mm_andnot_si128(entered_i, hit_texel));
@@ -2134,33 +2178,18 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   const __m128 z_face =
       _mm_and_ps(_mm_and_ps(hit_wall, lane_mask(start_on_z_face)), _mm_cmpeq_ps(hit_s_enter, zero));
   const __m128 moving_down = _mm_cmplt_ps(q1.z, q0.z);
-  __m128 hit_s = entry.s;
-  __m128 hit_z = SelectLanes(z_face, SelectLanes(moving_down, hit_top, hit_bottom), entry.z);
+  const __m128 hit_s = entry.s;
+  const __m128 hit_z = SelectLanes(z_face, SelectLanes(moving_down, hit_top, hit_bottom), entry.z);
   const __m128 hit_back = SelectLanes(z_face, _mm_andnot_ps(moving_down, z_face), entry.back);
   hit_wall = _mm_andnot_ps(z_face, hit_wall);
-  if (gap_entry_lanes != 0) {  // entries the walk's own visit placed
-    alignas(16) float placed[2][4];
-    _mm_store_ps(placed[0], hit_s);
-    _mm_store_ps(placed[1], hit_z);
-    uint32_t wall_bits = static_cast<uint32_t>(_mm_movemask_ps(hit_wall));
-    for (int lane = 0; lane < 4; ++lane) {
-      if (!((gap_entry_lanes >> lane) & 1u)) continue;
-      placed[0][lane] = gap_entries[lane].s;
-      placed[1][lane] = gap_entries[lane].z;
-      wall_bits = (wall_bits & ~(1u << lane)) | (gap_entries[lane].wall ? 1u << lane : 0u);
-    }
-    hit_s = _mm_load_ps(placed[0]);
-    hit_z = _mm_load_ps(placed[1]);
-    hit_wall = lane_mask(wall_bits);
-  }
 
   // The answer (WalkInto): the entry point on the segment, stepped back across a side wall by
   // 1e-3 texel, with the entered surface's normal (at a wall, the nearer surface of the entered
   // texel's slab); with no entry and p1 inside, p1 pushed out along z to the nearer surface of
   // its slab.
   const __m128 inside_end = _mm_andnot_ps(
-      lane_mask(end_outside), _mm_and_ps(p1_in_box, _mm_and_ps(_mm_cmple_ps(p1.z, slab_b_top),
-                                                               _mm_cmpge_ps(p1.z, slab_b_bottom))));
+      end_in_gap, _mm_and_ps(p1_in_box, _mm_and_ps(_mm_cmple_ps(p1.z, slab_b_top),
+                                                   _mm_cmpge_ps(p1.z, slab_b_bottom))));
   const __m128 push_out = _mm_andnot_ps(hit, inside_end);
   const uint32_t contact_lanes =
       static_cast<uint32_t>(_mm_movemask_ps(_mm_or_ps(hit, push_out))) & lanes;
@@ -2191,18 +2220,30 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   const __m128 use_back = SelectLanes(push_out, push_back, SelectLanes(wall, wall_back, hit_back));
   const uint32_t back_lanes = static_cast<uint32_t>(_mm_movemask_ps(use_back));
   const uint32_t push_lanes = static_cast<uint32_t>(_mm_movemask_ps(push_out));
-  alignas(16) int32_t entered_texel[4];
+  alignas(16) int32_t entered_texel[4], entered_slot[2][4], entered_i[4], entered_j[4];
   _mm_store_si128(reinterpret_cast<__m128i*>(entered_texel), hit_texel);
+  alignas(16) int32_t end_slot[2][4];
+  if (gap_layers_ != 0) {
+    _mm_store_si128(reinterpret_cast<__m128i*>(end_slot[0]), end_top_slot);
+    _mm_store_si128(reinterpret_cast<__m128i*>(end_slot[1]), end_bottom_slot);
+    _mm_store_si128(reinterpret_cast<__m128i*>(entered_slot[0]), hit_top_slot);
+    _mm_store_si128(reinterpret_cast<__m128i*>(entered_slot[1]), hit_bottom_slot);
+    _mm_store_si128(reinterpret_cast<__m128i*>(entered_i), hit_cell_i);
+    _mm_store_si128(reinterpret_cast<__m128i*>(entered_j), hit_cell_j);
+  }
   uint16_t qa[4] = {0, 0, 0, 0}, qb[4] = {0, 0, 0, 0};
   for (int lane = 0; lane < 4; ++lane) {
     const bool pushed = (push_lanes >> lane) & 1u, back = (back_lanes >> lane) & 1u;
     const int32_t t = pushed ? texel_b[lane] : entered_texel[lane];
     const TexelNormals& n = normals_[static_cast<size_t>(t)];
     const uint16_t* q = back ? n.back : n.front;
-    if (!pushed && ((gap_entry_lanes >> lane) & 1u)) q = gap_entries[lane].code;
-    if (pushed && ((end_in_gap_texel >> lane) & 1u)) {
+    if (!pushed && gap_layers_ != 0 && entered_slot[back ? 1 : 0][lane] >= 2) {  // a gap's
+      q = SlotCode(static_cast<uint32_t>(entered_i[lane]), static_cast<uint32_t>(entered_j[lane]),
+                   entered_slot[back ? 1 : 0][lane]);
+    }
+    if (pushed && ((end_in_gap_texel >> lane) & 1u) && end_slot[back ? 1 : 0][lane] >= 2) {
       q = SlotCode(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]),
-                   end_slots[lane][back ? 1 : 0]);
+                   end_slot[back ? 1 : 0][lane]);
     }
     qa[lane] = q[0];
     qb[lane] = q[1];

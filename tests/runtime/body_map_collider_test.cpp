@@ -1613,9 +1613,32 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
             const float u1 = (p1.x - c.origin_x()) / texel, v1 = (p1.y - c.origin_y()) / texel;
             if (u1 >= 0.f && v1 >= 0.f &&
                 c.TexelSlab(static_cast<uint32_t>(u1), static_cast<uint32_t>(v1), &top, &bottom)) {
-              const bool front = unit(rng) < 0.5f;
+              bool front = unit(rng) < 0.5f;
+              // In a texel with gaps, on a gap's boundary half the time (the lower one is the
+              // top of the interval below it).
+              float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+              const uint32_t gaps =
+                  c.TexelGaps(static_cast<uint32_t>(u1), static_cast<uint32_t>(v1), upper, lower);
+              if (gaps > 0 && unit(rng) < 0.5f) {
+                const uint32_t g =
+                    static_cast<uint32_t>(unit(rng) * static_cast<float>(gaps)) % gaps;
+                front = unit(rng) < 0.5f;
+                top = lower[g];
+                bottom = upper[g];
+              }
               p1.z = front ? top : bottom;
               p0.z = p1.z + (front ? 1.f : -1.f) * 0.001f * unit(rng);
+            }
+            // Or starting exactly on a gap's boundary of its own texel, moving sideways.
+            float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+            const uint32_t gaps =
+                u >= 0.f && v >= 0.f
+                    ? c.TexelGaps(static_cast<uint32_t>(u), static_cast<uint32_t>(v), upper, lower)
+                    : 0u;
+            if (gaps > 0 && unit(rng) < 0.5f) {
+              const uint32_t g = static_cast<uint32_t>(unit(rng) * static_cast<float>(gaps)) % gaps;
+              p0.z = unit(rng) < 0.5f ? upper[g] : lower[g];
+              p1.z = p0.z + (unit(rng) - 0.5f) * 0.004f;
             }
           }
           break;
