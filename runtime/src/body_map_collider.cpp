@@ -1935,13 +1935,39 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
     top_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].top;
     bottom_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].bottom;
   }
+  // Whether a lane can meet a texel with gaps: a walk stays in the box of its end texels, so
+  // when no 8x8 block under those boxes has one (most of a body, most of the time), the lanes
+  // run the walk without the gap tests.
+  bool gaps_near = false;
+  if (gap_layers_ != 0) {
+    constexpr int kMaxBlocksTested = 64;
+    int blocks_tested = 0;
+    for (int lane = 0; lane < 4 && !gaps_near; ++lane) {
+      if (!((lanes >> lane) & 1u)) continue;
+      const int bi0 = std::min(ia[lane], ib[lane]) >> kBlockShift;
+      const int bi1 = std::max(ia[lane], ib[lane]) >> kBlockShift;
+      const int bj0 = std::min(ja[lane], jb[lane]) >> kBlockShift;
+      const int bj1 = std::max(ja[lane], jb[lane]) >> kBlockShift;
+      blocks_tested += (bi1 - bi0 + 1) * (bj1 - bj0 + 1);
+      if (blocks_tested > kMaxBlocksTested) {
+        gaps_near = true;  // long walks: test texel by texel
+        break;
+      }
+      for (int bj = bj0; bj <= bj1; ++bj) {
+        for (int bi = bi0; bi <= bi1; ++bi) {
+          gaps_near |=
+              gap_masks_[static_cast<size_t>(bj) * blocks_w_ + static_cast<size_t>(bi)] != 0;
+        }
+      }
+    }
+  }
   __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
   // With gaps at p1's texel: IsInside(p1) excludes the gaps, and a push-out goes to the nearer
   // surface of p1's interval (IntervalAt).
   __m128 end_in_gap = zero;
   __m128i end_top_slot = front_slot, end_bottom_slot = back_slot;
   uint32_t end_in_gap_texel = 0;
-  if (gap_layers_ != 0) {
+  if (gaps_near) {
     GapLanes gaps;
     end_in_gap_texel = gather_gaps(ib, jb, lanes & p1_in_box_lanes, &gaps);
     if (end_in_gap_texel != 0) {
@@ -2014,7 +2040,7 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   // is outside.
   __m128 start_inside = _mm_andnot_ps(
       lane_mask(start_clipped), _mm_and_ps(_mm_cmple_ps(q0.z, top), _mm_cmpge_ps(q0.z, bottom)));
-  if (gap_layers_ != 0) {  // IsInside(p0) in a texel with gaps: not in a gap
+  if (gaps_near) {  // IsInside(p0) in a texel with gaps: not in a gap
     GapLanes gaps;
     if (gather_gaps(ia, ja, lanes & ~start_clipped, &gaps) != 0) {
       start_inside = _mm_andnot_ps(in_a_gap(gaps, q0.z), start_inside);
@@ -2162,7 +2188,7 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
       z_enter = z_exit;
     }
   };
-  if (gap_layers_ != 0) {
+  if (gaps_near) {
     walk_texels(std::true_type{});
   } else {
     walk_texels(std::false_type{});
@@ -2223,7 +2249,7 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   alignas(16) int32_t entered_texel[4], entered_slot[2][4], entered_i[4], entered_j[4];
   _mm_store_si128(reinterpret_cast<__m128i*>(entered_texel), hit_texel);
   alignas(16) int32_t end_slot[2][4];
-  if (gap_layers_ != 0) {
+  if (gaps_near) {
     _mm_store_si128(reinterpret_cast<__m128i*>(end_slot[0]), end_top_slot);
     _mm_store_si128(reinterpret_cast<__m128i*>(end_slot[1]), end_bottom_slot);
     _mm_store_si128(reinterpret_cast<__m128i*>(entered_slot[0]), hit_top_slot);
@@ -2237,7 +2263,7 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
     const int32_t t = pushed ? texel_b[lane] : entered_texel[lane];
     const TexelNormals& n = normals_[static_cast<size_t>(t)];
     const uint16_t* q = back ? n.back : n.front;
-    if (!pushed && gap_layers_ != 0 && entered_slot[back ? 1 : 0][lane] >= 2) {  // a gap's
+    if (!pushed && gaps_near && entered_slot[back ? 1 : 0][lane] >= 2) {  // a gap's
       q = SlotCode(static_cast<uint32_t>(entered_i[lane]), static_cast<uint32_t>(entered_j[lane]),
                    entered_slot[back ? 1 : 0][lane]);
     }

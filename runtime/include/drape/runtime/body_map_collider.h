@@ -175,9 +175,11 @@ class BodyMapCollider {
   // positions[i], velocities[i]. flags[i] is always written (CollisionFlags). A particle with a
   // non-finite previous/current position or velocity gets kCollisionInvalidInput and is left
   // untouched. OpenMP over particles, no allocation, bitwise identical at any thread count and
-  // to Query + ApplyResponse per particle (with kNearest, motions that stay in one texel are
-  // answered four at a time in SSE2 lanes). All four spans must have the same size; params must
-  // be finite. contact_count (optional) receives the number of particles with kCollisionContact.
+  // to Query + ApplyResponse per particle (with kNearest, four particles at a time in SSE2
+  // lanes: motions within a texel or across one edge, then the others walked texel by texel in
+  // step, up to kMaxLaneWalkTexels; the rest one by one). All four spans must have the same
+  // size; params must be finite. contact_count (optional) receives the number of particles with
+  // kCollisionContact.
   Status CollideBatch(std::span<const Float3> previous, std::span<Float3> positions,
                       std::span<Float3> velocities, std::span<uint8_t> flags,
                       const ResponseParams& params, uint32_t* contact_count = nullptr) const;
