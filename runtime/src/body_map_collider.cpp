@@ -1393,13 +1393,14 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
       queued_count = 0;
     };
     for (; k + 4 <= count; k += 4) {
-      uint32_t answered = 0, walk_candidates = 0xf;
+      uint32_t answered = 0, walk_candidates = 0xf, long_motions = 0;
       if (skip_short > 0) {
         --skip_short;
       } else {
         answered = CollideFourShortMotions(previous + k, positions + k, velocities + k, flags + k,
-                                           params, &walk_candidates);
-        if (std::popcount(walk_candidates & ~answered) >= 2) skip_short = kScalarGroups;
+                                           params, &walk_candidates, &long_motions);
+        // (Lanes it declines for gaps are short: they do not count.)
+        if (std::popcount(long_motions) >= 2) skip_short = kScalarGroups;
       }
       for (uint32_t lane = 0; lane < 4; ++lane) {
         if (answered & (1u << lane)) continue;
@@ -1574,7 +1575,8 @@ constexpr uint32_t kConsecutiveLanes[4] = {0, 1, 2, 3};
 uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3* positions,
                                                   Float3* velocities, uint8_t* flags,
                                                   const ResponseParams& params,
-                                                  uint32_t* walk_candidates) const {
+                                                  uint32_t* walk_candidates,
+                                                  uint32_t* long_motions) const {
   const Lanes3 p0 = LoadLanes(previous), p1 = LoadLanes(positions), v = LoadLanes(velocities);
   // Finite input (a sum holding a NaN or an infinity is not finite; an overflowing one only
   // sends the lane to CollideOne).
@@ -1625,6 +1627,8 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
       answerable, _mm_and_ps(_mm_and_ps(within(p0.x, x_lo, x_hi), within(p1.x, x_lo, x_hi)),
                              _mm_and_ps(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))));
   *walk_candidates = static_cast<uint32_t>(_mm_movemask_ps(in_box));
+  *long_motions =
+      static_cast<uint32_t>(_mm_movemask_ps(_mm_andnot_ps(_mm_or_ps(in_one, two), in_box)));
   answerable = _mm_or_ps(_mm_and_ps(answerable, in_one), _mm_and_ps(in_box, two));
   // A motion that stays at one coordinate outside the clip box never enters it (ClipMotion's
   // test for a zero extent, exact): no contact. Points away from the body are most of these.

@@ -331,10 +331,11 @@ class BodyMapCollider {
   // clip box (no contact): writes their flags, positions and velocities bit for bit as
   // CollideOne would and returns their lane mask (bit l = particle l); the other lanes are
   // untouched. *walk_candidates receives the lanes with finite input and both ends in the clip
-  // box (on the grid), which CollideFourWalks may answer.
+  // box (on the grid), which CollideFourWalks may answer; *long_motions those of them that cross
+  // more than one texel edge.
   uint32_t CollideFourShortMotions(const Float3* previous, Float3* positions, Float3* velocities,
                                    uint8_t* flags, const ResponseParams& params,
-                                   uint32_t* walk_candidates) const;
+                                   uint32_t* walk_candidates, uint32_t* long_motions) const;
   // CollideBatch for particles index[l] of the arrays, l in the mask `lanes` (SSE2, kNearest, a
   // non-empty map; unused lanes hold any valid index): each lane walks its motion texel by texel,
   // all four in step. Answers the lanes whose motion needs no clipping (both ends in the clip
