@@ -1518,6 +1518,59 @@ LaneVisit VisitLanes(__m128 top, __m128 bottom, __m128 s_enter, __m128 s_exit, _
   return visit;
 }
 
+// BodyMapCollider::ToTexels of four motions a -> b: u0, v0, u1, v1.
+struct TexelLanes {
+  __m128 u0, v0, u1, v1;
+};
+inline TexelLanes ToTexelLanes(const Lanes3& a, const Lanes3& b, float origin_x, float origin_y,
+                               float inverse_texel) {
+  const __m128 ox = _mm_set1_ps(origin_x), oy = _mm_set1_ps(origin_y);
+  const __m128 inverse = _mm_set1_ps(inverse_texel);
+  return {_mm_mul_ps(_mm_sub_ps(a.x, ox), inverse), _mm_mul_ps(_mm_sub_ps(a.y, oy), inverse),
+          _mm_mul_ps(_mm_sub_ps(b.x, ox), inverse), _mm_mul_ps(_mm_sub_ps(b.y, oy), inverse)};
+}
+
+// Two lane triples to memory, lane by lane: out[0..2] = a.x, a.y, a.z; out[3..5] = b's.
+inline void StoreLanes(const Lanes3& a, const Lanes3& b, float (&out)[6][4]) {
+  _mm_store_ps(out[0], a.x);
+  _mm_store_ps(out[1], a.y);
+  _mm_store_ps(out[2], a.z);
+  _mm_store_ps(out[3], b.x);
+  _mm_store_ps(out[4], b.y);
+  _mm_store_ps(out[5], b.z);
+}
+
+// WalkInto's contact point in lanes: the entry at parameter s on the walked segment q0 -> q1,
+// at z = entry_z, stepped back across a side wall (`wall` lanes) by `back_off_length` (metres)
+// when the segment moves in x or y; or, for the `push_out` lanes, p1 moved along z to the nearer
+// surface of its interval [end_bottom, end_top] (push_back: the bottom one).
+struct LanePoint {
+  Lanes3 point;
+  __m128 push_back;
+};
+inline LanePoint PlaceContactLanes(const Lanes3& q0, const Lanes3& q1, __m128 s, __m128 entry_z,
+                                   __m128 wall, __m128 push_out, const Lanes3& p1, __m128 end_top,
+                                   __m128 end_bottom, float back_off_length) {
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 dx = _mm_sub_ps(q1.x, q0.x), dy = _mm_sub_ps(q1.y, q0.y);
+  __m128 back_off = zero, stepped_back = zero;
+  if (_mm_movemask_ps(wall) != 0) {
+    const __m128 length = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)));
+    back_off = _mm_div_ps(_mm_set1_ps(back_off_length), length);
+    stepped_back = _mm_and_ps(wall, _mm_cmpgt_ps(length, zero));
+  }
+  const __m128 x = AlongLanes(q0.x, q1.x, s), y = AlongLanes(q0.y, q1.y, s);
+  LanePoint placed;
+  placed.push_back = _mm_cmplt_ps(_mm_sub_ps(p1.z, end_bottom), _mm_sub_ps(end_top, p1.z));
+  placed.point = {
+      SelectLanes(push_out, p1.x,
+                  SelectLanes(stepped_back, _mm_sub_ps(x, _mm_mul_ps(dx, back_off)), x)),
+      SelectLanes(push_out, p1.y,
+                  SelectLanes(stepped_back, _mm_sub_ps(y, _mm_mul_ps(dy, back_off)), y)),
+      SelectLanes(push_out, SelectLanes(placed.push_back, end_bottom, end_top), entry_z)};
+  return placed;
+}
+
 constexpr uint32_t kConsecutiveLanes[4] = {0, 1, 2, 3};
 
 // The lanes' answers, written to element index[l] of the arrays for each lane l in `lanes`:
@@ -1548,12 +1601,7 @@ constexpr uint32_t kConsecutiveLanes[4] = {0, 1, 2, 3};
   const Lanes3 velocity = {respond(v.x, normal.x), respond(v.y, normal.y), respond(v.z, normal.z)};
 
   alignas(16) float out[6][4];
-  _mm_store_ps(out[0], position.x);
-  _mm_store_ps(out[1], position.y);
-  _mm_store_ps(out[2], position.z);
-  _mm_store_ps(out[3], velocity.x);
-  _mm_store_ps(out[4], velocity.y);
-  _mm_store_ps(out[5], velocity.z);
+  StoreLanes(position, velocity, out);
   for (int lane = 0; lane < 4; ++lane) {
     if (!((lanes >> lane) & 1u)) continue;
     const uint32_t k = index[lane];
@@ -1588,12 +1636,7 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 finite = _mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero);
   __m128 answerable = finite;
   // Both ends on the grid (ToTexels' expressions) and in the clip box's z range.
-  const __m128 origin_x = _mm_set1_ps(origin_x_), origin_y = _mm_set1_ps(origin_y_);
-  const __m128 inverse = _mm_set1_ps(inv_texel_size_);
-  const __m128 u0 = _mm_mul_ps(_mm_sub_ps(p0.x, origin_x), inverse);
-  const __m128 v0 = _mm_mul_ps(_mm_sub_ps(p0.y, origin_y), inverse);
-  const __m128 u1 = _mm_mul_ps(_mm_sub_ps(p1.x, origin_x), inverse);
-  const __m128 v1 = _mm_mul_ps(_mm_sub_ps(p1.y, origin_y), inverse);
+  const auto [u0, v0, u1, v1] = ToTexelLanes(p0, p1, origin_x_, origin_y_, inv_texel_size_);
   const __m128 width = _mm_set1_ps(width_f_), height = _mm_set1_ps(height_f_);
   const auto within = [](__m128 x, __m128 lo, __m128 hi) {
     return _mm_and_ps(_mm_cmpge_ps(x, lo), _mm_cmple_ps(x, hi));
@@ -1727,25 +1770,12 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   // texel (WalkInto), or p1 moved to the nearer surface of its slab.
   const __m128 s_hit = SelectLanes(hit_a, in_a.s, in_b.s);
   const __m128 z_hit = SelectLanes(hit_a, in_a.z, in_b.z);
-  const __m128 dx = _mm_sub_ps(p1.x, p0.x), dy = _mm_sub_ps(p1.y, p0.y);
-  // WalkInto steps back only when the motion's length in x and y is > 0. A lane crossing an
-  // edge moves at least a float step of u, so its length never underflows; the lanes test it
-  // anyway, so that they stay the walk's operations one for one.
-  __m128 back_off = zero, stepped_back = zero;
-  if (_mm_movemask_ps(wall) != 0) {
-    const __m128 length = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)));
-    back_off = _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_), length);
-    stepped_back = _mm_and_ps(wall, _mm_cmpgt_ps(length, zero));
-  }
-  const __m128 hit_x = AlongLanes(p0.x, p1.x, s_hit), hit_y = AlongLanes(p0.y, p1.y, s_hit);
-  const __m128 push_back =
-      _mm_cmplt_ps(_mm_sub_ps(p1.z, slab_b_bottom), _mm_sub_ps(slab_b_top, p1.z));
-  const Lanes3 point = {
-      SelectLanes(push_out, p1.x,
-                  SelectLanes(stepped_back, _mm_sub_ps(hit_x, _mm_mul_ps(dx, back_off)), hit_x)),
-      SelectLanes(push_out, p1.y,
-                  SelectLanes(stepped_back, _mm_sub_ps(hit_y, _mm_mul_ps(dy, back_off)), hit_y)),
-      SelectLanes(push_out, SelectLanes(push_back, slab_b_bottom, slab_b_top), z_hit)};
+  // (A lane crossing an edge moves at least a float step of u, so its length in x and y never
+  // underflows; the lanes test it anyway, so that they stay the walk's operations one for one.)
+  const LanePoint placed = PlaceContactLanes(p0, p1, s_hit, z_hit, wall, push_out, p1, slab_b_top,
+                                             slab_b_bottom, 1e-3f * texel_size_);
+  const Lanes3& point = placed.point;
+  const __m128 push_back = placed.push_back;
   // The normal: the entered surface's; at a side wall the nearer surface of B's slab; for the
   // push-out the surface p1 goes to.
   const __m128 wall_back =
@@ -1808,12 +1838,7 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   uint32_t start_clipped = 0, start_on_z_face = 0, answered_misses = 0;
   if (clipped_lanes != 0) {
     alignas(16) float ends[6][4];
-    _mm_store_ps(ends[0], q0.x);
-    _mm_store_ps(ends[1], q0.y);
-    _mm_store_ps(ends[2], q0.z);
-    _mm_store_ps(ends[3], q1.x);
-    _mm_store_ps(ends[4], q1.y);
-    _mm_store_ps(ends[5], q1.z);
+    StoreLanes(q0, q1, ends);
     for (int lane = 0; lane < 4; ++lane) {
       if (!((clipped_lanes >> lane) & 1u)) continue;
       ClippedMotion clip;
@@ -1832,12 +1857,7 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
     q1 = {_mm_load_ps(ends[3]), _mm_load_ps(ends[4]), _mm_load_ps(ends[5])};
   }
   // Both walked ends on the grid (the box can reach a texel beyond it).
-  const __m128 origin_x = _mm_set1_ps(origin_x_), origin_y = _mm_set1_ps(origin_y_);
-  const __m128 inverse = _mm_set1_ps(inv_texel_size_);
-  const __m128 u0 = _mm_mul_ps(_mm_sub_ps(q0.x, origin_x), inverse);
-  const __m128 v0 = _mm_mul_ps(_mm_sub_ps(q0.y, origin_y), inverse);
-  const __m128 u1 = _mm_mul_ps(_mm_sub_ps(q1.x, origin_x), inverse);
-  const __m128 v1 = _mm_mul_ps(_mm_sub_ps(q1.y, origin_y), inverse);
+  const auto [u0, v0, u1, v1] = ToTexelLanes(q0, q1, origin_x_, origin_y_, inv_texel_size_);
   const __m128 width = _mm_set1_ps(width_f_), height = _mm_set1_ps(height_f_);
   const auto on_grid = [&](__m128 u, __m128 limit) {
     return _mm_and_ps(_mm_cmpge_ps(u, zero), _mm_cmplt_ps(u, limit));
@@ -2229,23 +2249,11 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
     }
     return lanes | answered_misses;
   }
-  const __m128 dx = _mm_sub_ps(q1.x, q0.x), dy = _mm_sub_ps(q1.y, q0.y);
   const __m128 wall = _mm_and_ps(hit, hit_wall);
-  __m128 back_off = zero, stepped_back = zero;
-  if (_mm_movemask_ps(wall) != 0) {
-    const __m128 length = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)));
-    back_off = _mm_div_ps(_mm_set1_ps(1e-3f * texel_size_), length);
-    stepped_back = _mm_and_ps(wall, _mm_cmpgt_ps(length, zero));
-  }
-  const __m128 hit_x = AlongLanes(q0.x, q1.x, hit_s), hit_y = AlongLanes(q0.y, q1.y, hit_s);
-  const __m128 push_back =
-      _mm_cmplt_ps(_mm_sub_ps(p1.z, slab_b_bottom), _mm_sub_ps(slab_b_top, p1.z));
-  const Lanes3 point = {
-      SelectLanes(push_out, p1.x,
-                  SelectLanes(stepped_back, _mm_sub_ps(hit_x, _mm_mul_ps(dx, back_off)), hit_x)),
-      SelectLanes(push_out, p1.y,
-                  SelectLanes(stepped_back, _mm_sub_ps(hit_y, _mm_mul_ps(dy, back_off)), hit_y)),
-      SelectLanes(push_out, SelectLanes(push_back, slab_b_bottom, slab_b_top), hit_z)};
+  const LanePoint placed = PlaceContactLanes(q0, q1, hit_s, hit_z, wall, push_out, p1, slab_b_top,
+                                             slab_b_bottom, 1e-3f * texel_size_);
+  const Lanes3& point = placed.point;
+  const __m128 push_back = placed.push_back;
   const __m128 wall_back = _mm_cmplt_ps(_mm_sub_ps(hit_z, hit_bottom), _mm_sub_ps(hit_top, hit_z));
   const __m128 use_back = SelectLanes(push_out, push_back, SelectLanes(wall, wall_back, hit_back));
   const uint32_t back_lanes = static_cast<uint32_t>(_mm_movemask_ps(use_back));
