@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 
 namespace drape::bench {
@@ -114,6 +115,18 @@ Metrics Evaluate(const Method& method, const QuerySet& set,
   std::vector<uint8_t> flags(set.size());
   method.Collide(set.previous, positions, velocities, flags);
   m.own_surface_misses = method.OwnSurfaceMisses(set.previous, set.current, flags);
+  {  // the batch against one particle at a time, on these real motions
+    std::vector<Float3> one_positions = set.current, one_velocities = StepVelocities(set);
+    std::vector<uint8_t> one_flags(set.size());
+    if (method.QueryEachAndRespond(set.previous, one_positions, one_velocities, one_flags)) {
+      m.batch_mismatches = 0;
+      for (size_t k = 0; k < set.size(); ++k) {
+        m.batch_mismatches += flags[k] != one_flags[k] ||
+                              std::memcmp(&positions[k], &one_positions[k], sizeof(Float3)) != 0 ||
+                              std::memcmp(&velocities[k], &one_velocities[k], sizeof(Float3)) != 0;
+      }
+    }
+  }
 
   const long count = static_cast<long>(set.size());
   std::vector<double> penetration(set.size(), -1.0), point_error(set.size(), -1.0),

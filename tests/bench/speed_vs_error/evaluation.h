@@ -46,6 +46,9 @@ struct Metrics {
   double contact_point_p50_mm = 0.0, contact_point_p99_mm = 0.0;
   double normal_p50_deg = 0.0, normal_p99_deg = 0.0;
   long own_surface_misses = -1;  // motions into the proxy's own surface left uncaught (-1: n/a)
+  // particles whose Collide answer (flags, position, velocity) differs in a bit from
+  // Method::QueryEachAndRespond (-1: the method documents no such equality)
+  long batch_mismatches = -1;
   bool has_accuracy = false;
 };
 

@@ -28,6 +28,20 @@ class BodyMapMethod final : public Method {
                setting);
   }
   ContactQuery Query(Float3 p0, Float3 p1) const override { return collider_.Query(p0, p1); }
+  bool QueryEachAndRespond(std::span<const Float3> previous, std::span<Float3> positions,
+                           std::span<Float3> velocities, std::span<uint8_t> flags) const override {
+    for (size_t k = 0; k < positions.size(); ++k) {
+      if (!IsFinite(previous[k]) || !IsFinite(positions[k]) || !IsFinite(velocities[k])) {
+        flags[k] = kCollisionInvalidInput;
+        continue;
+      }
+      const ContactQuery c = collider_.Query(previous[k], positions[k]);
+      flags[k] = c.contact ? static_cast<uint8_t>(kCollisionContact | c.flags)
+                           : static_cast<uint8_t>(kCollisionNone);
+      if (c.contact) ApplyResponse(c, BenchResponse(), &positions[k], &velocities[k]);
+    }
+    return true;
+  }
   const BodyMapCollider& collider() const { return collider_; }
 
  private:

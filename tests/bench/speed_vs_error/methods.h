@@ -42,6 +42,15 @@ class Method {
     return -1;
   }
 
+  // Query + ApplyResponse one particle at a time, the answers Collide documents to equal bit for
+  // bit (with kCollisionInvalidInput for non-finite input); false when the method documents no
+  // such equality (then nothing is written).
+  virtual bool QueryEachAndRespond(std::span<const Float3> previous, std::span<Float3> positions,
+                                   std::span<Float3> velocities, std::span<uint8_t> flags) const {
+    (void)previous, (void)positions, (void)velocities, (void)flags;
+    return false;
+  }
+
   std::string family;        // maps, hulls, spheres, hulls+spheres, maps+hulls, peer
   std::string setting;       // human-readable, unique within a character
   size_t baked_bytes = 0;    // bytes of baked data the method needs (0: computed at run time)

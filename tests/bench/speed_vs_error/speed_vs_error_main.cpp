@@ -550,7 +550,8 @@ class Measurement {
 
   // The accuracy claims, which do not depend on the machine or its load (timings never fail a
   // check: speed targets live in the report). Every continuous hull setting catches every motion
-  // into its own surface; the exact peer, measured like a method, misses nothing (the
+  // into its own surface; a body-map batch answers every motion bit for bit as its Query and
+  // response one at a time do; the exact peer, measured like a method, misses nothing (the
   // metrics are consistent with their reference); each human character has a body-map setting with
   // p99 penetration <= 2 mm and missed rate <= 0.1 %.
   bool Check() const {
@@ -569,6 +570,13 @@ class Measurement {
       if (m.own_surface_misses > 0 && r.setting.find("discrete") == std::string::npos) {
         std::fprintf(stderr, "check: %s %s missed its own surface %ld times\n", r.character.c_str(),
                      r.setting.c_str(), m.own_surface_misses);
+        ok = false;
+      }
+      if (m.batch_mismatches > 0) {
+        std::fprintf(stderr,
+                     "check: %s %s: the batch differs from one-by-one answers for %ld "
+                     "of %zu motions\n",
+                     r.character.c_str(), r.setting.c_str(), m.batch_mismatches, m.queries);
         ok = false;
       }
       // Detection only: its response (the entry point, or the nearest surface point for a
