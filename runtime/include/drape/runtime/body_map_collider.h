@@ -177,7 +177,7 @@ class BodyMapCollider {
   // untouched. OpenMP over particles, no allocation, bitwise identical at any thread count and
   // to Query + ApplyResponse per particle (with kNearest, four particles at a time in SSE2
   // lanes: motions within a texel or across one edge, then the others walked texel by texel in
-  // step, up to kMaxLaneWalkTexels; the rest one by one). All four spans must have the same
+  // step for up to 32 texels; the rest one by one). All four spans must have the same
   // size; params must be finite. contact_count (optional) receives the number of particles with
   // kCollisionContact.
   Status CollideBatch(std::span<const Float3> previous, std::span<Float3> positions,
@@ -337,9 +337,10 @@ class BodyMapCollider {
                                    uint8_t* flags, const ResponseParams& params,
                                    uint32_t* walk_candidates, uint32_t* long_motions) const;
   // CollideBatch for particles index[l] of the arrays, l in the mask `lanes` (SSE2, kNearest, a
-  // non-empty map; unused lanes hold any valid index): each lane walks its motion texel by texel,
-  // all four in step. Answers the lanes whose motion needs no clipping (both ends in the clip
-  // box), ends within kMaxLaneWalkTexels texels and meets no texel with gaps: writes their
+  // non-empty map; unused lanes hold any valid index): each lane walks its motion, clipped to the
+  // clip box (ClipMotion), texel by texel, all four in step, texels with gaps included. Answers
+  // the lanes with finite input that miss the box, or whose clipped ends lie on the grid and
+  // whose walk ends (an entry, or the last texel) within kMaxLaneWalkTexels texels: writes their
   // flags, positions and velocities bit for bit as CollideOne would and returns their mask; the
   // other lanes are untouched.
   uint32_t CollideFourWalks(const uint32_t (&index)[4], uint32_t lanes, const Float3* previous,
