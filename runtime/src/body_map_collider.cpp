@@ -1636,7 +1636,8 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 finite = _mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero);
   __m128 answerable = finite;
   // Both ends on the grid (ToTexels' expressions) and in the clip box's z range.
-  const auto [u0, v0, u1, v1] = ToTexelLanes(p0, p1, origin_x_, origin_y_, inv_texel_size_);
+  const TexelLanes texels = ToTexelLanes(p0, p1, origin_x_, origin_y_, inv_texel_size_);
+  const __m128 u0 = texels.u0, v0 = texels.v0, u1 = texels.u1, v1 = texels.v1;
   const __m128 width = _mm_set1_ps(width_f_), height = _mm_set1_ps(height_f_);
   const auto within = [](__m128 x, __m128 lo, __m128 hi) {
     return _mm_and_ps(_mm_cmpge_ps(x, lo), _mm_cmple_ps(x, hi));
@@ -1857,7 +1858,10 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
     q1 = {_mm_load_ps(ends[3]), _mm_load_ps(ends[4]), _mm_load_ps(ends[5])};
   }
   // Both walked ends on the grid (the box can reach a texel beyond it).
-  const auto [u0, v0, u1, v1] = ToTexelLanes(q0, q1, origin_x_, origin_y_, inv_texel_size_);
+  // (Named copies, not a structured binding: lambdas below capture them, which clang < 16
+  // rejects for bindings.)
+  const TexelLanes texels = ToTexelLanes(q0, q1, origin_x_, origin_y_, inv_texel_size_);
+  const __m128 u0 = texels.u0, v0 = texels.v0, u1 = texels.u1, v1 = texels.v1;
   const __m128 width = _mm_set1_ps(width_f_), height = _mm_set1_ps(height_f_);
   const auto on_grid = [&](__m128 u, __m128 limit) {
     return _mm_and_ps(_mm_cmpge_ps(u, zero), _mm_cmplt_ps(u, limit));
