@@ -1374,8 +1374,9 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
     // Groups of four consecutive particles go through the short-motion lanes first; the
     // particles they do not answer queue for the walking lanes, four at a time, and what those
     // do not answer goes one by one. Where particles move a texel or more per step the short
-    // lanes answer few and their work is wasted: after a group they answered fewer than two
-    // of, the next kScalarGroups groups queue directly. Every path gives the same bits.
+    // lanes answer few and their work is wasted: after a group with two or more motions across
+    // more than one texel edge, the next kScalarGroups groups queue directly. Every path gives
+    // the same bits.
     constexpr int kScalarGroups = 4;
     int skip_short = 0;
     uint32_t queued[4];
@@ -1404,7 +1405,7 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
       }
       for (uint32_t lane = 0; lane < 4; ++lane) {
         if (answered & (1u << lane)) continue;
-        if (!(walk_candidates & (1u << lane))) {  // needs clipping, or invalid: no lane takes it
+        if (!(walk_candidates & (1u << lane))) {  // non-finite input: CollideOne flags it
           flags[k + lane] =
               CollideOne(previous[k + lane], &positions[k + lane], &velocities[k + lane], params);
           continue;
@@ -1670,7 +1671,7 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 in_box = _mm_and_ps(
       answerable, _mm_and_ps(_mm_and_ps(within(p0.x, x_lo, x_hi), within(p1.x, x_lo, x_hi)),
                              _mm_and_ps(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))));
-  *walk_candidates = static_cast<uint32_t>(_mm_movemask_ps(in_box));
+  *walk_candidates = static_cast<uint32_t>(_mm_movemask_ps(finite));
   *long_motions =
       static_cast<uint32_t>(_mm_movemask_ps(_mm_andnot_ps(_mm_or_ps(in_one, two), in_box)));
   answerable = _mm_or_ps(_mm_and_ps(answerable, in_one), _mm_and_ps(in_box, two));

@@ -330,9 +330,9 @@ class BodyMapCollider {
   // and no gaps in either texel, and for those whose motion keeps one coordinate outside the
   // clip box (no contact): writes their flags, positions and velocities bit for bit as
   // CollideOne would and returns their lane mask (bit l = particle l); the other lanes are
-  // untouched. *walk_candidates receives the lanes with finite input and both ends in the clip
-  // box (on the grid), which CollideFourWalks may answer; *long_motions those of them that cross
-  // more than one texel edge.
+  // untouched. *walk_candidates receives the lanes with finite input, which CollideFourWalks
+  // may answer; *long_motions those with both ends in the clip box that cross more than one
+  // texel edge.
   uint32_t CollideFourShortMotions(const Float3* previous, Float3* positions, Float3* velocities,
                                    uint8_t* flags, const ResponseParams& params,
                                    uint32_t* walk_candidates, uint32_t* long_motions) const;
