@@ -481,10 +481,39 @@ struct BodyMapWalk {
       const auto clamp_j = [&](int x) {
         return std::min(std::max(x, lo_j), lo_j + kBlockCells - 1);
       };
-      const int first_i = clamp_i(s_enter == 0.f ? ci0 : FloorToInt(U(s_enter) * kSub));
-      const int first_j = clamp_j(s_enter == 0.f ? cj0 : FloorToInt(V(s_enter) * kSub));
-      const int last_i = clamp_i(s_exit == 1.f ? ci1 : FloorToInt(U(s_exit) * kSub));
-      const int last_j = clamp_j(s_exit == 1.f ? cj1 : FloorToInt(V(s_exit) * kSub));
+      // The block's first and last cells are the one-level walk's own: along each axis, the
+      // cell after every edge whose crossing parameter (WalkCells' expression) is <= s_enter,
+      // and before every edge whose crossing is >= s_exit. The position at s only estimates it:
+      // near a block corner U(s) or V(s) can round to the other side of an edge, and the blocks
+      // must visit exactly the cells of the one-level walk (the batch's lanes walk one level).
+      const auto exact_cell = [](int estimate, int c0, int c1, float g0, float inverse, float s,
+                                 bool strict) {
+        const int step = (c1 > c0) - (c1 < c0);
+        if (step == 0) return c0;
+        const int edge = step > 0 ? 1 : 0;    // the edge a cell is left through
+        const auto crossed = [&](int cell) {  // the edge leaving `cell` is crossed by s
+          const float at = (static_cast<float>(cell + edge) - g0) * inverse;
+          return strict ? at < s : at <= s;
+        };
+        int cell = std::min(std::max(estimate, std::min(c0, c1)), std::max(c0, c1));
+        while (cell != c1 && crossed(cell)) cell += step;
+        while (cell != c0 && !crossed(cell - step)) cell -= step;
+        return cell;
+      };
+      const int first_i =
+          clamp_i(s_enter == 0.f ? ci0
+                                 : exact_cell(FloorToInt(U(s_enter) * kSub), ci0, ci1, line.g0x,
+                                              line.inv_dx, s_enter, false));
+      const int first_j =
+          clamp_j(s_enter == 0.f ? cj0
+                                 : exact_cell(FloorToInt(V(s_enter) * kSub), cj0, cj1, line.g0y,
+                                              line.inv_dy, s_enter, false));
+      const int last_i = clamp_i(s_exit == 1.f ? ci1
+                                               : exact_cell(FloorToInt(U(s_exit) * kSub), ci0, ci1,
+                                                            line.g0x, line.inv_dx, s_exit, true));
+      const int last_j = clamp_j(s_exit == 1.f ? cj1
+                                               : exact_cell(FloorToInt(V(s_exit) * kSub), cj0, cj1,
+                                                            line.g0y, line.inv_dy, s_exit, true));
       return WalkCells(line, 0, first_i, first_j, last_i, last_j, s_enter, s_exit, visit);
     };
     WalkCells(line, kShift, ci0 >> kShift, cj0 >> kShift, ci1 >> kShift, cj1 >> kShift, 0.f, 1.f,
