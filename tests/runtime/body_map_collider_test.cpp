@@ -1542,7 +1542,8 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
 // Query's long walks step 8x8 blocks; the batch's lanes step texels. A segment through a texel
 // corner on a block's edge is where the block walk could begin a block in another texel than the
 // texel walk (the crossing point's other coordinate rounds across an edge): both must visit the
-// same texels, so the answers are the same bits. (Without 7497812: 190 of 80 000 differ.)
+// same texels, so the answers are the same bits. (Without 7497812, 190 of the sphere's 40 000
+// differ.)
 TEST(BodyMapBatch, LongWalksThroughBlockEdgeCornersAnswerAsQuery) {
   const BodyMapCollider bodies[2] = {BuildOrDie(MakePose(SphereGrid(), Sphere)),
                                      BuildOrDie(LayeredPose(3, kStack))};
