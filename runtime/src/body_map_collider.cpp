@@ -1423,22 +1423,17 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
       queued_count = 0;
     };
     for (; k + 4 <= count; k += 4) {
-      uint32_t answered = 0, walk_candidates = 0xf, long_motions = 0;
+      uint32_t answered = 0, long_motions = 0;
       if (skip_short > 0) {
         --skip_short;
       } else {
         answered = CollideFourShortMotions(previous + k, positions + k, velocities + k, flags + k,
-                                           params, &walk_candidates, &long_motions);
+                                           params, &long_motions);
         // (Lanes it declines for gaps are short: they do not count.)
         if (std::popcount(long_motions) >= 2) skip_short = kScalarGroups;
       }
       for (uint32_t lane = 0; lane < 4; ++lane) {
         if (answered & (1u << lane)) continue;
-        if (!(walk_candidates & (1u << lane))) {  // non-finite input: CollideOne flags it
-          flags[k + lane] =
-              CollideOne(previous[k + lane], &positions[k + lane], &velocities[k + lane], params);
-          continue;
-        }
         queued[queued_count++] = static_cast<uint32_t>(k + lane);
         if (queued_count == 4) walk_queued();
       }
@@ -1548,6 +1543,16 @@ LaneVisit VisitLanes(__m128 top, __m128 bottom, __m128 s_enter, __m128 s_exit, _
   return visit;
 }
 
+// Lanes whose nine input values are all finite: a sum holding a NaN or an infinity is not
+// finite (an overflowing one only sends a finite lane to the one-by-one path).
+inline __m128 FiniteLanes(const Lanes3& p0, const Lanes3& p1, const Lanes3& v) {
+  const __m128 sum =
+      _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(p0.x, p0.y), _mm_add_ps(p0.z, p1.x)),
+                            _mm_add_ps(_mm_add_ps(p1.y, p1.z), _mm_add_ps(v.x, v.y))),
+                 v.z);
+  return _mm_cmpeq_ps(_mm_sub_ps(sum, sum), _mm_setzero_ps());
+}
+
 // BodyMapCollider::ToTexels of four motions a -> b: u0, v0, u1, v1.
 struct TexelLanes {
   __m128 u0, v0, u1, v1;
@@ -1653,17 +1658,10 @@ constexpr uint32_t kConsecutiveLanes[4] = {0, 1, 2, 3};
 uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3* positions,
                                                   Float3* velocities, uint8_t* flags,
                                                   const ResponseParams& params,
-                                                  uint32_t* walk_candidates,
                                                   uint32_t* long_motions) const {
   const Lanes3 p0 = LoadLanes(previous), p1 = LoadLanes(positions), v = LoadLanes(velocities);
-  // Finite input (a sum holding a NaN or an infinity is not finite; an overflowing one only
-  // sends the lane to CollideOne).
-  const __m128 sum =
-      _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(p0.x, p0.y), _mm_add_ps(p0.z, p1.x)),
-                            _mm_add_ps(_mm_add_ps(p1.y, p1.z), _mm_add_ps(v.x, v.y))),
-                 v.z);
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
-  const __m128 finite = _mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero);
+  const __m128 finite = FiniteLanes(p0, p1, v);
   __m128 answerable = finite;
   // Both ends on the grid (ToTexels' expressions) and in the clip box's z range.
   const TexelLanes texels = ToTexelLanes(p0, p1, origin_x_, origin_y_, inv_texel_size_);
@@ -1700,7 +1698,6 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   const __m128 in_box = _mm_and_ps(
       answerable, _mm_and_ps(_mm_and_ps(within(p0.x, x_lo, x_hi), within(p1.x, x_lo, x_hi)),
                              _mm_and_ps(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))));
-  *walk_candidates = static_cast<uint32_t>(_mm_movemask_ps(finite));
   *long_motions =
       static_cast<uint32_t>(_mm_movemask_ps(_mm_andnot_ps(_mm_or_ps(in_one, two), in_box)));
   answerable = _mm_or_ps(_mm_and_ps(answerable, in_one), _mm_and_ps(in_box, two));
@@ -1841,13 +1838,9 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
                   _mm_setr_ps(a0.z, a1.z, a2.z, a3.z)};
   };
   const Lanes3 p0 = gather(previous), p1 = gather(positions), v = gather(velocities);
-  // Finite input, as CollideFourShortMotions checks it.
-  const __m128 sum =
-      _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(p0.x, p0.y), _mm_add_ps(p0.z, p1.x)),
-                            _mm_add_ps(_mm_add_ps(p1.y, p1.z), _mm_add_ps(v.x, v.y))),
-                 v.z);
+  // Finite input (non-finite lanes go one by one, which flags them).
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f), inf = _mm_set1_ps(kInf);
-  lanes &= static_cast<uint32_t>(_mm_movemask_ps(_mm_cmpeq_ps(_mm_sub_ps(sum, sum), zero)));
+  lanes &= static_cast<uint32_t>(_mm_movemask_ps(FiniteLanes(p0, p1, v)));
   if (lanes == 0) return 0;
   // Ends in the clip box (its x and y as the nearest inside floats: the double test's answer).
   const auto within = [](__m128 x, __m128 lo, __m128 hi) {

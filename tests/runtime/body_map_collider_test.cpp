@@ -40,9 +40,8 @@ struct BodyMapColliderTestAccess {
   // the batch).
   static uint32_t CollideFour(const BodyMapCollider& c, const Float3* previous, Float3* positions,
                               Float3* velocities, uint8_t* flags, const ResponseParams& params) {
-    uint32_t walk_candidates = 0, long_motions = 0;
-    return c.CollideFourShortMotions(previous, positions, velocities, flags, params,
-                                     &walk_candidates, &long_motions);
+    uint32_t long_motions = 0;
+    return c.CollideFourShortMotions(previous, positions, velocities, flags, params, &long_motions);
   }
   // CollideBatch's walking lanes alone, on particles index[l] for l in `lanes`.
   static uint32_t CollideWalks(const BodyMapCollider& c, const uint32_t (&index)[4], uint32_t lanes,

@@ -330,12 +330,11 @@ class BodyMapCollider {
   // and no gaps in either texel, and for those whose motion keeps one coordinate outside the
   // clip box (no contact): writes their flags, positions and velocities bit for bit as
   // CollideOne would and returns their lane mask (bit l = particle l); the other lanes are
-  // untouched. *walk_candidates receives the lanes with finite input, which CollideFourWalks
-  // may answer; *long_motions those with both ends in the clip box that cross more than one
-  // texel edge.
+  // untouched. *long_motions receives the lanes with finite input and both ends in the clip box
+  // that cross more than one texel edge.
   uint32_t CollideFourShortMotions(const Float3* previous, Float3* positions, Float3* velocities,
                                    uint8_t* flags, const ResponseParams& params,
-                                   uint32_t* walk_candidates, uint32_t* long_motions) const;
+                                   uint32_t* long_motions) const;
   // CollideBatch for particles index[l] of the arrays, l in the mask `lanes` (SSE2, kNearest, a
   // non-empty map; unused lanes hold any valid index): each lane walks its motion, clipped to the
   // clip box (ClipMotion), texel by texel, all four in step, texels with gaps included. Answers
