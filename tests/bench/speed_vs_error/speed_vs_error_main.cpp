@@ -194,6 +194,15 @@ std::vector<MapSetting> MapSweep(bool quick) {
   std::vector<MapSetting> sweep;
   const std::vector<uint32_t> sizes =
       quick ? std::vector<uint32_t>{256, 512} : std::vector<uint32_t>{256, 512, 1024, 2048};
+  if (!quick) {
+    // Below paper A's sizes, nearest only: where the misses start, and the cost floor that the
+    // fixed per-particle work sets (N = 128 costs about what N = 256 does).
+    for (uint32_t n : {128u, 192u}) {
+      MapSetting m;
+      m.resolution = n;
+      sweep.push_back(m);
+    }
+  }
   for (uint32_t n : sizes) {
     for (DepthSampling s : {DepthSampling::kNearest, DepthSampling::kBilinear}) {
       MapSetting m;
