@@ -14,7 +14,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   drape::bake::BakeConfig config;
   if (!drape::bake::ApplyBakeConfig(parsed, "fuzz.json", &config).ok()) return 0;
   drape::bake::BakeConfig again;
-  if (!drape::bake::ApplyBakeConfig(drape::bake::BakeConfigToJson(config), "again", &again).ok()) std::abort();
+  if (!drape::bake::ApplyBakeConfig(drape::bake::BakeConfigToJson(config), "again", &again).ok())
+    std::abort();
   if (drape::bake::BakeConfigToJson(again) != drape::bake::BakeConfigToJson(config)) std::abort();
   return 0;
 }

@@ -60,8 +60,8 @@
 //     every input point x with d >= n.x + delta*|n| plus the worst-case rounding error of a float
 //     dot product (3 float ulps of sum |n_i x_i|, and of the delta-ball point), rounded up to float
 //     and one more float ulp up. So the runtime test fl(dot(n, p)) <= d in float accepts every
-//     float point p within delta of an input point, and every collider vertex. (kVertexNormalOffset:
-//     over the collider vertices only, see step 2.)
+//     float point p within delta of an input point, and every collider vertex.
+//     (kVertexNormalOffset: over the collider vertices only, see step 2.)
 //  6. OBB of the final collider: kCovariance = paper's statistical method, covariance of the hull
 //     surface (area weighted, Gottschalk); kCgalOptimal = CGAL::oriented_bounding_box with a fixed
 //     seed. Axes orthonormal, right-handed, axes[0] the longest. Half extents cover every collider
