@@ -289,6 +289,13 @@ const std::vector<Parameter>& Parameters() {
                [](BakeConfig& c) -> bool& { return c.spheres_enabled; }),
       MakeFloat("spheres", "delta", "m", 0, 0.1, false, "added to each joint sphere's radius",
                 [](BakeConfig& c) -> float& { return c.sphere_delta; }),
+      MakeEnum<SphereCover>(
+          "spheres", "cover",
+          {{"flexible", SphereCover::kFlexible}, {"left_by_hulls", SphereCover::kLeftByHulls}},
+          "flexible: every flexible vertex of the joint (paper B); left_by_hulls: only the "
+          "corners of rest-pose triangles no single hull holds (smaller spheres on smoothly "
+          "weighted rigs; needs hulls.enabled)",
+          [](BakeConfig& c) -> SphereCover& { return c.sphere_cover; }),
   };
   return table;
 }

@@ -349,7 +349,11 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   }
   if (config.spheres_enabled) {
     start = Clock::now();
-    asset.joint_spheres = BuildJointSpheres(regions, config.sphere_delta);
+    static const std::vector<HullColliderData> kNoHulls;
+    const bool left_by_hulls = config.sphere_cover == SphereCover::kLeftByHulls;
+    asset.joint_spheres =
+        BuildJointSpheres(regions, config.sphere_delta, left_by_hulls ? asset.hulls : kNoHulls,
+                          character.mesh.triangles);
     json spheres = json::array();
     for (const JointSphereData& s : asset.joint_spheres) {
       spheres.push_back(

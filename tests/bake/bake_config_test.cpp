@@ -31,6 +31,10 @@ TEST(BakeConfig, OutOfRangeAndUnknownKeysNameTheirPath) {
   EXPECT_NE(s.message().find("c.json: /maps/renderer 'vulkan' is not one of cpu | osmesa"),
             std::string::npos)
       << s.message();
+  s = ApplyBakeConfig({{"spheres", {{"cover", "all"}}}}, "c.json", &config);
+  EXPECT_NE(s.message().find("c.json: /spheres/cover 'all' is not one of flexible | left_by_hulls"),
+            std::string::npos)
+      << s.message();
   s = ApplyBakeConfig({{"hull", {{"delta", 0.01}}}}, "c.json", &config);
   EXPECT_NE(s.message().find("/hull/delta is not a parameter"), std::string::npos) << s.message();
   s = ApplyBakeConfig({{"hulls", 3}}, "c.json", &config);

@@ -157,6 +157,86 @@ TEST_P(BakeEveryCharacter, BodyMapsAgreeWithWindingNumber) {
   }
 }
 
+// spheres.cover left_by_hulls: the same spheres (joints, centres) as paper B's, none larger, and
+// every rest-pose triangle with a flexible corner lies in one hull or has each flexible corner in
+// its joint's sphere (the runtime's float tests on the stored values).
+TEST_P(BakeEveryCharacter, SpheresLeftByHullsHoldWhatNoHullHolds) {
+  const std::string path = Path();
+  DRAPE_REQUIRE_FILE(path);
+  BakeConfig config;
+  config.maps_enabled = false;
+  BakeResult flexible, left;
+  ASSERT_TRUE(BakeCharacter(path, config, &flexible).ok());
+  config.sphere_cover = bake::SphereCover::kLeftByHulls;
+  ASSERT_TRUE(BakeCharacter(path, config, &left).ok());
+  const auto& paper_b = flexible.asset.joint_spheres;
+  const auto& spheres = left.asset.joint_spheres;
+  ASSERT_EQ(spheres.size(), paper_b.size());
+  uint32_t smaller = 0;
+  for (size_t k = 0; k < spheres.size(); ++k) {
+    EXPECT_EQ(spheres[k].joint, paper_b[k].joint);
+    EXPECT_EQ(spheres[k].parent_joint, paper_b[k].parent_joint);
+    EXPECT_EQ(Length(spheres[k].center - paper_b[k].center), 0.f);
+    EXPECT_LE(spheres[k].radius, paper_b[k].radius);
+    smaller += spheres[k].radius < paper_b[k].radius;
+  }
+  if (!*GetParam().path) {
+    EXPECT_GT(smaller, 0u) << "the mannequin's spheres shrink";
+  }
+
+  bake::Character character;
+  ASSERT_TRUE(bake::ImportCharacter(path, config.import, &character).ok());
+  bake::Regions regions;
+  ASSERT_TRUE(
+      bake::SplitRegions(character, config.rigid_threshold, &regions, config.shape_threshold).ok());
+  std::vector<int32_t> sphere_of(regions.rest_positions.size(), -1);
+  for (const bake::JointRegion& region : regions.joints) {
+    for (size_t k = 0; k < spheres.size(); ++k) {
+      if (spheres[k].joint != region.child || spheres[k].parent_joint != region.parent) continue;
+      for (uint32_t v : region.flexible_vertices) sphere_of[v] = static_cast<int32_t>(k);
+    }
+  }
+  const auto in_sphere = [&](uint32_t v) {
+    const bake::JointRegion* region = nullptr;
+    for (const bake::JointRegion& r : regions.joints) {
+      if (r.child == spheres[sphere_of[v]].joint && r.parent == spheres[sphere_of[v]].parent_joint)
+        region = &r;
+    }
+    return region != nullptr &&
+           Length(regions.rest_positions[v] - region->center) <= spheres[sphere_of[v]].radius;
+  };
+  const auto in_hull = [&](const HullColliderData& hull, uint32_t v) {
+    const Float3 p = TransformPoint(InverseRigid(regions.collider_frames[hull.joint]),
+                                    regions.rest_positions[v]);
+    for (const Plane& plane : hull.planes) {
+      if (Dot(plane.normal, p) > plane.offset) return false;
+    }
+    return true;
+  };
+  const std::vector<uint32_t>& triangles = character.mesh.triangles;
+  uint32_t checked = 0, held_by_spheres = 0;
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    const uint32_t corner[3] = {triangles[t], triangles[t + 1], triangles[t + 2]};
+    if (sphere_of[corner[0]] < 0 && sphere_of[corner[1]] < 0 && sphere_of[corner[2]] < 0) continue;
+    ++checked;
+    const bool in_one_hull =
+        std::any_of(left.asset.hulls.begin(), left.asset.hulls.end(), [&](const auto& hull) {
+          return in_hull(hull, corner[0]) && in_hull(hull, corner[1]) && in_hull(hull, corner[2]);
+        });
+    if (in_one_hull) continue;
+    ++held_by_spheres;
+    for (uint32_t v : corner) {
+      if (sphere_of[v] >= 0) {
+        EXPECT_TRUE(in_sphere(v)) << "triangle " << t / 3 << " vertex " << v;
+      }
+    }
+  }
+  if (!spheres.empty()) {
+    EXPECT_GT(checked, 0u);
+  }
+  RecordProperty("triangles_left_to_spheres", static_cast<int>(held_by_spheres));
+}
+
 INSTANTIATE_TEST_SUITE_P(
     SharedCharacters, BakeEveryCharacter,
     ::testing::Values(CharacterCase{"", 0.995},

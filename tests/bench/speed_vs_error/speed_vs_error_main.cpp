@@ -314,6 +314,12 @@ std::vector<HullBake> HullBakes(const bake::ImportOptions& import, bool quick) {
                                   : "shape threshold " + std::to_string(shape).substr(0, 4),
                      c});
   }
+  {
+    // Joint spheres over what the hulls leave out, not over every flexible vertex.
+    bake::BakeConfig c = base();
+    c.sphere_cover = bake::SphereCover::kLeftByHulls;
+    bakes.push_back({"spheres left by hulls", c});
+  }
   for (uint32_t rows : {8u, 32u}) {
     bake::BakeConfig c = base();
     c.map_table.sphere_rows = c.map_table.cylinder_rows = rows;
@@ -462,10 +468,11 @@ class Measurement {
     if (!options_.quick) RunPosed(spec, character, for_posed);
   }
 
-  // The hull settings the posed run measures: the defaults and the thresholds.
+  // The hull settings the posed run measures: the defaults, the thresholds, and the spheres left
+  // by hulls (a bent joint is what a joint sphere is for).
   static bool MeasuredPosed(const std::string& label) {
-    for (const char* prefix :
-         {"default", "shape threshold", "paper B's rigid-only", "rigid threshold"}) {
+    for (const char* prefix : {"default", "shape threshold", "paper B's rigid-only",
+                               "rigid threshold", "spheres left by hulls"}) {
       if (label.rfind(prefix, 0) == 0) return true;
     }
     return false;

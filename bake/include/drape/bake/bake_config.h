@@ -15,6 +15,12 @@
 
 namespace drape::bake {
 
+// What a joint sphere's radius reaches (BuildJointSpheres).
+enum class SphereCover : uint8_t {
+  kFlexible = 0,     // every flexible vertex of the joint's two bones (paper B)
+  kLeftByHulls = 1,  // only what the bones' hulls leave out of the rest-pose mesh
+};
+
 struct BakeConfig {
   ImportOptions import;
 
@@ -42,6 +48,9 @@ struct BakeConfig {
 
   bool spheres_enabled = true;  // paper B: a sphere per joint over its flexible vertices
   float sphere_delta = 0.005f;  // metres added to each joint sphere's radius, >= 0
+  // What a joint sphere holds (spheres.cover). Paper B's default; kLeftByHulls shrinks the spheres
+  // of smoothly weighted rigs (CesiumMan: 12-34 cm radii) to what the hulls do not hold.
+  SphereCover sphere_cover = SphereCover::kFlexible;
 };
 
 // Reads a JSON config file over the defaults in `config`. `path` names the file in messages.

@@ -37,7 +37,11 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
                     float shape_threshold = 1.f);
 
 // Joint spheres (paper B §2.3): centred on the joint, radius covering its flexible vertices plus
-// delta (metres). Written into the bind-pose frame the runtime expects.
-std::vector<JointSphereData> BuildJointSpheres(const Regions& regions, float delta);
+// delta (metres). Written into the bind-pose frame the runtime expects. With the bones' hulls
+// (inflated, built from `regions`) and the mesh's triangles, a sphere covers only what the hulls
+// leave out: the corners of rest-pose triangles that no single hull holds.
+std::vector<JointSphereData> BuildJointSpheres(const Regions& regions, float delta,
+                                               const std::vector<HullColliderData>& hulls = {},
+                                               const std::vector<uint32_t>& triangles = {});
 
 }  // namespace drape::bake
