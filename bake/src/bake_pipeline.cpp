@@ -351,6 +351,11 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     start = Clock::now();
     static const std::vector<HullColliderData> kNoHulls;
     const bool left_by_hulls = config.sphere_cover == SphereCover::kLeftByHulls;
+    if (left_by_hulls && asset.hulls.empty()) {
+      character.warnings.push_back(
+          "spheres.cover is left_by_hulls but no hull was baked: the joint spheres cover every "
+          "flexible vertex (paper B)");
+    }
     asset.joint_spheres =
         BuildJointSpheres(regions, config.sphere_delta, left_by_hulls ? asset.hulls : kNoHulls,
                           character.mesh.triangles);

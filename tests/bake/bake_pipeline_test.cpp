@@ -346,6 +346,27 @@ TEST(BakePipeline, ShapingVerticesGrowTheHullsAndKeepTheSpheres) {
 // With paper B's rigid-only hulls, a smoothly weighted rig (CesiumMan: 13 % of its vertices
 // reach 0.99) gets a warning naming the thresholds; the mannequin (68 %) does not; a lower rigid
 // or shape threshold (the default 0.51) removes it.
+// Without hulls there is nothing for left_by_hulls to leave out: paper B's spheres, and a warning.
+TEST(BakePipeline, SpheresLeftByHullsWithoutHullsWarnAndKeepPaperB) {
+  BakeConfig config;
+  config.maps_enabled = false;
+  config.hulls_enabled = false;
+  BakeResult paper_b, left;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &paper_b).ok());
+  config.sphere_cover = bake::SphereCover::kLeftByHulls;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &left).ok());
+  ASSERT_EQ(left.asset.joint_spheres.size(), paper_b.asset.joint_spheres.size());
+  for (size_t k = 0; k < left.asset.joint_spheres.size(); ++k) {
+    EXPECT_EQ(left.asset.joint_spheres[k].radius, paper_b.asset.joint_spheres[k].radius);
+  }
+  int warned = 0;
+  for (const auto& w : left.report["warnings"]) {
+    warned += w.get<std::string>().find("spheres.cover is left_by_hulls but no hull") !=
+              std::string::npos;
+  }
+  EXPECT_EQ(warned, 1);
+}
+
 TEST(BakePipeline, WarnsWhenFewVerticesShapeTheHulls) {
   const auto rigid_warnings = [](const nlohmann::json& report) {
     int count = 0;
