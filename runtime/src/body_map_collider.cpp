@@ -1575,6 +1575,17 @@ inline void StoreLanes(const Lanes3& a, const Lanes3& b, float (&out)[6][4]) {
   _mm_store_ps(out[5], b.z);
 }
 
+// The slabs (top, bottom) of four texels as lanes: 8-byte loads into halves and two shuffles.
+// (Four scalar stores read back as one vector would stall the store forwarding.)
+inline void LoadSlabLanes(const float* slabs, size_t t0, size_t t1, size_t t2, size_t t3,
+                          __m128* top, __m128* bottom) {
+  const auto pair = [&](size_t t) { return reinterpret_cast<const __m64*>(slabs + 2 * t); };
+  const __m128 slabs01 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(t0)), pair(t1));
+  const __m128 slabs23 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(t2)), pair(t3));
+  *top = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(2, 0, 2, 0));
+  *bottom = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(3, 1, 3, 1));
+}
+
 // WalkInto's contact point in lanes: the entry at parameter s on the walked segment q0 -> q1,
 // at z = entry_z, stepped back across a side wall (`wall` lanes) by `back_off_length` (metres)
 // when the segment moves in x or y; or, for the `push_out` lanes, p1 moved along z to the nearer
@@ -1725,17 +1736,12 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
   _mm_store_si128(reinterpret_cast<__m128i*>(ib), i1);
   _mm_store_si128(reinterpret_cast<__m128i*>(jb), j1);
   size_t texel_a[4], texel_b[4];
-  alignas(16) float top_a[4], bottom_a[4], top_b[4], bottom_b[4];
   for (int lane = 0; lane < 4; ++lane) {
     const bool used = (lanes >> lane) & 1u;
     texel_a[lane] =
         used ? static_cast<size_t>(ja[lane]) * width_ + static_cast<size_t>(ia[lane]) : 0;
     texel_b[lane] =
         used ? static_cast<size_t>(jb[lane]) * width_ + static_cast<size_t>(ib[lane]) : 0;
-    top_a[lane] = slabs_[texel_a[lane]].top;
-    bottom_a[lane] = slabs_[texel_a[lane]].bottom;
-    top_b[lane] = slabs_[texel_b[lane]].top;
-    bottom_b[lane] = slabs_[texel_b[lane]].bottom;
   }
   if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
     for (int lane = 0; lane < 4; ++lane) {
@@ -1747,8 +1753,12 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
     }
   }
   if (lanes == 0) return free_lanes;
-  const __m128 slab_a_top = _mm_load_ps(top_a), slab_a_bottom = _mm_load_ps(bottom_a);
-  const __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
+  const float* slab_floats = &slabs_[0].top;
+  __m128 slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
+  LoadSlabLanes(slab_floats, texel_a[0], texel_a[1], texel_a[2], texel_a[3], &slab_a_top,
+                &slab_a_bottom);
+  LoadSlabLanes(slab_floats, texel_b[0], texel_b[1], texel_b[2], texel_b[3], &slab_b_top,
+                &slab_b_bottom);
 
   // The walk (BodyMapWalk::Run<1>): the crossing parameter of the edge, A over [0, s_cross],
   // then B over [s_cross, 1]. One texel: A over [0, 1], and B (the same texel) adds nothing.
@@ -1919,21 +1929,24 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   };
   const auto gather_gaps = [&](const int32_t(&ci)[4], const int32_t(&cj)[4], uint32_t which,
                                GapLanes* out) {
-    alignas(16) float upper[kMaxBodyMapLayers - 1][4], lower[kMaxBodyMapLayers - 1][4];
+    int64_t base[4];
     uint32_t with_gaps = 0;
     for (int lane = 0; lane < 4; ++lane) {
-      const int64_t base = ((which >> lane) & 1u) ? GapBase(static_cast<uint32_t>(ci[lane]),
-                                                            static_cast<uint32_t>(cj[lane]))
-                                                  : -1;
-      with_gaps |= static_cast<uint32_t>(base >= 0) << lane;
-      for (uint32_t g = 0; g < gap_layers_; ++g) {
-        upper[g][lane] = base >= 0 ? gaps_[static_cast<size_t>(base) + g].top : -kInf;
-        lower[g][lane] = base >= 0 ? gaps_[static_cast<size_t>(base) + g].bottom : kInf;
-      }
+      base[lane] = ((which >> lane) & 1u)
+                       ? GapBase(static_cast<uint32_t>(ci[lane]), static_cast<uint32_t>(cj[lane]))
+                       : -1;
+      with_gaps |= static_cast<uint32_t>(base[lane] >= 0) << lane;
     }
+    // Built from scalars, not stored and read back (that would stall the store forwarding).
+    const auto top = [&](int lane, uint32_t g) {
+      return base[lane] >= 0 ? gaps_[static_cast<size_t>(base[lane]) + g].top : -kInf;
+    };
+    const auto bottom = [&](int lane, uint32_t g) {
+      return base[lane] >= 0 ? gaps_[static_cast<size_t>(base[lane]) + g].bottom : kInf;
+    };
     for (uint32_t g = 0; g < gap_layers_; ++g) {
-      out->top[g] = _mm_load_ps(upper[g]);
-      out->bottom[g] = _mm_load_ps(lower[g]);
+      out->top[g] = _mm_setr_ps(top(0, g), top(1, g), top(2, g), top(3, g));
+      out->bottom[g] = _mm_setr_ps(bottom(0, g), bottom(1, g), bottom(2, g), bottom(3, g));
     }
     return with_gaps;
   };
@@ -1976,15 +1989,12 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   _mm_store_si128(reinterpret_cast<__m128i*>(ja), j0);
   _mm_store_si128(reinterpret_cast<__m128i*>(ib), i1);
   _mm_store_si128(reinterpret_cast<__m128i*>(jb), j1);
-  alignas(16) float top_b[4], bottom_b[4];
   int32_t texel_b[4];
   const uint32_t p1_in_box_lanes = static_cast<uint32_t>(_mm_movemask_ps(p1_in_box));
   for (int lane = 0; lane < 4; ++lane) {
     const bool used = (lanes >> lane) & 1u;
     start[lane] = used ? ja[lane] * static_cast<int32_t>(width_) + ia[lane] : 0;
     texel_b[lane] = used ? jb[lane] * static_cast<int32_t>(width_) + ib[lane] : 0;
-    top_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].top;
-    bottom_b[lane] = slabs_[static_cast<size_t>(texel_b[lane])].bottom;
   }
   // Whether a lane can meet a texel with gaps: a walk stays in the box of its end texels, so
   // when no 8x8 block under those boxes has one (most of a body, most of the time), the lanes
@@ -2012,7 +2022,11 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
       }
     }
   }
-  __m128 slab_b_top = _mm_load_ps(top_b), slab_b_bottom = _mm_load_ps(bottom_b);
+  const float* slab_floats = &slabs_[0].top;
+  const auto texel_at = [](int32_t t) { return static_cast<size_t>(t); };
+  __m128 slab_b_top, slab_b_bottom;
+  LoadSlabLanes(slab_floats, texel_at(texel_b[0]), texel_at(texel_b[1]), texel_at(texel_b[2]),
+                texel_at(texel_b[3]), &slab_b_top, &slab_b_bottom);
   // With gaps at p1's texel: IsInside(p1) excludes the gaps, and a push-out goes to the nearer
   // surface of p1's interval (IntervalAt).
   __m128 end_in_gap = zero;
@@ -2076,14 +2090,8 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   // its division runs once, after the loop. A lane keeps stepping after its entry (along its own
   // segment, so over valid texels) until every lane is done; only `active` lanes record.
   const auto load_slabs = [&](const int32_t(&at)[4], __m128* top, __m128* bottom) {
-    // Two slabs per 16 bytes: (top, bottom) of lanes 0, 1 and of lanes 2, 3.
-    const auto slab = [&](int lane) {
-      return reinterpret_cast<const __m64*>(&slabs_[static_cast<size_t>(at[lane])]);
-    };
-    const __m128 slabs01 = _mm_loadh_pi(_mm_loadl_pi(zero, slab(0)), slab(1));
-    const __m128 slabs23 = _mm_loadh_pi(_mm_loadl_pi(zero, slab(2)), slab(3));
-    *top = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(2, 0, 2, 0));
-    *bottom = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(3, 1, 3, 1));
+    LoadSlabLanes(slab_floats, texel_at(at[0]), texel_at(at[1]), texel_at(at[2]), texel_at(at[3]),
+                  top, bottom);
   };
   __m128 top, bottom;
   load_slabs(start, &top, &bottom);
