@@ -293,8 +293,8 @@ const std::vector<Parameter>& Parameters() {
           "spheres", "cover",
           {{"flexible", SphereCover::kFlexible}, {"left_by_hulls", SphereCover::kLeftByHulls}},
           "flexible: every flexible vertex of the joint (paper B); left_by_hulls: only the "
-          "corners of rest-pose triangles no single hull holds (smaller spheres on smoothly "
-          "weighted rigs; needs hulls.enabled)",
+          "flexible corners of rest-pose triangles no single hull holds (smaller spheres on "
+          "smoothly weighted rigs; needs hulls.enabled)",
           [](BakeConfig& c) -> SphereCover& { return c.sphere_cover; }),
   };
   return table;

@@ -349,7 +349,7 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   }
   if (config.spheres_enabled) {
     start = Clock::now();
-    static const std::vector<HullColliderData> kNoHulls;
+    static const std::vector<HullColliderData> kNoHulls;  // (a ternary would copy the hulls)
     const bool left_by_hulls = config.sphere_cover == SphereCover::kLeftByHulls;
     if (left_by_hulls && asset.hulls.empty()) {
       character.warnings.push_back(

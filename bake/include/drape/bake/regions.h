@@ -39,7 +39,7 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
 // Joint spheres (paper B §2.3): centred on the joint, radius covering its flexible vertices plus
 // delta (metres). Written into the bind-pose frame the runtime expects. With the bones' hulls
 // (inflated, built from `regions`) and the mesh's triangles, a sphere covers only what the hulls
-// leave out: the corners of rest-pose triangles that no single hull holds.
+// leave out: the flexible corners of rest-pose triangles that no single hull holds.
 std::vector<JointSphereData> BuildJointSpheres(const Regions& regions, float delta,
                                                const std::vector<HullColliderData>& hulls = {},
                                                const std::vector<uint32_t>& triangles = {});
