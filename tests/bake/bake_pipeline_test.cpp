@@ -367,6 +367,33 @@ TEST(BakePipeline, SpheresLeftByHullsWithoutHullsWarnAndKeepPaperB) {
   EXPECT_EQ(warned, 1);
 }
 
+// The default (paper B's spheres) says when left_by_hulls would take more than a fifth off the
+// radii: CesiumMan's 12-34 cm spheres, not the mannequin's.
+TEST(BakePipeline, WarnsWhenLeftByHullsWouldShrinkTheSpheres) {
+  const auto shrink_warnings = [](const nlohmann::json& report) {
+    int count = 0;
+    for (const auto& w : report["warnings"]) {
+      count += w.get<std::string>().find("spheres.cover left_by_hulls would shrink") !=
+               std::string::npos;
+    }
+    return count;
+  };
+  BakeConfig config;
+  config.maps_enabled = false;
+  BakeResult mannequin;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &mannequin).ok());
+  EXPECT_EQ(shrink_warnings(mannequin.report), 0);
+  const std::string cesium = test::CharacterPath("CesiumMan/CesiumMan.glb");
+  DRAPE_REQUIRE_FILE(cesium);
+  BakeResult smooth;
+  ASSERT_TRUE(BakeCharacter(cesium, config, &smooth).ok());
+  EXPECT_EQ(shrink_warnings(smooth.report), 1);
+  config.sphere_cover = bake::SphereCover::kLeftByHulls;  // taken: no advice
+  BakeResult shrunk;
+  ASSERT_TRUE(BakeCharacter(cesium, config, &shrunk).ok());
+  EXPECT_EQ(shrink_warnings(shrunk.report), 0);
+}
+
 TEST(BakePipeline, WarnsWhenFewVerticesShapeTheHulls) {
   const auto rigid_warnings = [](const nlohmann::json& report) {
     int count = 0;
