@@ -1575,13 +1575,13 @@ inline void StoreLanes(const Lanes3& a, const Lanes3& b, float (&out)[6][4]) {
   _mm_store_ps(out[5], b.z);
 }
 
-// The slabs (top, bottom) of four texels as lanes: 8-byte loads into halves and two shuffles.
-// (Four scalar stores read back as one vector would stall the store forwarding.)
-inline void LoadSlabLanes(const float* slabs, size_t t0, size_t t1, size_t t2, size_t t3,
-                          __m128* top, __m128* bottom) {
-  const auto pair = [&](size_t t) { return reinterpret_cast<const __m64*>(slabs + 2 * t); };
-  const __m128 slabs01 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(t0)), pair(t1));
-  const __m128 slabs23 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(t2)), pair(t3));
+// The slabs (top, bottom: 8 bytes each) of four texels as lanes: 8-byte loads into halves and
+// two shuffles. (Four scalar stores read back as one vector would stall the store forwarding.)
+inline void LoadSlabLanes(const void* slab0, const void* slab1, const void* slab2,
+                          const void* slab3, __m128* top, __m128* bottom) {
+  const auto pair = [](const void* slab) { return static_cast<const __m64*>(slab); };
+  const __m128 slabs01 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab0)), pair(slab1));
+  const __m128 slabs23 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab2)), pair(slab3));
   *top = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(2, 0, 2, 0));
   *bottom = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(3, 1, 3, 1));
 }
@@ -1753,12 +1753,12 @@ uint32_t BodyMapCollider::CollideFourShortMotions(const Float3* previous, Float3
     }
   }
   if (lanes == 0) return free_lanes;
-  const float* slab_floats = &slabs_[0].top;
+  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabLanes loads a slab as 8 bytes");
   __m128 slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
-  LoadSlabLanes(slab_floats, texel_a[0], texel_a[1], texel_a[2], texel_a[3], &slab_a_top,
-                &slab_a_bottom);
-  LoadSlabLanes(slab_floats, texel_b[0], texel_b[1], texel_b[2], texel_b[3], &slab_b_top,
-                &slab_b_bottom);
+  LoadSlabLanes(&slabs_[texel_a[0]], &slabs_[texel_a[1]], &slabs_[texel_a[2]], &slabs_[texel_a[3]],
+                &slab_a_top, &slab_a_bottom);
+  LoadSlabLanes(&slabs_[texel_b[0]], &slabs_[texel_b[1]], &slabs_[texel_b[2]], &slabs_[texel_b[3]],
+                &slab_b_top, &slab_b_bottom);
 
   // The walk (BodyMapWalk::Run<1>): the crossing parameter of the edge, A over [0, s_cross],
   // then B over [s_cross, 1]. One texel: A over [0, 1], and B (the same texel) adds nothing.
@@ -2022,11 +2022,10 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
       }
     }
   }
-  const float* slab_floats = &slabs_[0].top;
-  const auto texel_at = [](int32_t t) { return static_cast<size_t>(t); };
+  const auto slab = [&](int32_t texel) { return &slabs_[static_cast<size_t>(texel)]; };
   __m128 slab_b_top, slab_b_bottom;
-  LoadSlabLanes(slab_floats, texel_at(texel_b[0]), texel_at(texel_b[1]), texel_at(texel_b[2]),
-                texel_at(texel_b[3]), &slab_b_top, &slab_b_bottom);
+  LoadSlabLanes(slab(texel_b[0]), slab(texel_b[1]), slab(texel_b[2]), slab(texel_b[3]), &slab_b_top,
+                &slab_b_bottom);
   // With gaps at p1's texel: IsInside(p1) excludes the gaps, and a push-out goes to the nearer
   // surface of p1's interval (IntervalAt).
   __m128 end_in_gap = zero;
@@ -2090,8 +2089,7 @@ uint32_t BodyMapCollider::CollideFourWalks(const uint32_t (&index)[4], uint32_t 
   // its division runs once, after the loop. A lane keeps stepping after its entry (along its own
   // segment, so over valid texels) until every lane is done; only `active` lanes record.
   const auto load_slabs = [&](const int32_t(&at)[4], __m128* top, __m128* bottom) {
-    LoadSlabLanes(slab_floats, texel_at(at[0]), texel_at(at[1]), texel_at(at[2]), texel_at(at[3]),
-                  top, bottom);
+    LoadSlabLanes(slab(at[0]), slab(at[1]), slab(at[2]), slab(at[3]), top, bottom);
   };
   __m128 top, bottom;
   load_slabs(start, &top, &bottom);
