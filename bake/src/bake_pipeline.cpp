@@ -353,16 +353,15 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   }
   if (config.spheres_enabled) {
     start = Clock::now();
-    static const std::vector<HullColliderData> kNoHulls;  // (a ternary would copy the hulls)
     const bool left_by_hulls = config.sphere_cover == SphereCover::kLeftByHulls;
     if (left_by_hulls && asset.hulls.empty()) {
       character.warnings.push_back(
           "spheres.cover is left_by_hulls but no hull was baked: the joint spheres cover every "
           "flexible vertex (paper B)");
     }
-    asset.joint_spheres =
-        BuildJointSpheres(regions, config.sphere_delta, left_by_hulls ? asset.hulls : kNoHulls,
-                          character.mesh.triangles);
+    asset.joint_spheres = left_by_hulls ? BuildJointSpheres(regions, config.sphere_delta,
+                                                            asset.hulls, character.mesh.triangles)
+                                        : BuildJointSpheres(regions, config.sphere_delta);
     if (!left_by_hulls && !asset.hulls.empty()) {
       // Smoothly weighted rigs get spheres of a limb's size; say when the option would help.
       const auto radius_sum = [](const std::vector<JointSphereData>& spheres) {
