@@ -1624,7 +1624,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   size_t answered_outside = 0;
   size_t walked_answered = 0, walked_walls = 0, walked_inside = 0, walked_entries = 0;
   size_t walked_clipped_entries = 0, walked_z_face = 0, walked_long = 0;  // walking lanes
-  size_t walked_gap_contacts = 0;
+  size_t walked_gap_contacts = 0, walked_gap_starts = 0;
   for (int body = 0; body < 4; ++body) {
     SCOPED_TRACE(::testing::Message() << "body " << body);
     const BodyMapCollider& c = bodies[body];
@@ -1853,6 +1853,20 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
         };
         walked_gap_contacts +=
             (f & kCollisionContact) != 0 && (has_gaps(previous[q]) || has_gaps(positions[q]));
+        // Starts strictly inside a gap, which the lanes' start test does not look for (their
+        // answers must match anyway: CollideFourWalks' note at start_inside).
+        const auto in_a_gap = [&](Float3 p) {
+          const float u = (p.x - c.origin_x()) / texel, v = (p.y - c.origin_y()) / texel;
+          float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+          if (!(u >= 0.f && v >= 0.f)) return false;
+          const uint32_t gaps =
+              c.TexelGaps(static_cast<uint32_t>(u), static_cast<uint32_t>(v), upper, lower);
+          for (uint32_t g = 0; g < gaps; ++g) {
+            if (p.z < upper[g] && p.z > lower[g]) return true;
+          }
+          return false;
+        };
+        walked_gap_starts += in_a_gap(previous[q]);
       }
       // Restore what the lanes wrote, so later groups see the input.
       for (uint32_t q : index) {
@@ -1879,11 +1893,13 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   EXPECT_GT(walked_z_face, 500u);
   EXPECT_GT(walked_long, 500u);
   EXPECT_GT(walked_gap_contacts, 500u);
+  EXPECT_GT(walked_gap_starts, 100u);
   std::printf(
       "walking lanes: %zu answered, %zu walls, %zu entries (%zu clipped, %zu through the "
-      "box's z face), %zu pushed out, %zu contacts >= 3 texels away, %zu at texels with gaps\n",
+      "box's z face), %zu pushed out, %zu contacts >= 3 texels away, %zu at texels with gaps, "
+      "%zu starts in a gap\n",
       walked_answered, walked_walls, walked_entries, walked_clipped_entries, walked_z_face,
-      walked_inside, walked_long, walked_gap_contacts);
+      walked_inside, walked_long, walked_gap_contacts, walked_gap_starts);
 #endif
 }
 
