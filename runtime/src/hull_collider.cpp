@@ -11,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "cpu_features.h"
 #include "sse_lanes.h"
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
 #include <immintrin.h>
@@ -27,7 +28,7 @@ constexpr float kPadCenter = 3.0e38f;    // padded broad-phase spheres: never re
 constexpr double kScrewMinAngle = 1e-4;  // radians; below: pivot about the OBB centre
 constexpr float kUnitTolerance = 1e-3f;
 
-bool CpuHasAvx2();  // defined with the plane kernels below
+using detail::CpuHasAvx2;
 
 bool Finite(Float3 a) { return IsFinite(a); }
 bool Finite(const Mat34& m) {
@@ -1150,9 +1151,6 @@ DRAPE_AVX2 uint32_t EntryAvx(const PlaneSoa& s, Float3 a, Float3 b, float t_in) 
   }
   return 0;
 }
-bool CpuHasAvx2() { return __builtin_cpu_supports("avx2"); }
-#else
-bool CpuHasAvx2() { return false; }
 #endif
 
 // Broad phase: indices k < total with |mid - c_k|^2 <= (r_k + half)^2 (SoA padded to a multiple of

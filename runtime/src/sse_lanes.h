@@ -2,9 +2,16 @@
 // Private to the runtime: SSE2 lane helpers shared by the colliders' four-lane paths. Each gives
 // lane by lane what the scalar expression gives (IEEE single precision per lane), so a lane path
 // can be bit for bit its scalar twin.
+//
+// The lane operations are named once for any width: the overloads here take __m128 / __m128i,
+// those in body_map_collider_avx2.cpp take __m256 / __m256i, and a pack type (Sse2Lanes here,
+// Avx2Lanes there) holds what only the width decides. A template written in these names
+// (body_map_lane_walk.inl) is one text for four lanes and for eight, with the same bits per lane.
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+
+#include <cstdint>
 
 namespace drape::detail {
 
@@ -22,6 +29,100 @@ inline __m128i SelectLanesI(__m128 mask, __m128i a, __m128i b) {
   const __m128i m = _mm_castps_si128(mask);
   return _mm_or_si128(_mm_and_si128(m, a), _mm_andnot_si128(m, b));
 }
+
+namespace lanes {
+
+// Float lanes: IEEE single-precision arithmetic per lane; comparisons give all-ones masks (false
+// on NaN, as the scalar comparison).
+inline __m128 Add(__m128 a, __m128 b) { return _mm_add_ps(a, b); }
+inline __m128 Sub(__m128 a, __m128 b) { return _mm_sub_ps(a, b); }
+inline __m128 Mul(__m128 a, __m128 b) { return _mm_mul_ps(a, b); }
+inline __m128 Div(__m128 a, __m128 b) { return _mm_div_ps(a, b); }
+inline __m128 Sqrt(__m128 a) { return _mm_sqrt_ps(a); }
+inline __m128 And(__m128 a, __m128 b) { return _mm_and_ps(a, b); }
+inline __m128 Or(__m128 a, __m128 b) { return _mm_or_ps(a, b); }
+inline __m128 AndNot(__m128 not_a, __m128 b) { return _mm_andnot_ps(not_a, b); }  // ~a & b
+inline __m128 Less(__m128 a, __m128 b) { return _mm_cmplt_ps(a, b); }
+inline __m128 LessEq(__m128 a, __m128 b) { return _mm_cmple_ps(a, b); }
+inline __m128 Greater(__m128 a, __m128 b) { return _mm_cmpgt_ps(a, b); }
+inline __m128 GreaterEq(__m128 a, __m128 b) { return _mm_cmpge_ps(a, b); }
+inline __m128 Equal(__m128 a, __m128 b) { return _mm_cmpeq_ps(a, b); }
+// Bit l = lane l's sign bit (a mask's lane l).
+inline uint32_t LaneBits(__m128 mask) { return static_cast<uint32_t>(_mm_movemask_ps(mask)); }
+
+// 32-bit integer lanes (wrapping arithmetic; comparisons signed).
+inline __m128i Add(__m128i a, __m128i b) { return _mm_add_epi32(a, b); }
+inline __m128i Sub(__m128i a, __m128i b) { return _mm_sub_epi32(a, b); }
+inline __m128i And(__m128i a, __m128i b) { return _mm_and_si128(a, b); }
+inline __m128i Or(__m128i a, __m128i b) { return _mm_or_si128(a, b); }
+inline __m128i AndNot(__m128i not_a, __m128i b) { return _mm_andnot_si128(not_a, b); }
+inline __m128i Less(__m128i a, __m128i b) { return _mm_cmplt_epi32(a, b); }
+inline __m128i Greater(__m128i a, __m128i b) { return _mm_cmpgt_epi32(a, b); }
+inline __m128i Equal(__m128i a, __m128i b) { return _mm_cmpeq_epi32(a, b); }
+inline __m128i Abs(__m128i x) {  // SSE2 has no pabsd; wraps for INT32_MIN as |x| would
+  const __m128i sign = _mm_srai_epi32(x, 31);
+  return _mm_sub_epi32(_mm_xor_si128(x, sign), sign);
+}
+
+// Conversions: truncation toward zero (the cast), exact int -> float below 2^24, bit casts.
+inline __m128i TruncateToInt(__m128 a) { return _mm_cvttps_epi32(a); }
+inline __m128 ToFloat(__m128i a) { return _mm_cvtepi32_ps(a); }
+inline __m128i AsInt(__m128 a) { return _mm_castps_si128(a); }
+inline __m128 AsFloat(__m128i a) { return _mm_castsi128_ps(a); }
+
+}  // namespace lanes
+
+// What only the width decides: four lanes of SSE2.
+struct Sse2Lanes {
+  static constexpr int kCount = 4;
+  using F = __m128;
+  using I = __m128i;
+  static F Splat(float x) { return _mm_set1_ps(x); }
+  static F Zero() { return _mm_setzero_ps(); }
+  static I SplatI(int32_t x) { return _mm_set1_epi32(x); }
+  static I ZeroI() { return _mm_setzero_si128(); }
+  static I LaneBitValues() { return _mm_setr_epi32(1, 2, 4, 8); }  // lane l holds 1 << l
+  // Lane l = value(l), built from scalars (not stored and read back: four scalar stores read as
+  // one vector would stall the store forwarding).
+  template <class Value>
+  static F FromLanes(const Value& value) {
+    return _mm_setr_ps(value(0), value(1), value(2), value(3));
+  }
+  static I Load(const int32_t* aligned) {
+    return _mm_load_si128(reinterpret_cast<const __m128i*>(aligned));
+  }
+  static void Store(int32_t* aligned, I a) {
+    _mm_store_si128(reinterpret_cast<__m128i*>(aligned), a);
+  }
+  static void Store(float* aligned, F a) { _mm_store_ps(aligned, a); }
+  // Four consecutive (x, y, z) float triples (48 packed bytes) as lanes: three loads and a
+  // transpose.
+  static void LoadFloat3s(const void* triples, F* x, F* y, F* z) {
+    const float* f = static_cast<const float*>(triples);
+    const __m128 a = _mm_loadu_ps(f);      // x0 y0 z0 x1
+    const __m128 b = _mm_loadu_ps(f + 4);  // y1 z1 x2 y2
+    const __m128 c = _mm_loadu_ps(f + 8);  // z2 x3 y3 z3
+    const __m128 b2c1 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2));
+    const __m128 a1b0 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1));
+    const __m128 b3c2 = _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3));
+    const __m128 a2b1 = _mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2));
+    const __m128 c0c3 = _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0));
+    *x = _mm_shuffle_ps(a, b2c1, _MM_SHUFFLE(2, 0, 3, 0));
+    *y = _mm_shuffle_ps(a1b0, b3c2, _MM_SHUFFLE(2, 0, 2, 0));
+    *z = _mm_shuffle_ps(a2b1, c0c3, _MM_SHUFFLE(2, 0, 2, 0));
+  }
+  // The slabs (two floats, 8 bytes: top then bottom) at slab[0..3] as lanes: 8-byte loads into
+  // halves and two shuffles.
+  static void LoadSlabs(const void* const* slab, F* top, F* bottom) {
+    const auto pair = [](const void* s) { return static_cast<const __m64*>(s); };
+    const __m128 slabs01 =
+        _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab[0])), pair(slab[1]));
+    const __m128 slabs23 =
+        _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab[2])), pair(slab[3]));
+    *top = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(2, 0, 2, 0));
+    *bottom = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(3, 1, 3, 1));
+  }
+};
 
 }  // namespace drape::detail
 

@@ -1,0 +1,841 @@
+// Private to the runtime: BodyMapCollider's lanes (short motions, walks), written once for any
+// width in the lane operations of sse_lanes.h. Included by body_map_collider.cpp (four SSE2 lanes)
+// and by body_map_collider_avx2.cpp (eight AVX2 lanes, inside its AVX2 target region).
+//
+// No #include here: everything this text uses must be declared before it is included. In the
+// AVX2 file that keeps the headers (and every inline function they define) outside the AVX2
+// region, so that no function the SSE2 code also uses is ever compiled for AVX2.
+
+namespace drape {
+namespace {
+
+using detail::AbsLanes;
+using detail::SelectLanes;
+using detail::SelectLanesI;
+using detail::StdMax;
+using detail::StdMin;
+using namespace detail::lanes;
+
+// Particles' coordinates, one lane each.
+template <class P>
+struct Lanes3 {
+  typename P::F x, y, z;
+};
+
+// P::kCount consecutive Float3 as lanes.
+template <class P>
+Lanes3<P> LoadFloat3Lanes(const Float3* p) {
+  Lanes3<P> lanes;
+  P::LoadFloat3s(p, &lanes.x, &lanes.y, &lanes.z);
+  return lanes;
+}
+
+constexpr uint32_t kConsecutiveLanes[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+
+// BodyMapWalk::Along.
+template <class P>
+typename P::F AlongLanes(typename P::F a, typename P::F b, typename P::F s) {
+  const typename P::F d = Sub(b, a);
+  const typename P::F from_a = Add(a, Mul(d, s));
+  const typename P::F from_b = Sub(b, Mul(d, Sub(P::Splat(1.f), s)));
+  return SelectLanes(Less(s, P::Splat(0.5f)), from_a, from_b);
+}
+
+// DecodeOct16 of one code per lane.
+template <class P>
+[[gnu::always_inline]] inline Lanes3<P> DecodeOct16Lanes(const uint16_t* qa, const uint16_t* qb) {
+  using F = typename P::F;
+  const F one = P::Splat(1.f);
+  const F scale = P::Splat(2.f / 65535.f);
+  F x = Sub(Mul(P::FromLanes([&](int l) { return static_cast<float>(qa[l]); }), scale), one);
+  F y = Sub(Mul(P::FromLanes([&](int l) { return static_cast<float>(qb[l]); }), scale), one);
+  const F z = Sub(Sub(one, AbsLanes(x)), AbsLanes(y));
+  const F minus_one = P::Splat(-1.f), zero = P::Zero();
+  const F sign_x = SelectLanes(GreaterEq(x, zero), one, minus_one);
+  const F sign_y = SelectLanes(GreaterEq(y, zero), one, minus_one);
+  const F fold = Less(z, zero);
+  const F unfolded_x = Mul(Sub(one, AbsLanes(y)), sign_x);
+  const F unfolded_y = Mul(Sub(one, AbsLanes(x)), sign_y);
+  x = SelectLanes(fold, unfolded_x, x);
+  y = SelectLanes(fold, unfolded_y, y);
+  // NormalizeOr(n, +z).
+  const F length = Sqrt(Add(Add(Mul(x, x), Mul(y, y)), Mul(z, z)));
+  const F usable = Greater(length, P::Splat(1e-20f));
+  const F inverse = Div(one, length);
+  return {SelectLanes(usable, Mul(x, inverse), zero), SelectLanes(usable, Mul(y, inverse), zero),
+          SelectLanes(usable, Mul(z, inverse), one)};
+}
+
+// One walk visit (BodyMapWalk::VisitTexel without gaps) of the lanes' texels over
+// [s_enter, s_exit], z from z_enter to z_exit, `inside` at the entry point: where each lane
+// enters the texel's slab first, if it does.
+template <class P>
+struct LaneVisit {
+  typename P::F wall, front, back;  // masks: entered through a side wall, the front, the back
+  typename P::F s, z;               // the entry parameter and the entry's z (surface or z_enter)
+  typename P::F inside_after;       // no entry and inside at s_exit
+};
+
+template <class P>
+LaneVisit<P> VisitLanes(typename P::F top, typename P::F bottom, typename P::F s_enter,
+                        typename P::F s_exit, typename P::F z_enter, typename P::F z_exit,
+                        typename P::F inside) {
+  using F = typename P::F;
+  LaneVisit<P> visit;
+  const F in_enter = And(LessEq(z_enter, top), GreaterEq(z_enter, bottom));
+  const F above = Greater(z_enter, top);  // also every background texel (top = -inf)
+  visit.wall = AndNot(inside, in_enter);
+  visit.front = AndNot(in_enter, And(above, LessEq(z_exit, top)));
+  visit.back = AndNot(in_enter, AndNot(above, GreaterEq(z_exit, bottom)));
+  // CrossingS(surface, z_enter, z_exit, s_enter, s_exit).
+  const F surface = SelectLanes(above, top, bottom);
+  const F r = Div(Sub(surface, z_enter), Sub(z_exit, z_enter));
+  const F crossing = StdMin(StdMax(Add(s_enter, Mul(r, Sub(s_exit, s_enter))), s_enter), s_exit);
+  visit.s = SelectLanes(visit.wall, s_enter, crossing);
+  visit.z = SelectLanes(visit.wall, z_enter, surface);
+  visit.inside_after =
+      And(And(inside, in_enter), And(LessEq(z_exit, top), GreaterEq(z_exit, bottom)));
+  return visit;
+}
+
+// Lanes whose nine input values are all finite: a sum holding a NaN or an infinity is not
+// finite (an overflowing one only sends a finite lane to the one-by-one path).
+template <class P>
+typename P::F FiniteLanes(const Lanes3<P>& p0, const Lanes3<P>& p1, const Lanes3<P>& v) {
+  const typename P::F sum =
+      Add(Add(Add(Add(p0.x, p0.y), Add(p0.z, p1.x)), Add(Add(p1.y, p1.z), Add(v.x, v.y))), v.z);
+  return Equal(Sub(sum, sum), P::Zero());
+}
+
+// BodyMapCollider::ToTexels of the motions a -> b: u0, v0, u1, v1.
+template <class P>
+struct TexelLanes {
+  typename P::F u0, v0, u1, v1;
+};
+template <class P>
+TexelLanes<P> ToTexelLanes(const Lanes3<P>& a, const Lanes3<P>& b, float origin_x, float origin_y,
+                           float inverse_texel) {
+  const typename P::F ox = P::Splat(origin_x), oy = P::Splat(origin_y);
+  const typename P::F inverse = P::Splat(inverse_texel);
+  return {Mul(Sub(a.x, ox), inverse), Mul(Sub(a.y, oy), inverse), Mul(Sub(b.x, ox), inverse),
+          Mul(Sub(b.y, oy), inverse)};
+}
+
+// Two lane triples to memory, lane by lane: out[0..2] = a.x, a.y, a.z; out[3..5] = b's.
+template <class P>
+void StoreLanes(const Lanes3<P>& a, const Lanes3<P>& b, float (&out)[6][P::kCount]) {
+  P::Store(out[0], a.x);
+  P::Store(out[1], a.y);
+  P::Store(out[2], a.z);
+  P::Store(out[3], b.x);
+  P::Store(out[4], b.y);
+  P::Store(out[5], b.z);
+}
+
+// WalkInto's contact point in lanes: the entry at parameter s on the walked segment q0 -> q1,
+// at z = entry_z, stepped back across a side wall (`wall` lanes) by `back_off_length` (metres)
+// when the segment moves in x or y; or, for the `push_out` lanes, p1 moved along z to the nearer
+// surface of its interval [end_bottom, end_top] (push_back: the bottom one).
+template <class P>
+struct LanePoint {
+  Lanes3<P> point;
+  typename P::F push_back;
+};
+template <class P>
+LanePoint<P> PlaceContactLanes(const Lanes3<P>& q0, const Lanes3<P>& q1, typename P::F s,
+                               typename P::F entry_z, typename P::F wall, typename P::F push_out,
+                               const Lanes3<P>& p1, typename P::F end_top, typename P::F end_bottom,
+                               float back_off_length) {
+  using F = typename P::F;
+  const F zero = P::Zero();
+  const F dx = Sub(q1.x, q0.x), dy = Sub(q1.y, q0.y);
+  F back_off = zero, stepped_back = zero;
+  if (LaneBits(wall) != 0) {
+    const F length = Sqrt(Add(Mul(dx, dx), Mul(dy, dy)));
+    back_off = Div(P::Splat(back_off_length), length);
+    stepped_back = And(wall, Greater(length, zero));
+  }
+  const F x = AlongLanes<P>(q0.x, q1.x, s), y = AlongLanes<P>(q0.y, q1.y, s);
+  LanePoint<P> placed;
+  placed.push_back = Less(Sub(p1.z, end_bottom), Sub(end_top, p1.z));
+  placed.point = {
+      SelectLanes(push_out, p1.x, SelectLanes(stepped_back, Sub(x, Mul(dx, back_off)), x)),
+      SelectLanes(push_out, p1.y, SelectLanes(stepped_back, Sub(y, Mul(dy, back_off)), y)),
+      SelectLanes(push_out, SelectLanes(placed.push_back, end_bottom, end_top), entry_z)};
+  return placed;
+}
+
+// The lanes' answers, written to element index[l] of the arrays for each lane l in `lanes`:
+// ApplyResponse (collision_types.h) at `point` with `normal` for the lanes in contact, and the
+// flags CollideOne gives. `v` holds the lanes' velocities.
+template <class P>
+[[gnu::always_inline]] inline void WriteLaneAnswers(const uint32_t* index, uint32_t lanes,
+                                                    uint32_t contact_lanes, uint32_t wall_lanes,
+                                                    uint32_t started_inside_lanes,
+                                                    const Lanes3<P>& point, const Lanes3<P>& normal,
+                                                    const Lanes3<P>& v,
+                                                    const ResponseParams& params, Float3* positions,
+                                                    Float3* velocities, uint8_t* flags) {
+  using F = typename P::F;
+  // The position on the surface plus the separation; the velocity only where it points into
+  // the body.
+  const F zero = P::Zero();
+  const F separation = P::Splat(params.separation);
+  const Lanes3<P> position = {Add(point.x, Mul(normal.x, separation)),
+                              Add(point.y, Mul(normal.y, separation)),
+                              Add(point.z, Mul(normal.z, separation))};
+  const F vn = Add(Add(Mul(v.x, normal.x), Mul(v.y, normal.y)), Mul(v.z, normal.z));
+  const F keep = P::Splat(1.f - params.friction);
+  const F restitution = P::Splat(params.restitution);
+  const F into = Less(vn, zero);
+  const auto respond = [&](F velocity, F n) {
+    const F normal_part = Mul(n, vn);
+    const F changed = Sub(Mul(Sub(velocity, normal_part), keep), Mul(normal_part, restitution));
+    return SelectLanes(into, changed, velocity);
+  };
+  const Lanes3<P> velocity = {respond(v.x, normal.x), respond(v.y, normal.y),
+                              respond(v.z, normal.z)};
+
+  alignas(32) float out[6][P::kCount];
+  StoreLanes<P>(position, velocity, out);
+  for (int lane = 0; lane < P::kCount; ++lane) {
+    if (!((lanes >> lane) & 1u)) continue;
+    const uint32_t k = index[lane];
+    if (!((contact_lanes >> lane) & 1u)) {
+      flags[k] = kCollisionNone;
+      continue;
+    }
+    positions[k] = Float3{out[0][lane], out[1][lane], out[2][lane]};
+    velocities[k] = Float3{out[3][lane], out[4][lane], out[5][lane]};
+    const uint8_t kind = (wall_lanes >> lane) & 1u             ? kCollisionSideWall
+                         : (started_inside_lanes >> lane) & 1u ? kCollisionStartedInside
+                                                               : kCollisionNone;
+    flags[k] = static_cast<uint8_t>(kCollisionContact | kind);
+  }
+}
+
+}  // namespace
+
+template <class P>
+uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* positions,
+                                            Float3* velocities, uint8_t* flags,
+                                            const ResponseParams& params,
+                                            uint32_t* long_motions) const {
+  using F = typename P::F;
+  using I = typename P::I;
+  constexpr int kLanes = P::kCount;
+  const Lanes3<P> p0 = LoadFloat3Lanes<P>(previous), p1 = LoadFloat3Lanes<P>(positions),
+                  v = LoadFloat3Lanes<P>(velocities);
+  const F zero = P::Zero(), one = P::Splat(1.f);
+  const F finite = FiniteLanes<P>(p0, p1, v);
+  F answerable = finite;
+  // Both ends on the grid (ToTexels' expressions) and in the clip box's z range.
+  const TexelLanes<P> texels = ToTexelLanes<P>(p0, p1, origin_x_, origin_y_, inv_texel_size_);
+  const F u0 = texels.u0, v0 = texels.v0, u1 = texels.u1, v1 = texels.v1;
+  const F width = P::Splat(width_f_), height = P::Splat(height_f_);
+  const auto within = [&](F x, F lo, F hi) { return And(GreaterEq(x, lo), LessEq(x, hi)); };
+  const auto on_grid = [&](F u, F limit) { return And(GreaterEq(u, zero), Less(u, limit)); };
+  answerable = And(answerable, And(on_grid(u0, width), on_grid(v0, height)));
+  answerable = And(answerable, And(on_grid(u1, width), on_grid(v1, height)));
+  const F z_lo = P::Splat(bounds_min_.z), z_hi = P::Splat(bounds_max_.z);
+  answerable = And(answerable, And(within(p0.z, z_lo, z_hi), within(p1.z, z_lo, z_hi)));
+  const F x_lo = P::Splat(clip_lo_float_[0]), x_hi = P::Splat(clip_hi_float_[0]);
+  const F y_lo = P::Splat(clip_lo_float_[1]), y_hi = P::Splat(clip_hi_float_[1]);
+  // The texels (truncation as in the scalar path; off-grid lanes are not used): one texel, or
+  // two across one edge (the walk's one-crossing path: two visits split at s_cross).
+  const I i0 = TruncateToInt(u0), j0 = TruncateToInt(v0);
+  const I i1 = TruncateToInt(u1), j1 = TruncateToInt(v1);
+  const I same_i = Equal(i0, i1), same_j = Equal(j0, j1);
+  const I di = Sub(i1, i0), dj = Sub(j1, j0);
+  const I minus_one_i = P::SplatI(-1), one_i = P::SplatI(1);
+  const I step_i = Or(Equal(di, one_i), Equal(di, minus_one_i));
+  const I step_j = Or(Equal(dj, one_i), Equal(dj, minus_one_i));
+  const F in_one = AsFloat(And(same_i, same_j));
+  const F across_i = AsFloat(And(step_i, same_j));
+  const F across_j = AsFloat(And(same_i, step_j));
+  const F two = Or(across_i, across_j);
+  // A motion across an edge is walked only when it needs no clipping: both ends inside the clip
+  // box in x and y too (in one valid texel they are; a background texel holds nothing).
+  const F in_box = And(answerable, And(And(within(p0.x, x_lo, x_hi), within(p1.x, x_lo, x_hi)),
+                                       And(within(p0.y, y_lo, y_hi), within(p1.y, y_lo, y_hi))));
+  *long_motions = LaneBits(AndNot(Or(in_one, two), in_box));
+  answerable = Or(And(answerable, in_one), And(in_box, two));
+  // A motion that stays at one coordinate outside the clip box never enters it (ClipMotion's
+  // test for a zero extent, exact): no contact. Points away from the body are most of these.
+  const auto fixed_outside = [&](F a, F b, F lo, F hi) {
+    return AndNot(within(a, lo, hi), Equal(a, b));
+  };
+  const uint32_t free_lanes = LaneBits(And(finite, Or(Or(fixed_outside(p0.x, p1.x, x_lo, x_hi),
+                                                         fixed_outside(p0.y, p1.y, y_lo, y_hi)),
+                                                      fixed_outside(p0.z, p1.z, z_lo, z_hi)))) &
+                              ~LaneBits(answerable);
+  for (int lane = 0; lane < kLanes; ++lane) {
+    if ((free_lanes >> lane) & 1u) flags[lane] = kCollisionNone;
+  }
+  uint32_t lanes = LaneBits(answerable);
+  if (lanes == 0) return free_lanes;
+
+  // The lanes' slabs: A holds p0, B holds p1 (texel 0 for unused lanes, never used).
+  alignas(32) int32_t ia[kLanes], ja[kLanes], ib[kLanes], jb[kLanes];
+  P::Store(ia, i0);
+  P::Store(ja, j0);
+  P::Store(ib, i1);
+  P::Store(jb, j1);
+  size_t texel_a[kLanes], texel_b[kLanes];
+  for (int lane = 0; lane < kLanes; ++lane) {
+    const bool used = (lanes >> lane) & 1u;
+    texel_a[lane] =
+        used ? static_cast<size_t>(ja[lane]) * width_ + static_cast<size_t>(ia[lane]) : 0;
+    texel_b[lane] =
+        used ? static_cast<size_t>(jb[lane]) * width_ + static_cast<size_t>(ib[lane]) : 0;
+  }
+  if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
+    for (int lane = 0; lane < kLanes; ++lane) {
+      if (((lanes >> lane) & 1u) &&
+          (GapBase(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane])) >= 0 ||
+           GapBase(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane])) >= 0)) {
+        lanes &= ~(1u << lane);
+      }
+    }
+  }
+  if (lanes == 0) return free_lanes;
+  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
+  F slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
+  const void* slab_a[kLanes];
+  const void* slab_b[kLanes];
+  for (int lane = 0; lane < kLanes; ++lane) {
+    slab_a[lane] = &slabs_[texel_a[lane]];
+    slab_b[lane] = &slabs_[texel_b[lane]];
+  }
+  P::LoadSlabs(slab_a, &slab_a_top, &slab_a_bottom);
+  P::LoadSlabs(slab_b, &slab_b_top, &slab_b_bottom);
+
+  // The walk (BodyMapWalk::Run<1>): the crossing parameter of the edge, A over [0, s_cross],
+  // then B over [s_cross, 1]. One texel: A over [0, 1], and B (the same texel) adds nothing.
+  // SafeInverse, then the one-crossing path's min(max((edge - g0) * inverse, 0), 1).
+  const auto crossing = [&](I a, I b, F g0, F g1) {
+    const F inverse_d = StdMin(StdMax(Div(one, Sub(g1, g0)), P::Splat(-1e30f)), P::Splat(1e30f));
+    const I edge = Or(And(Greater(b, a), b), AndNot(Greater(b, a), a));
+    return StdMin(StdMax(Mul(Sub(ToFloat(edge), g0), inverse_d), zero), one);
+  };
+  // Groups without a lane across an edge (points, resting cloth) skip the second visit.
+  const uint32_t two_lanes = LaneBits(two) & lanes;
+  F s_cross = one, z_cross = p1.z;  // Z(1) = z1 exactly
+  if (two_lanes != 0) {
+    s_cross = SelectLanes(across_i, crossing(i0, i1, u0, u1),
+                          SelectLanes(across_j, crossing(j0, j1, v0, v1), one));
+    z_cross = AlongLanes<P>(p0.z, p1.z, s_cross);
+  }
+  const F start_inside = And(LessEq(p0.z, slab_a_top), GreaterEq(p0.z, slab_a_bottom));
+  const LaneVisit<P> in_a =
+      VisitLanes<P>(slab_a_top, slab_a_bottom, zero, s_cross, p0.z, z_cross, start_inside);
+  const F hit_a = Or(in_a.front, in_a.back);  // no wall at s = 0 without clipping
+  LaneVisit<P> in_b = in_a;                   // unused without a lane across an edge
+  F hit_b = zero;
+  if (two_lanes != 0) {
+    in_b = VisitLanes<P>(slab_b_top, slab_b_bottom, s_cross, one, z_cross, p1.z, in_a.inside_after);
+    hit_b = AndNot(hit_a, And(two, Or(in_b.wall, Or(in_b.front, in_b.back))));
+  }
+  const F wall = And(hit_b, in_b.wall);
+  // No entry and p1 inside (IsInside(p1): texel B's slab): pushed out along z.
+  const F inside_end = And(LessEq(p1.z, slab_b_top), GreaterEq(p1.z, slab_b_bottom));
+  const F push_out = AndNot(Or(hit_a, hit_b), inside_end);
+  const F contact = Or(Or(hit_a, hit_b), push_out);
+  const uint32_t contact_lanes = LaneBits(contact) & lanes;
+  if (contact_lanes == 0) {  // points and motions in air
+    for (int lane = 0; lane < kLanes; ++lane) {
+      if ((lanes >> lane) & 1u) flags[lane] = kCollisionNone;
+    }
+    return lanes | free_lanes;
+  }
+
+  // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3
+  // texel (WalkInto), or p1 moved to the nearer surface of its slab.
+  const F s_hit = SelectLanes(hit_a, in_a.s, in_b.s);
+  const F z_hit = SelectLanes(hit_a, in_a.z, in_b.z);
+  // (A lane crossing an edge moves at least a float step of u, so its length in x and y never
+  // underflows; the lanes test it anyway, so that they stay the walk's operations one for one.)
+  const LanePoint<P> placed = PlaceContactLanes<P>(p0, p1, s_hit, z_hit, wall, push_out, p1,
+                                                   slab_b_top, slab_b_bottom, 1e-3f * texel_size_);
+  // The normal: the entered surface's; at a side wall the nearer surface of B's slab; for the
+  // push-out the surface p1 goes to.
+  const F wall_back = Less(Sub(z_hit, slab_b_bottom), Sub(slab_b_top, z_hit));
+  const F use_back =
+      SelectLanes(push_out, placed.push_back,
+                  SelectLanes(wall, wall_back, SelectLanes(hit_a, in_a.back, in_b.back)));
+  const uint32_t back_lanes = LaneBits(use_back);
+  const uint32_t from_a = LaneBits(hit_a);
+  uint16_t qa[kLanes] = {}, qb[kLanes] = {};
+  for (int lane = 0; lane < kLanes; ++lane) {
+    const TexelNormals& n = normals_[(from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane]];
+    const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
+    qa[lane] = q[0];
+    qb[lane] = q[1];
+  }
+  const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
+  const uint32_t wall_lanes = LaneBits(wall);
+  const uint32_t started_inside_lanes = LaneBits(And(push_out, start_inside));
+  WriteLaneAnswers<P>(kConsecutiveLanes, lanes, contact_lanes, wall_lanes, started_inside_lanes,
+                      placed.point, normal, v, params, positions, velocities, flags);
+  return lanes | free_lanes;
+}
+
+template <class P>
+uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes,
+                                           const Float3* previous, Float3* positions,
+                                           Float3* velocities, uint8_t* flags,
+                                           const ResponseParams& params) const {
+  using F = typename P::F;
+  using I = typename P::I;
+  constexpr int kLanes = P::kCount;
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  const auto gather = [&](const Float3* a) {
+    return Lanes3<P>{P::FromLanes([&](int l) { return a[index[l]].x; }),
+                     P::FromLanes([&](int l) { return a[index[l]].y; }),
+                     P::FromLanes([&](int l) { return a[index[l]].z; })};
+  };
+  const Lanes3<P> p0 = gather(previous), p1 = gather(positions), v = gather(velocities);
+  // Finite input (non-finite lanes go one by one, which flags them).
+  const F zero = P::Zero(), one = P::Splat(1.f), inf = P::Splat(kInfinity);
+  lanes &= LaneBits(FiniteLanes<P>(p0, p1, v));
+  if (lanes == 0) return 0;
+  // Ends in the clip box (its x and y as the nearest inside floats: the double test's answer).
+  // (The lambdas taking or returning lanes all capture: a capture-less one gets a conversion to
+  // a function pointer, which the compiler writes outside the AVX2 region of its includer.)
+  const auto within = [&](F x, F lo, F hi) { return And(GreaterEq(x, lo), LessEq(x, hi)); };
+  const F x_lo = P::Splat(clip_lo_float_[0]), x_hi = P::Splat(clip_hi_float_[0]);
+  const F y_lo = P::Splat(clip_lo_float_[1]), y_hi = P::Splat(clip_hi_float_[1]);
+  const F z_lo = P::Splat(bounds_min_.z), z_hi = P::Splat(bounds_max_.z);
+  const auto in_box = [&](const Lanes3<P>& p) {
+    return And(And(within(p.x, x_lo, x_hi), within(p.y, y_lo, y_hi)), within(p.z, z_lo, z_hi));
+  };
+  const F p1_in_box = in_box(p1);
+  // The walked segment q0 -> q1: the motion itself, or clipped to the box (ClipMotion, one lane
+  // at a time: motions from outside the box are a few percent).
+  Lanes3<P> q0 = p0, q1 = p1;
+  const uint32_t clipped_lanes = lanes & ~LaneBits(And(in_box(p0), p1_in_box));
+  uint32_t start_clipped = 0, start_on_z_face = 0, answered_misses = 0;
+  if (clipped_lanes != 0) {
+    alignas(32) float ends[6][kLanes];
+    StoreLanes<P>(q0, q1, ends);
+    for (int lane = 0; lane < kLanes; ++lane) {
+      if (!((clipped_lanes >> lane) & 1u)) continue;
+      ClippedMotion clip;
+      if (!ClipMotion(previous[index[lane]], positions[index[lane]], &clip)) {
+        flags[index[lane]] = kCollisionNone;  // misses the box: no contact, ends outside
+        answered_misses |= 1u << lane;
+        continue;
+      }
+      const float q[6] = {clip.q0.x, clip.q0.y, clip.q0.z, clip.q1.x, clip.q1.y, clip.q1.z};
+      for (int k = 0; k < 6; ++k) ends[k][lane] = q[k];
+      start_clipped |= static_cast<uint32_t>(clip.t_start > 0.0) << lane;
+      start_on_z_face |= static_cast<uint32_t>(clip.start_on_z_face) << lane;
+    }
+    lanes &= ~answered_misses;
+    // Read back lane by lane: a vector load of lanes just written one by one would stall the
+    // store forwarding.
+    const auto lanes_of = [&](int k) { return P::FromLanes([&](int l) { return ends[k][l]; }); };
+    q0 = {lanes_of(0), lanes_of(1), lanes_of(2)};
+    q1 = {lanes_of(3), lanes_of(4), lanes_of(5)};
+  }
+  // Both walked ends on the grid (the box can reach a texel beyond it).
+  // (Named copies, not a structured binding: lambdas below capture them, which clang < 16
+  // rejects for bindings.)
+  const TexelLanes<P> texels = ToTexelLanes<P>(q0, q1, origin_x_, origin_y_, inv_texel_size_);
+  const F u0 = texels.u0, v0 = texels.v0, u1 = texels.u1, v1 = texels.v1;
+  const F width = P::Splat(width_f_), height = P::Splat(height_f_);
+  const auto on_grid = [&](F u, F limit) { return And(GreaterEq(u, zero), Less(u, limit)); };
+  lanes &= LaneBits(And(And(on_grid(u0, width), on_grid(v0, height)),
+                        And(on_grid(u1, width), on_grid(v1, height))));
+  if (lanes == 0) return answered_misses;
+  // The end texels (truncation is the floor on the grid) and the texel edges between them.
+  const I i0 = TruncateToInt(u0), j0 = TruncateToInt(v0);
+  const I i1 = TruncateToInt(u1), j1 = TruncateToInt(v1);
+  const I di = Sub(i1, i0), dj = Sub(j1, j0);
+  I left_i = Abs(di), left_j = Abs(dj);
+
+  const auto lane_mask = [&](uint32_t bits) {
+    const I bit = P::LaneBitValues();
+    return AsFloat(Equal(And(P::SplatI(static_cast<int32_t>(bits)), bit), bit));
+  };
+  // Texels with gaps (maps.layers > 1): their inside set is the slab less the open gaps, split
+  // into intervals whose surfaces have slots (BodyMapCollider::Interval).
+  const I front_slot = P::SplatI(kFrontSlot), back_slot = P::SplatI(kBackSlot);
+  const F all_lanes = AsFloat(P::SplatI(-1)), minus_inf = P::Splat(-kInfinity);
+  // The gaps of the lanes' texels (absent ones: top -inf, bottom +inf, which no z lies strictly
+  // between); returns the lanes (of `which`) whose texel has gaps.
+  struct GapLanes {
+    F top[kMaxBodyMapLayers - 1], bottom[kMaxBodyMapLayers - 1];
+  };
+  const auto gather_gaps = [&](const int32_t(&ci)[kLanes], const int32_t(&cj)[kLanes],
+                               uint32_t which, GapLanes* out) {
+    int64_t base[kLanes];
+    uint32_t with_gaps = 0;
+    for (int lane = 0; lane < kLanes; ++lane) {
+      base[lane] = ((which >> lane) & 1u)
+                       ? GapBase(static_cast<uint32_t>(ci[lane]), static_cast<uint32_t>(cj[lane]))
+                       : -1;
+      with_gaps |= static_cast<uint32_t>(base[lane] >= 0) << lane;
+    }
+    // Built from scalars, not stored and read back (that would stall the store forwarding).
+    for (uint32_t g = 0; g < gap_layers_; ++g) {
+      out->top[g] = P::FromLanes([&](int l) {
+        return base[l] >= 0 ? gaps_[static_cast<size_t>(base[l]) + g].top : -kInfinity;
+      });
+      out->bottom[g] = P::FromLanes([&](int l) {
+        return base[l] >= 0 ? gaps_[static_cast<size_t>(base[l]) + g].bottom : kInfinity;
+      });
+    }
+    return with_gaps;
+  };
+  // z strictly inside one of the gaps (BodyMapCollider::InGap).
+  const auto in_a_gap = [&](const GapLanes& gaps, F z) {
+    F in = zero;
+    for (uint32_t g = 0; g < gap_layers_; ++g) {
+      in = Or(in, And(Less(z, gaps.top[g]), Greater(z, gaps.bottom[g])));
+    }
+    return in;
+  };
+  // The interval of the inside set holding z (BodyMapCollider::TexelIntervals): bounded by the
+  // nearest gap boundary or slab surface above and below z.
+  struct IntervalLanes {
+    F top, bottom;
+    I top_slot, bottom_slot;
+  };
+  const auto interval_around = [&](const GapLanes& gaps, F z, F slab_top, F slab_bottom) {
+    IntervalLanes in{slab_top, slab_bottom, front_slot, back_slot};
+    for (uint32_t g = 0; g < gap_layers_; ++g) {
+      const F lower_above = And(GreaterEq(gaps.bottom[g], z), Less(gaps.bottom[g], in.top));
+      in.top = SelectLanes(lower_above, gaps.bottom[g], in.top);
+      in.top_slot = SelectLanesI(lower_above, P::SplatI(3 + 2 * static_cast<int>(g)), in.top_slot);
+      const F upper_below = And(LessEq(gaps.top[g], z), Greater(gaps.top[g], in.bottom));
+      in.bottom = SelectLanes(upper_below, gaps.top[g], in.bottom);
+      in.bottom_slot =
+          SelectLanesI(upper_below, P::SplatI(2 + 2 * static_cast<int>(g)), in.bottom_slot);
+    }
+    return in;
+  };
+
+  // Texel indices (row-major) of the start and of the end. With p1 in the box the end is p1's
+  // texel, whose slab answers IsInside(p1); beyond the box p1 is outside.
+  alignas(32) int32_t ia[kLanes], ja[kLanes], ib[kLanes], jb[kLanes], start[kLanes];
+  P::Store(ia, i0);
+  P::Store(ja, j0);
+  P::Store(ib, i1);
+  P::Store(jb, j1);
+  int32_t texel_b[kLanes];
+  const uint32_t p1_in_box_lanes = LaneBits(p1_in_box);
+  for (int lane = 0; lane < kLanes; ++lane) {
+    const bool used = (lanes >> lane) & 1u;
+    start[lane] = used ? ja[lane] * static_cast<int32_t>(width_) + ia[lane] : 0;
+    texel_b[lane] = used ? jb[lane] * static_cast<int32_t>(width_) + ib[lane] : 0;
+  }
+  // Whether a lane can meet a texel with gaps: a walk stays in the box of its end texels, so
+  // when no 8x8 block under those boxes has one (most of a body, most of the time), the lanes
+  // run the walk without the gap tests.
+  bool gaps_near = false;
+  if (gap_layers_ != 0) {
+    constexpr int kMaxBlocksTested = 64;
+    int blocks_tested = 0;
+    for (int lane = 0; lane < kLanes && !gaps_near; ++lane) {
+      if (!((lanes >> lane) & 1u)) continue;
+      const int bi0 = std::min(ia[lane], ib[lane]) >> kBlockShift;
+      const int bi1 = std::max(ia[lane], ib[lane]) >> kBlockShift;
+      const int bj0 = std::min(ja[lane], jb[lane]) >> kBlockShift;
+      const int bj1 = std::max(ja[lane], jb[lane]) >> kBlockShift;
+      blocks_tested += (bi1 - bi0 + 1) * (bj1 - bj0 + 1);
+      if (blocks_tested > kMaxBlocksTested) {
+        gaps_near = true;  // long walks: test texel by texel
+        break;
+      }
+      for (int bj = bj0; bj <= bj1; ++bj) {
+        for (int bi = bi0; bi <= bi1; ++bi) {
+          gaps_near |=
+              gap_masks_[static_cast<size_t>(bj) * blocks_w_ + static_cast<size_t>(bi)] != 0;
+        }
+      }
+    }
+  }
+  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
+  const auto load_slabs = [&](const int32_t* at, F* top, F* bottom) {
+    const void* slab[kLanes];
+    for (int lane = 0; lane < kLanes; ++lane) slab[lane] = &slabs_[static_cast<size_t>(at[lane])];
+    P::LoadSlabs(slab, top, bottom);
+  };
+  F slab_b_top, slab_b_bottom;
+  load_slabs(texel_b, &slab_b_top, &slab_b_bottom);
+  // With gaps at p1's texel: IsInside(p1) excludes the gaps, and a push-out goes to the nearer
+  // surface of p1's interval (IntervalAt).
+  F end_in_gap = zero;
+  I end_top_slot = front_slot, end_bottom_slot = back_slot;
+  uint32_t end_in_gap_texel = 0;
+  if (gaps_near) {
+    GapLanes gaps;
+    end_in_gap_texel = gather_gaps(ib, jb, lanes & p1_in_box_lanes, &gaps);
+    if (end_in_gap_texel != 0) {
+      end_in_gap = in_a_gap(gaps, p1.z);
+      const IntervalLanes around = interval_around(gaps, p1.z, slab_b_top, slab_b_bottom);
+      slab_b_top = around.top;
+      slab_b_bottom = around.bottom;
+      end_top_slot = around.top_slot;
+      end_bottom_slot = around.bottom_slot;
+    }
+  }
+
+  // The walk (BodyMapWalk::Run<1>, WalkCells with cells of one texel). Each step moves to the
+  // neighbour across the edge the segment crosses first, both on an exact corner; the crossing
+  // parameters are (edge - g0) * SafeInverse(g1 - g0), +inf on an axis with no edge left. Run's
+  // path for at most one edge per axis clamps them to [0, 1] (so a corner both reach at s = 1
+  // is one step): the lanes clamp where it applies, which is only the first crossing.
+  const auto safe_inverse = [&](F d) {
+    return StdMin(StdMax(Div(one, d), P::Splat(-1e30f)), P::Splat(1e30f));
+  };
+  const F inv_du = safe_inverse(Sub(u1, u0)), inv_dv = safe_inverse(Sub(v1, v0));
+  const I zero_i = P::ZeroI(), one_i = P::SplatI(1);
+  const I up_i = Greater(di, zero_i), down_i = Less(di, zero_i);
+  const I up_j = Greater(dj, zero_i), down_j = Less(dj, zero_i);
+  const I step_i = Sub(down_i, up_i);  // +1, -1 or 0
+  const I step_j = Sub(down_j, up_j);
+  const I width_i = P::SplatI(static_cast<int32_t>(width_));
+  const I step_row = Or(And(up_j, width_i), And(down_j, Sub(zero_i, width_i)));
+  const F step_u = ToFloat(step_i), step_v = ToFloat(step_j);
+  // Per axis: the next edge the segment leaves through, as a float (exact; i + 1 moving up, i
+  // moving down), its crossing `next`, and the crossing of the edge after it, so that a step
+  // only selects (the crossing's arithmetic stays off the loop's dependency chain).
+  F edge_u = ToFloat(Sub(i0, up_i));
+  F edge_v = ToFloat(Sub(j0, up_j));
+  const auto crossing = [&](F edge, F g0, F inv, I left, I more) {
+    return SelectLanes(AsFloat(Greater(left, more)), Mul(Sub(edge, g0), inv), inf);
+  };
+  const F clamped = AsFloat(And(Less(left_i, P::SplatI(2)), Less(left_j, P::SplatI(2))));
+  F active = lane_mask(lanes);
+  const auto first_crossing = [&](F edge, F g0, F inv, I left) {
+    const F s = crossing(edge, g0, inv, left, zero_i);
+    // Lanes that are not walked never step (their texel stays a valid index).
+    return SelectLanes(active, SelectLanes(clamped, StdMin(StdMax(s, zero), one), s), inf);
+  };
+  F next_u = first_crossing(edge_u, u0, inv_du, left_i);
+  F next_v = first_crossing(edge_v, v0, inv_dv, left_j);
+  F after_u = crossing(Add(edge_u, step_u), u0, inv_du, left_i, one_i);
+  F after_v = crossing(Add(edge_v, step_v), v0, inv_dv, left_j, one_i);
+
+  // Texel by texel (BodyMapWalk::VisitTexel without gaps): the first entry of each lane. The
+  // loop only finds the texel of the entry and keeps what VisitLanes needs to place it, so that
+  // its division runs once, after the loop. A lane keeps stepping after its entry (along its own
+  // segment, so over valid texels) until every lane is done; only `active` lanes record.
+  F top, bottom;
+  load_slabs(start, &top, &bottom);
+  // IsInside(p0) when the walk starts at p0 (the walk starts inside when p0 is); a clipped start
+  // is outside.
+  const F start_inside =
+      AndNot(lane_mask(start_clipped), And(LessEq(q0.z, top), GreaterEq(q0.z, bottom)));
+  // (IsInside(p0) also excludes the gaps of p0's texel; the lanes need not. A start in a gap is
+  // outside every interval of its texel, so the first step's gap test already sees no wall and
+  // no staying inside there; and such a motion cannot end in a push-out, the only reader of
+  // start_inside, without an entry first. The batch tests and --check hold this bit for bit.)
+  F inside = start_inside;
+  I texel = P::Load(start);
+  I cell_i = i0, cell_j = j0;  // for the gap test
+  // BodyMapWalk::Z, with the difference z1 - z0 computed once (the same bits).
+  const F dz = Sub(q1.z, q0.z), half = P::Splat(0.5f);
+  const auto z_at = [&](F s) {
+    return SelectLanes(Less(s, half), Add(q0.z, Mul(dz, s)), Sub(q1.z, Mul(dz, Sub(one, s))));
+  };
+  F s_enter = zero, z_enter = z_at(zero);
+  // At the entered texel: the piece [s_enter, s_exit], its z, the slab, a side-wall entry.
+  F hit = zero, hit_s_enter = zero, hit_s_exit = zero, hit_z_enter = zero;
+  F hit_z_exit = zero, hit_top = zero, hit_bottom = zero, hit_wall = zero;
+  I hit_texel = zero_i;
+  alignas(32) int32_t at[kLanes], at_i[kLanes], at_j[kLanes];
+  // With gaps: the entered surfaces' slots (BodyMapCollider::Interval) and the entered texel.
+  I hit_top_slot = front_slot, hit_bottom_slot = back_slot;
+  I hit_cell_i = zero_i, hit_cell_j = zero_i;
+  const auto walk_texels = [&](auto with_gaps) {
+    constexpr bool kGaps = decltype(with_gaps)::value;
+    for (int walked = 1;; ++walked) {
+      const F next = StdMin(next_u, next_v);
+      const F s_exit = StdMin(StdMax(next, s_enter), one);
+      const F z_exit = z_at(s_exit);
+      if (walked > 1) {
+        P::Store(at, texel);
+        load_slabs(at, &top, &bottom);
+      }
+      // VisitLanes' tests: inside at entry, or reaching the slab from above or below.
+      F in_enter = And(LessEq(z_enter, top), GreaterEq(z_enter, bottom));
+      const F above = Greater(z_enter, top);  // also every background texel
+      F wall = AndNot(inside, in_enter);
+      const F reaches = SelectLanes(above, LessEq(z_exit, top), GreaterEq(z_exit, bottom));
+      F entered = And(active, Or(wall, AndNot(in_enter, reaches)));
+      F inside_after =
+          And(And(inside, in_enter), And(LessEq(z_exit, top), GreaterEq(z_exit, bottom)));
+      // What the answer needs of the entered texel: VisitLanes' top and bottom (the entered
+      // interval, or the surface reached), and with gaps the surfaces' slots.
+      F kept_top = top, kept_bottom = bottom;
+      I top_slot = front_slot, bottom_slot = back_slot;
+      if constexpr (kGaps) {
+        P::Store(at_i, cell_i);
+        P::Store(at_j, cell_j);
+        GapLanes gaps;
+        if (gather_gaps(at_i, at_j, LaneBits(active), &gaps) != 0) [[unlikely]] {
+          // BodyMapWalk::VisitTexelWithGaps: the inside set is the slab less the open gaps,
+          // z is monotone along the piece, so the first entry is into the interval holding
+          // z_enter (a side wall) or into the next interval in the direction of motion.
+          in_enter = AndNot(in_a_gap(gaps, z_enter), in_enter);
+          wall = AndNot(inside, in_enter);
+          const IntervalLanes around = interval_around(gaps, z_enter, top, bottom);
+          const F stays = And(And(inside, in_enter),
+                              And(LessEq(z_exit, around.top), GreaterEq(z_exit, around.bottom)));
+          const F search = AndNot(Or(wall, stays), all_lanes);
+          // The nearest interval top below z_enter and bottom above it.
+          F below = SelectLanes(Less(top, z_enter), top, minus_inf);
+          I below_slot = front_slot;
+          F over = SelectLanes(Greater(bottom, z_enter), bottom, inf);
+          I over_slot = back_slot;
+          for (uint32_t g = 0; g < gap_layers_; ++g) {
+            const F lower = gaps.bottom[g], upper = gaps.top[g];
+            const F lower_below = And(Less(lower, z_enter), Greater(lower, below));
+            below = SelectLanes(lower_below, lower, below);
+            below_slot =
+                SelectLanesI(lower_below, P::SplatI(3 + 2 * static_cast<int>(g)), below_slot);
+            const F upper_over = And(Greater(upper, z_enter), Less(upper, over));
+            over = SelectLanes(upper_over, upper, over);
+            over_slot = SelectLanesI(upper_over, P::SplatI(2 + 2 * static_cast<int>(g)), over_slot);
+          }
+          const F front = And(search, And(Less(z_exit, z_enter), LessEq(z_exit, below)));
+          const F back = And(search, And(Greater(z_exit, z_enter), GreaterEq(z_exit, over)));
+          entered = And(active, Or(wall, Or(front, back)));
+          inside_after = stays;
+          // VisitLanes recomputes the entry from these: the interval for a wall; the surface
+          // reached as `top` (front) or `bottom` (back), the other bound out of the way.
+          kept_top = SelectLanes(wall, around.top, SelectLanes(front, below, inf));
+          kept_bottom = SelectLanes(wall, around.bottom, SelectLanes(back, over, minus_inf));
+          top_slot = SelectLanesI(wall, around.top_slot, below_slot);
+          bottom_slot = SelectLanesI(wall, around.bottom_slot, over_slot);
+        }
+      }
+      if (LaneBits(entered) != 0) {
+        hit = Or(hit, entered);
+        hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
+        hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
+        hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
+        hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
+        hit_top = SelectLanes(entered, kept_top, hit_top);
+        hit_bottom = SelectLanes(entered, kept_bottom, hit_bottom);
+        hit_wall = SelectLanes(entered, wall, hit_wall);
+        if constexpr (kGaps) {
+          hit_top_slot = SelectLanesI(entered, top_slot, hit_top_slot);
+          hit_bottom_slot = SelectLanesI(entered, bottom_slot, hit_bottom_slot);
+          hit_cell_i = SelectLanesI(entered, cell_i, hit_cell_i);
+          hit_cell_j = SelectLanesI(entered, cell_j, hit_cell_j);
+        }
+        hit_texel = SelectLanesI(entered, texel, hit_texel);
+      }
+      inside = inside_after;
+      const F going = Less(next, inf);  // an edge left to cross
+      active = And(AndNot(entered, active), going);
+      if (LaneBits(active) == 0) return;
+      if (walked == kMaxLaneWalkTexels) {  // still walking: long through air, one by one
+        lanes &= ~LaneBits(active);
+        return;
+      }
+      // Step across the edge(s) reached at `next`.
+      const F across_u = And(going, Equal(next_u, next));
+      const F across_v = And(going, Equal(next_v, next));
+      const I across_u_i = AsInt(across_u), across_v_i = AsInt(across_v);
+      next_u = SelectLanes(across_u, after_u, next_u);
+      next_v = SelectLanes(across_v, after_v, next_v);
+      texel = Add(texel, Add(And(across_u_i, step_i), And(across_v_i, step_row)));
+      if constexpr (kGaps) {
+        cell_i = Add(cell_i, And(across_u_i, step_i));
+        cell_j = Add(cell_j, And(across_v_i, step_j));
+      }
+      left_i = Add(left_i, across_u_i);  // a mask is -1
+      left_j = Add(left_j, across_v_i);
+      edge_u = Add(edge_u, And(across_u, step_u));
+      edge_v = Add(edge_v, And(across_v, step_v));
+      after_u =
+          SelectLanes(across_u, crossing(Add(edge_u, step_u), u0, inv_du, left_i, one_i), after_u);
+      after_v =
+          SelectLanes(across_v, crossing(Add(edge_v, step_v), v0, inv_dv, left_j, one_i), after_v);
+      s_enter = s_exit;
+      z_enter = z_exit;
+    }
+  };
+  if (gaps_near) {
+    walk_texels(std::true_type{});
+  } else {
+    walk_texels(std::false_type{});
+  }
+  if (lanes == 0) return answered_misses;
+  // The entry in its texel: VisitLanes again on the kept piece (a side-wall entry is one where
+  // the walk was not inside at the texel's entry point).
+  const LaneVisit<P> entry = VisitLanes<P>(hit_top, hit_bottom, hit_s_enter, hit_s_exit,
+                                           hit_z_enter, hit_z_exit, AndNot(hit_wall, all_lanes));
+  // A side-wall entry at the clipped start on the box's top or bottom face is through that face:
+  // the front surface moving down, the back moving up (BodyMapWalk::HitAtStart).
+  const F z_face = And(And(hit_wall, lane_mask(start_on_z_face)), Equal(hit_s_enter, zero));
+  const F moving_down = Less(q1.z, q0.z);
+  const F hit_s = entry.s;
+  const F hit_z = SelectLanes(z_face, SelectLanes(moving_down, hit_top, hit_bottom), entry.z);
+  const F hit_back = SelectLanes(z_face, AndNot(moving_down, z_face), entry.back);
+  hit_wall = AndNot(z_face, hit_wall);
+
+  // The answer (WalkInto): the entry point on the segment, stepped back across a side wall by
+  // 1e-3 texel, with the entered surface's normal (at a wall, the nearer surface of the entered
+  // texel's slab); with no entry and p1 inside, p1 pushed out along z to the nearer surface of
+  // its slab.
+  const F inside_end = AndNot(
+      end_in_gap, And(p1_in_box, And(LessEq(p1.z, slab_b_top), GreaterEq(p1.z, slab_b_bottom))));
+  const F push_out = AndNot(hit, inside_end);
+  const uint32_t contact_lanes = LaneBits(Or(hit, push_out)) & lanes;
+  if (contact_lanes == 0) {  // through air (most long motions in free space)
+    for (int lane = 0; lane < kLanes; ++lane) {
+      if ((lanes >> lane) & 1u) flags[index[lane]] = kCollisionNone;
+    }
+    return lanes | answered_misses;
+  }
+  const F wall = And(hit, hit_wall);
+  const LanePoint<P> placed = PlaceContactLanes<P>(q0, q1, hit_s, hit_z, wall, push_out, p1,
+                                                   slab_b_top, slab_b_bottom, 1e-3f * texel_size_);
+  const F wall_back = Less(Sub(hit_z, hit_bottom), Sub(hit_top, hit_z));
+  const F use_back =
+      SelectLanes(push_out, placed.push_back, SelectLanes(wall, wall_back, hit_back));
+  const uint32_t back_lanes = LaneBits(use_back);
+  const uint32_t push_lanes = LaneBits(push_out);
+  alignas(32) int32_t entered_texel[kLanes], entered_slot[2][kLanes];
+  alignas(32) int32_t entered_i[kLanes], entered_j[kLanes], end_slot[2][kLanes];
+  P::Store(entered_texel, hit_texel);
+  if (gaps_near) {
+    P::Store(end_slot[0], end_top_slot);
+    P::Store(end_slot[1], end_bottom_slot);
+    P::Store(entered_slot[0], hit_top_slot);
+    P::Store(entered_slot[1], hit_bottom_slot);
+    P::Store(entered_i, hit_cell_i);
+    P::Store(entered_j, hit_cell_j);
+  }
+  uint16_t qa[kLanes] = {}, qb[kLanes] = {};
+  for (int lane = 0; lane < kLanes; ++lane) {
+    const bool pushed = (push_lanes >> lane) & 1u, back = (back_lanes >> lane) & 1u;
+    const int32_t t = pushed ? texel_b[lane] : entered_texel[lane];
+    const TexelNormals& n = normals_[static_cast<size_t>(t)];
+    const uint16_t* q = back ? n.back : n.front;
+    if (!pushed && gaps_near && entered_slot[back ? 1 : 0][lane] >= 2) {  // a gap's
+      q = SlotCode(static_cast<uint32_t>(entered_i[lane]), static_cast<uint32_t>(entered_j[lane]),
+                   entered_slot[back ? 1 : 0][lane]);
+    }
+    if (pushed && ((end_in_gap_texel >> lane) & 1u) && end_slot[back ? 1 : 0][lane] >= 2) {
+      q = SlotCode(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]),
+                   end_slot[back ? 1 : 0][lane]);
+    }
+    qa[lane] = q[0];
+    qb[lane] = q[1];
+  }
+  const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
+  const uint32_t wall_lanes = LaneBits(wall);
+  const uint32_t started_inside_lanes = push_lanes & LaneBits(start_inside);
+  WriteLaneAnswers<P>(index, lanes, contact_lanes, wall_lanes, started_inside_lanes, placed.point,
+                      normal, v, params, positions, velocities, flags);
+  return lanes | answered_misses;
+}
+
+}  // namespace drape
