@@ -11,8 +11,9 @@
 //                                        nearest, 1 bilinear; motion 0: 0.1-0.5 texels
 //                                        sideways, 1: 1-2 texels, 2: up to 0.02 texels
 //                                        (cloth resting on the body)
-//  BM_CollideBatch/<shape>/<N>/<threads>/<motion>
-//                                        the same segments through CollideBatch (+ response)
+//  BM_CollideBatch/<shape>/<N>/<threads>/<motion>/<lanes>
+//                                        the same segments through CollideBatch (+ response);
+//                                        lanes 8: AVX2 where the CPU has it, 4: SSE2 forced
 //  BM_SegmentLength/<texels>/<sampling>  Query on horizontal segments of 1..256 texels at a
 //                                        random depth inside the body's z range, N = 1024 man
 //
@@ -120,7 +121,7 @@ BodyMapPose MakePose(int shape, uint32_t n) {
   return pose;
 }
 
-const BodyMapCollider& Collider(int shape, uint32_t n, DepthSampling sampling) {
+BodyMapCollider& Collider(int shape, uint32_t n, DepthSampling sampling) {
   static std::unique_ptr<BodyMapCollider> cache[2][2][2];
   std::unique_ptr<BodyMapCollider>& slot =
       cache[shape][n == 1024 ? 1 : 0][sampling == DepthSampling::kBilinear ? 1 : 0];
@@ -243,8 +244,13 @@ BENCHMARK(BM_Continuous)->ArgsProduct({{0, 1}, {512, 1024}, {0, 1}, {0, 1, 2}});
 
 void BM_CollideBatch(benchmark::State& state) {
   const int shape = static_cast<int>(state.range(0));
-  const BodyMapCollider& c =
+  BodyMapCollider& c =
       Collider(shape, static_cast<uint32_t>(state.range(1)), DepthSampling::kNearest);
+  c.AllowAvx2(state.range(4) == 8);
+  if (state.range(4) == 8 && !c.uses_avx2()) {
+    state.SkipWithError("this CPU has no AVX2");
+    return;
+  }
   std::vector<Float3> from, to;
   SheetSegments(shape, c.texel_size(), static_cast<int>(state.range(3)), &from, &to);
   std::vector<Float3> positions(to.size()), velocities(to.size());
@@ -264,7 +270,9 @@ void BM_CollideBatch(benchmark::State& state) {
   omp_set_num_threads(omp_get_num_procs());
   SetPerParticle(state, from.size());
 }
-BENCHMARK(BM_CollideBatch)->ArgsProduct({{0, 1}, {512, 1024}, {1, 2}, {0, 1, 2}})->UseRealTime();
+BENCHMARK(BM_CollideBatch)
+    ->ArgsProduct({{0, 1}, {512, 1024}, {1, 2}, {0, 1, 2}, {8, 4}})
+    ->UseRealTime();
 
 // Horizontal segments of a fixed length in texels, random start over the figure's box and a
 // random depth inside its z range: the walk runs until the first entry or the end.

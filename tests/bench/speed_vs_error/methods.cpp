@@ -19,7 +19,8 @@ void DieOnError(const Status& status, const std::string& what) {
 
 class BodyMapMethod final : public Method {
  public:
-  BodyMapMethod(const BodyMapPose& pose, DepthSampling sampling) {
+  BodyMapMethod(const BodyMapPose& pose, DepthSampling sampling, bool allow_avx2) {
+    collider_.AllowAvx2(allow_avx2);
     DieOnError(collider_.Build(pose, sampling), "body maps");
   }
   void Collide(std::span<const Float3> previous, std::span<Float3> positions,
@@ -261,8 +262,9 @@ ResponseParams BenchResponse() {
 }
 
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
-                                          std::string setting, size_t baked_bytes) {
-  auto method = std::make_unique<BodyMapMethod>(pose, sampling);
+                                          std::string setting, size_t baked_bytes,
+                                          bool allow_avx2) {
+  auto method = std::make_unique<BodyMapMethod>(pose, sampling, allow_avx2);
   method->family = "maps";
   method->setting = std::move(setting);
   method->baked_bytes = baked_bytes;

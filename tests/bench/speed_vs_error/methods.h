@@ -59,9 +59,10 @@ class Method {
   bool speed_only = false;   // no accuracy metrics (its answers do not classify inside)
 };
 
-// Paper A's body maps of one pose.
+// Paper A's body maps of one pose; allow_avx2 false keeps CollideBatch to four SSE2 lanes.
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
-                                          std::string setting, size_t baked_bytes);
+                                          std::string setting, size_t baked_bytes,
+                                          bool allow_avx2 = true);
 
 // Paper B's colliders at one pose (skinning applied at the start and the end of the step).
 // Either list may be empty (hulls alone, joint spheres alone).

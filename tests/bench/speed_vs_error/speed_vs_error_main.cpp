@@ -160,7 +160,8 @@ struct MapSetting {
   float epsilon = 0.005f;
   DepthEncoding depth = DepthEncoding::kUnorm16;
   NormalEncoding normals = NormalEncoding::kOct16;
-  uint8_t layers = 1;  // the slab plus layers - 1 air gaps per texel
+  uint8_t layers = 1;       // the slab plus layers - 1 air gaps per texel
+  bool sse2_lanes = false;  // CollideBatch kept to four SSE2 lanes (else eight with AVX2)
 };
 
 std::string Describe(const MapSetting& m) {
@@ -168,6 +169,7 @@ std::string Describe(const MapSetting& m) {
   s << "N=" << m.resolution << (m.sampling == DepthSampling::kBilinear ? " bilinear" : " nearest");
   if (m.fitted) s << " fitted";
   if (m.layers != 1) s << " layers=" << int(m.layers);
+  if (m.sse2_lanes) s << " SSE2 lanes";
   if (m.epsilon != 0.005f) s << " eps=" << m.epsilon * 1000.f << "mm";
   if (m.depth != DepthEncoding::kUnorm16 || m.normals != NormalEncoding::kOct16) {
     s << (m.depth == DepthEncoding::kFloat32 ? " depth=f32" : " depth=u16")
@@ -208,6 +210,14 @@ std::vector<MapSetting> MapSweep(bool quick) {
       MapSetting m;
       m.resolution = n;
       m.sampling = s;
+      sweep.push_back(m);
+    }
+    // The same maps with the batch kept to four SSE2 lanes: what the eight AVX2 lanes buy
+    // (the answers are the same bits; --check holds both to the one-by-one query).
+    if (n <= 512) {
+      MapSetting m;
+      m.resolution = n;
+      m.sse2_lanes = true;
       sweep.push_back(m);
     }
     // Air-gap layers (nearest): what paper A's slab bias costs in missed crossings.
@@ -387,7 +397,8 @@ class Measurement {
       bake::BodyMapPoseStats stats;
       const Status baked = bake::BakeBodyMapPose(positions, triangles, o, &pose, &stats);
       if (!baked.ok()) Fail(spec.label + " maps " + Describe(m) + ": " + baked.message());
-      Measure(context, *MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes));
+      Measure(context,
+              *MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes, !m.sse2_lanes));
       const bool combo = m.sampling == DepthSampling::kBilinear && !m.fitted &&
                          m.epsilon == 0.005f && m.depth == DepthEncoding::kUnorm16 &&
                          m.normals == NormalEncoding::kOct16 &&
@@ -516,7 +527,7 @@ class Measurement {
     for (const MapSetting& m : posed_maps) {
       const MapSetting defaults;
       if (m.sampling != DepthSampling::kNearest || m.fitted || m.epsilon != defaults.epsilon ||
-          m.depth != defaults.depth || m.normals != defaults.normals) {
+          m.depth != defaults.depth || m.normals != defaults.normals || m.sse2_lanes) {
         continue;
       }
       const bake::BodyMapOptions o = BodyMapOptionsFor(m);
