@@ -477,6 +477,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
                        : -1;
       with_gaps |= static_cast<uint32_t>(base[lane] >= 0) << lane;
     }
+    if (with_gaps == 0) return with_gaps;  // the callers read the gaps only when a lane has some
     // Built from scalars, not stored and read back (that would stall the store forwarding).
     for (uint32_t g = 0; g < gap_layers_; ++g) {
       out->top[g] = P::FromLanes([&](int l) {
