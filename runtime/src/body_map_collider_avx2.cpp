@@ -92,8 +92,10 @@ struct Avx2Lanes {
     return _mm256_setr_ps(value(0), value(1), value(2), value(3), value(4), value(5), value(6),
                           value(7));
   }
-  static I Load(const int32_t* aligned) {
-    return _mm256_load_si256(reinterpret_cast<const __m256i*>(aligned));
+  template <class Value>
+  static I FromLanesI(const Value& value) {
+    return _mm256_setr_epi32(value(0), value(1), value(2), value(3), value(4), value(5), value(6),
+                             value(7));
   }
   static void Store(int32_t* aligned, I a) {
     _mm256_store_si256(reinterpret_cast<__m256i*>(aligned), a);

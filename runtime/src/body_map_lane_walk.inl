@@ -142,10 +142,10 @@ struct LanePoint {
   typename P::F push_back;
 };
 template <class P>
-LanePoint<P> PlaceContactLanes(const Lanes3<P>& q0, const Lanes3<P>& q1, typename P::F s,
-                               typename P::F entry_z, typename P::F wall, typename P::F push_out,
-                               const Lanes3<P>& p1, typename P::F end_top, typename P::F end_bottom,
-                               float back_off_length) {
+[[gnu::always_inline]] inline LanePoint<P> PlaceContactLanes(
+    const Lanes3<P>& q0, const Lanes3<P>& q1, typename P::F s, typename P::F entry_z,
+    typename P::F wall, typename P::F push_out, const Lanes3<P>& p1, typename P::F end_top,
+    typename P::F end_bottom, float back_off_length) {
   using F = typename P::F;
   const F zero = P::Zero();
   const F dx = Sub(q1.x, q0.x), dy = Sub(q1.y, q0.y);
@@ -281,13 +281,20 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   P::Store(ja, j0);
   P::Store(ib, i1);
   P::Store(jb, j1);
+  // (The slab addresses are taken in the same loop: a vector read of the indices written lane
+  // by lane just before would stall the store forwarding.)
+  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
   size_t texel_a[kLanes], texel_b[kLanes];
+  const void* slab_a[kLanes];
+  const void* slab_b[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
     const bool used = (lanes >> lane) & 1u;
     texel_a[lane] =
         used ? static_cast<size_t>(ja[lane]) * width_ + static_cast<size_t>(ia[lane]) : 0;
     texel_b[lane] =
         used ? static_cast<size_t>(jb[lane]) * width_ + static_cast<size_t>(ib[lane]) : 0;
+    slab_a[lane] = &slabs_[texel_a[lane]];
+    slab_b[lane] = &slabs_[texel_b[lane]];
   }
   if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
     for (int lane = 0; lane < kLanes; ++lane) {
@@ -299,14 +306,7 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
     }
   }
   if (lanes == 0) return free_lanes;
-  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
   F slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
-  const void* slab_a[kLanes];
-  const void* slab_b[kLanes];
-  for (int lane = 0; lane < kLanes; ++lane) {
-    slab_a[lane] = &slabs_[texel_a[lane]];
-    slab_b[lane] = &slabs_[texel_b[lane]];
-  }
   P::LoadSlabs(slab_a, &slab_a_top, &slab_a_bottom);
   P::LoadSlabs(slab_b, &slab_b_top, &slab_b_bottom);
 
@@ -635,8 +635,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   // no staying inside there; and such a motion cannot end in a push-out, the only reader of
   // start_inside, without an entry first. The batch tests and --check hold this bit for bit.)
   F inside = start_inside;
-  I texel = P::Load(start);
-  I cell_i = i0, cell_j = j0;  // for the gap test
+  I texel = P::FromLanesI([&](int l) { return start[l]; });  // (written lane by lane above)
+  I cell_i = i0, cell_j = j0;                                // for the gap test
   // BodyMapWalk::Z, with the difference z1 - z0 computed once (the same bits).
   const F dz = Sub(q1.z, q0.z), half = P::Splat(0.5f);
   const auto z_at = [&](F s) {

@@ -88,8 +88,9 @@ struct Sse2Lanes {
   static F FromLanes(const Value& value) {
     return _mm_setr_ps(value(0), value(1), value(2), value(3));
   }
-  static I Load(const int32_t* aligned) {
-    return _mm_load_si128(reinterpret_cast<const __m128i*>(aligned));
+  template <class Value>
+  static I FromLanesI(const Value& value) {
+    return _mm_setr_epi32(value(0), value(1), value(2), value(3));
   }
   static void Store(int32_t* aligned, I a) {
     _mm_store_si128(reinterpret_cast<__m128i*>(aligned), a);
