@@ -1906,7 +1906,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
           walked_gap_contacts +=
               (f & kCollisionContact) != 0 && (has_gaps(previous[q]) || has_gaps(positions[q]));
           // Starts strictly inside a gap, which the lanes' start test does not look for (their
-          // answers must match anyway: CollideFourWalks' note at start_inside).
+          // answers must match anyway: the note at start_inside in body_map_lane_walk.inl).
           const auto in_a_gap = [&](Float3 p) {
             const float u = (p.x - c.origin_x()) / texel, v = (p.y - c.origin_y()) / texel;
             float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];

@@ -373,7 +373,7 @@ class BodyMapCollider {
                             Float3* positions, Float3* velocities, uint8_t* flags,
                             const ResponseParams& params) const;
   // A lane still walking after this many texels is answered one by one: a walk that long goes
-  // through air, which the one-by-one walk skips 8x8 blocks at a time, and four lanes in step
+  // through air, which the one-by-one walk skips 8x8 blocks at a time, and lanes in step
   // wait for the longest. Tuned on the speed-vs-error query sets (docs/PERFORMANCE.md).
   static constexpr int kMaxLaneWalkTexels = 32;
   // top/bottom at texel coordinates (u, v) >= 0 inside the grid, in half-texel cell (ci, cj) =
