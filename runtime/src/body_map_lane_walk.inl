@@ -467,12 +467,19 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   struct GapLanes {
     F top[kMaxBodyMapLayers - 1], bottom[kMaxBodyMapLayers - 1];
   };
-  const auto gather_gaps = [&](const int32_t(&ci)[kLanes], const int32_t(&cj)[kLanes],
-                               uint32_t which, GapLanes* out) {
+  const auto gather_gaps = [&](I cell_i_lanes, I cell_j_lanes, uint32_t which, GapLanes* out) {
+    // The lanes that may have gaps first (AVX2 tests the blocks' masks in lanes), so that a step
+    // without one (most steps near gaps) skips the scalar work.
+    const uint32_t maybe =
+        P::LanesWithGapBit(cell_i_lanes, cell_j_lanes, gap_masks_.data(), blocks_w_, which);
+    if (maybe == 0) return maybe;
+    alignas(32) int32_t ci[kLanes], cj[kLanes];
+    P::Store(ci, cell_i_lanes);
+    P::Store(cj, cell_j_lanes);
     int64_t base[kLanes];
     uint32_t with_gaps = 0;
     for (int lane = 0; lane < kLanes; ++lane) {
-      base[lane] = ((which >> lane) & 1u)
+      base[lane] = ((maybe >> lane) & 1u)
                        ? GapBase(static_cast<uint32_t>(ci[lane]), static_cast<uint32_t>(cj[lane]))
                        : -1;
       with_gaps |= static_cast<uint32_t>(base[lane] >= 0) << lane;
@@ -572,7 +579,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   uint32_t end_in_gap_texel = 0;
   if (gaps_near) {
     GapLanes gaps;
-    end_in_gap_texel = gather_gaps(ib, jb, lanes & p1_in_box_lanes, &gaps);
+    end_in_gap_texel = gather_gaps(i1, j1, lanes & p1_in_box_lanes, &gaps);
     if (end_in_gap_texel != 0) {
       end_in_gap = in_a_gap(gaps, p1.z);
       const IntervalLanes around = interval_around(gaps, p1.z, slab_b_top, slab_b_bottom);
@@ -647,7 +654,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   F hit = zero, hit_s_enter = zero, hit_s_exit = zero, hit_z_enter = zero;
   F hit_z_exit = zero, hit_top = zero, hit_bottom = zero, hit_wall = zero;
   I hit_texel = zero_i;
-  alignas(32) int32_t at[kLanes], at_i[kLanes], at_j[kLanes];
+  alignas(32) int32_t at[kLanes];
   // With gaps: the entered surfaces' slots (BodyMapCollider::Interval) and the entered texel.
   I hit_top_slot = front_slot, hit_bottom_slot = back_slot;
   I hit_cell_i = zero_i, hit_cell_j = zero_i;
@@ -674,10 +681,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       F kept_top = top, kept_bottom = bottom;
       I top_slot = front_slot, bottom_slot = back_slot;
       if constexpr (kGaps) {
-        P::Store(at_i, cell_i);
-        P::Store(at_j, cell_j);
         GapLanes gaps;
-        if (gather_gaps(at_i, at_j, LaneBits(active), &gaps) != 0) [[unlikely]] {
+        if (gather_gaps(cell_i, cell_j, LaneBits(active), &gaps) != 0) [[unlikely]] {
           // BodyMapWalk::VisitTexelWithGaps: the inside set is the slab less the open gaps,
           // z is monotone along the piece, so the first entry is into the interval holding
           // z_enter (a side wall) or into the next interval in the direction of motion.

@@ -96,6 +96,10 @@ struct Sse2Lanes {
     _mm_store_si128(reinterpret_cast<__m128i*>(aligned), a);
   }
   static void Store(float* aligned, F a) { _mm_store_ps(aligned, a); }
+  // The lanes of `which` whose texel (i, j) may have air gaps, given the per-8x8-block bit masks
+  // (BodyMapCollider::GapBase): here all of them (GapBase answers lane by lane); Avx2Lanes tests
+  // the masks.
+  static uint32_t LanesWithGapBit(I, I, const uint64_t*, uint32_t, uint32_t which) { return which; }
   // Four consecutive (x, y, z) float triples (48 packed bytes) as lanes: three loads and a
   // transpose.
   static void LoadFloat3s(const void* triples, F* x, F* y, F* z) {
