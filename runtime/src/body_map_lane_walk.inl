@@ -297,8 +297,11 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
     slab_b[lane] = &slabs_[texel_b[lane]];
   }
   if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
+    // Only the lanes whose texels may have gaps are asked (the walk's gap gather does the same).
+    const uint32_t maybe = P::LanesWithGapBit(i0, j0, gap_masks_.data(), blocks_w_, lanes) |
+                           P::LanesWithGapBit(i1, j1, gap_masks_.data(), blocks_w_, lanes);
     for (int lane = 0; lane < kLanes; ++lane) {
-      if (((lanes >> lane) & 1u) &&
+      if (((maybe >> lane) & 1u) &&
           (GapBase(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane])) >= 0 ||
            GapBase(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane])) >= 0)) {
         lanes &= ~(1u << lane);
