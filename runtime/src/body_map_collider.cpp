@@ -1413,22 +1413,27 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
     const bool eight_lanes = uses_avx2();
     const uint32_t width = eight_lanes ? 8u : 4u;
     uint32_t skip_short = 0;  // groups
-    uint32_t queued[8];
+    // The particles waiting for the walking lanes: fewer than `width` between groups, so a group
+    // adds at most `width` more.
+    uint32_t queued[16];
     uint32_t queued_count = 0;
+    // Walks the first `width` queued particles (all of them, padded, for the last group).
     const auto walk_queued = [&] {
-      for (uint32_t lane = queued_count; lane < width; ++lane) queued[lane] = queued[0];
-      const uint32_t lanes = (1u << queued_count) - 1u;
+      const uint32_t walked = std::min(queued_count, width);
+      for (uint32_t lane = walked; lane < width; ++lane) queued[lane] = queued[0];
+      const uint32_t lanes = (1u << walked) - 1u;
       const uint32_t answered =
           eight_lanes
               ? CollideEightWalks(queued, lanes, previous, positions, velocities, flags, params)
               : CollideFourWalks(queued, lanes, previous, positions, velocities, flags, params);
-      for (uint32_t lane = 0; lane < queued_count; ++lane) {
+      for (uint32_t lane = 0; lane < walked; ++lane) {
         if (!(answered & (1u << lane))) {
           const uint32_t q = queued[lane];
           flags[q] = CollideOne(previous[q], &positions[q], &velocities[q], params);
         }
       }
-      queued_count = 0;
+      for (uint32_t i = walked; i < queued_count; ++i) queued[i - walked] = queued[i];
+      queued_count -= walked;
     };
     for (; k + width <= count; k += width) {
       uint32_t answered = 0, long_motions = 0;
@@ -1445,13 +1450,15 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
           skip_short = kScalarParticles / width;
         }
       }
+      // The unanswered lanes join the queue without a branch each: which lanes a group answers
+      // is data, and mispredicted branches here cost more than the stores.
       for (uint32_t lane = 0; lane < width; ++lane) {
-        if (answered & (1u << lane)) continue;
-        queued[queued_count++] = static_cast<uint32_t>(k + lane);
-        if (queued_count == width) walk_queued();
+        queued[queued_count] = static_cast<uint32_t>(k + lane);
+        queued_count += ((answered >> lane) & 1u) ^ 1u;
       }
+      if (queued_count >= width) walk_queued();
     }
-    if (queued_count != 0) walk_queued();
+    while (queued_count != 0) walk_queued();
   }
 #endif
   for (; k < count; ++k) {

@@ -32,6 +32,13 @@ Lanes3<P> LoadFloat3Lanes(const Float3* p) {
 
 constexpr uint32_t kConsecutiveLanes[8] = {0, 1, 2, 3, 4, 5, 6, 7};
 
+// The mask of the lanes whose bit is set in `bits`.
+template <class P>
+typename P::F MaskOfLanes(uint32_t bits) {
+  const typename P::I bit = P::LaneBitValues();
+  return AsFloat(Equal(And(P::SplatI(static_cast<int32_t>(bits)), bit), bit));
+}
+
 // BodyMapWalk::Along.
 template <class P>
 typename P::F AlongLanes(typename P::F a, typename P::F b, typename P::F s) {
@@ -167,27 +174,33 @@ template <class P>
 
 // The lanes' answers, written to element index[l] of the arrays for each lane l in `lanes`:
 // ApplyResponse (collision_types.h) at `point` with `normal` for the lanes in contact, and the
-// flags CollideOne gives. `v` holds the lanes' velocities.
+// flags CollideOne gives. `p` and `v` hold the lanes' positions and velocities as read: a lane
+// without contact writes them back, the same bits, so that no write waits on a branch over the
+// contact (which lanes touch the body is data, and a mispredicted branch costs more than the
+// store).
 template <class P>
 [[gnu::always_inline]] inline void WriteLaneAnswers(const uint32_t* index, uint32_t lanes,
                                                     uint32_t contact_lanes, uint32_t wall_lanes,
                                                     uint32_t started_inside_lanes,
                                                     const Lanes3<P>& point, const Lanes3<P>& normal,
-                                                    const Lanes3<P>& v,
+                                                    const Lanes3<P>& p, const Lanes3<P>& v,
                                                     const ResponseParams& params, Float3* positions,
                                                     Float3* velocities, uint8_t* flags) {
   using F = typename P::F;
   // The position on the surface plus the separation; the velocity only where it points into
   // the body.
   const F zero = P::Zero();
+  const F in_contact = MaskOfLanes<P>(contact_lanes);
   const F separation = P::Splat(params.separation);
-  const Lanes3<P> position = {Add(point.x, Mul(normal.x, separation)),
-                              Add(point.y, Mul(normal.y, separation)),
-                              Add(point.z, Mul(normal.z, separation))};
+  const auto place = [&](F on_surface, F n, F unchanged) {
+    return SelectLanes(in_contact, Add(on_surface, Mul(n, separation)), unchanged);
+  };
+  const Lanes3<P> position = {place(point.x, normal.x, p.x), place(point.y, normal.y, p.y),
+                              place(point.z, normal.z, p.z)};
   const F vn = Add(Add(Mul(v.x, normal.x), Mul(v.y, normal.y)), Mul(v.z, normal.z));
   const F keep = P::Splat(1.f - params.friction);
   const F restitution = P::Splat(params.restitution);
-  const F into = Less(vn, zero);
+  const F into = And(in_contact, Less(vn, zero));
   const auto respond = [&](F velocity, F n) {
     const F normal_part = Mul(n, vn);
     const F changed = Sub(Mul(Sub(velocity, normal_part), keep), Mul(normal_part, restitution));
@@ -201,16 +214,13 @@ template <class P>
   for (int lane = 0; lane < P::kCount; ++lane) {
     if (!((lanes >> lane) & 1u)) continue;
     const uint32_t k = index[lane];
-    if (!((contact_lanes >> lane) & 1u)) {
-      flags[k] = kCollisionNone;
-      continue;
-    }
     positions[k] = Float3{out[0][lane], out[1][lane], out[2][lane]};
     velocities[k] = Float3{out[3][lane], out[4][lane], out[5][lane]};
-    const uint8_t kind = (wall_lanes >> lane) & 1u             ? kCollisionSideWall
-                         : (started_inside_lanes >> lane) & 1u ? kCollisionStartedInside
-                                                               : kCollisionNone;
-    flags[k] = static_cast<uint8_t>(kCollisionContact | kind);
+    const uint32_t contact = (contact_lanes >> lane) & 1u;
+    const uint32_t wall = (wall_lanes >> lane) & 1u;
+    const uint32_t started_inside = (started_inside_lanes >> lane) & 1u & (wall ^ 1u);
+    flags[k] = static_cast<uint8_t>(contact * (kCollisionContact | wall * kCollisionSideWall |
+                                               started_inside * kCollisionStartedInside));
   }
 }
 
@@ -269,9 +279,9 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
                                                          fixed_outside(p0.y, p1.y, y_lo, y_hi)),
                                                       fixed_outside(p0.z, p1.z, z_lo, z_hi)))) &
                               ~LaneBits(answerable);
-  for (int lane = 0; lane < kLanes; ++lane) {
-    if ((free_lanes >> lane) & 1u) flags[lane] = kCollisionNone;
-  }
+  // Every lane's flag starts as no contact (one store): the free lanes' answer, and the lanes in
+  // air keep it. The lanes not answered here get theirs from the walk or one by one, after.
+  for (int lane = 0; lane < kLanes; ++lane) flags[lane] = kCollisionNone;
   uint32_t lanes = LaneBits(answerable);
   if (lanes == 0) return free_lanes;
 
@@ -345,12 +355,7 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   const F push_out = AndNot(Or(hit_a, hit_b), inside_end);
   const F contact = Or(Or(hit_a, hit_b), push_out);
   const uint32_t contact_lanes = LaneBits(contact) & lanes;
-  if (contact_lanes == 0) {  // points and motions in air
-    for (int lane = 0; lane < kLanes; ++lane) {
-      if ((lanes >> lane) & 1u) flags[lane] = kCollisionNone;
-    }
-    return lanes | free_lanes;
-  }
+  if (contact_lanes == 0) return lanes | free_lanes;  // points and motions in air
 
   // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3
   // texel (WalkInto), or p1 moved to the nearer surface of its slab.
@@ -378,8 +383,11 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
   const uint32_t wall_lanes = LaneBits(wall);
   const uint32_t started_inside_lanes = LaneBits(And(push_out, start_inside));
-  WriteLaneAnswers<P>(kConsecutiveLanes, lanes, contact_lanes, wall_lanes, started_inside_lanes,
-                      placed.point, normal, v, params, positions, velocities, flags);
+  // Every lane is written, with no branch on which are answered: the others get their own
+  // position and velocity back and a flag the walk or the one-by-one query replaces.
+  WriteLaneAnswers<P>(kConsecutiveLanes, (1u << kLanes) - 1u, contact_lanes, wall_lanes,
+                      started_inside_lanes, placed.point, normal, p1, v, params, positions,
+                      velocities, flags);
   return lanes | free_lanes;
 }
 
@@ -457,10 +465,6 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   const I di = Sub(i1, i0), dj = Sub(j1, j0);
   I left_i = Abs(di), left_j = Abs(dj);
 
-  const auto lane_mask = [&](uint32_t bits) {
-    const I bit = P::LaneBitValues();
-    return AsFloat(Equal(And(P::SplatI(static_cast<int32_t>(bits)), bit), bit));
-  };
   // Texels with gaps (maps.layers > 1): their inside set is the slab less the open gaps, split
   // into intervals whose surfaces have slots (BodyMapCollider::Interval).
   const I front_slot = P::SplatI(kFrontSlot), back_slot = P::SplatI(kBackSlot);
@@ -619,7 +623,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     return SelectLanes(AsFloat(Greater(left, more)), Mul(Sub(edge, g0), inv), inf);
   };
   const F clamped = AsFloat(And(Less(left_i, P::SplatI(2)), Less(left_j, P::SplatI(2))));
-  F active = lane_mask(lanes);
+  F active = MaskOfLanes<P>(lanes);
   const auto first_crossing = [&](F edge, F g0, F inv, I left) {
     const F s = crossing(edge, g0, inv, left, zero_i);
     // Lanes that are not walked never step (their texel stays a valid index).
@@ -639,7 +643,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   // IsInside(p0) when the walk starts at p0 (the walk starts inside when p0 is); a clipped start
   // is outside.
   const F start_inside =
-      AndNot(lane_mask(start_clipped), And(LessEq(q0.z, top), GreaterEq(q0.z, bottom)));
+      AndNot(MaskOfLanes<P>(start_clipped), And(LessEq(q0.z, top), GreaterEq(q0.z, bottom)));
   // (IsInside(p0) also excludes the gaps of p0's texel; the lanes need not. A start in a gap is
   // outside every interval of its texel, so the first step's gap test already sees no wall and
   // no staying inside there; and such a motion cannot end in a push-out, the only reader of
@@ -722,7 +726,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
           bottom_slot = SelectLanesI(wall, around.bottom_slot, over_slot);
         }
       }
-      if (LaneBits(entered) != 0) {
+      {
         hit = Or(hit, entered);
         hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
         hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
@@ -782,7 +786,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
                                            hit_z_enter, hit_z_exit, AndNot(hit_wall, all_lanes));
   // A side-wall entry at the clipped start on the box's top or bottom face is through that face:
   // the front surface moving down, the back moving up (BodyMapWalk::HitAtStart).
-  const F z_face = And(And(hit_wall, lane_mask(start_on_z_face)), Equal(hit_s_enter, zero));
+  const F z_face = And(And(hit_wall, MaskOfLanes<P>(start_on_z_face)), Equal(hit_s_enter, zero));
   const F moving_down = Less(q1.z, q0.z);
   const F hit_s = entry.s;
   const F hit_z = SelectLanes(z_face, SelectLanes(moving_down, hit_top, hit_bottom), entry.z);
@@ -843,7 +847,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   const uint32_t wall_lanes = LaneBits(wall);
   const uint32_t started_inside_lanes = push_lanes & LaneBits(start_inside);
   WriteLaneAnswers<P>(index, lanes, contact_lanes, wall_lanes, started_inside_lanes, placed.point,
-                      normal, v, params, positions, velocities, flags);
+                      normal, p1, v, params, positions, velocities, flags);
   return lanes | answered_misses;
 }
 

@@ -336,8 +336,9 @@ class BodyMapCollider {
   // whose motion stays in one texel or crosses one texel edge, with both ends in the clip box
   // and no gaps in either texel, and for those whose motion keeps one coordinate outside the
   // clip box (no contact): writes their flags, positions and velocities bit for bit as
-  // CollideOne would and returns their lane mask (bit l = particle l); the other lanes are
-  // untouched. *long_motions receives the lanes with finite input and both ends in the clip box
+  // CollideOne would and returns their lane mask (bit l = particle l). The other lanes keep
+  // their positions and velocities (written back, the same bits) and get flags the caller must
+  // replace. *long_motions receives the lanes with finite input and both ends in the clip box
   // that cross more than one texel edge.
   uint32_t CollideFourShortMotions(const Float3* previous, Float3* positions, Float3* velocities,
                                    uint8_t* flags, const ResponseParams& params,
