@@ -726,23 +726,23 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
           bottom_slot = SelectLanesI(wall, around.bottom_slot, over_slot);
         }
       }
-      {
-        hit = Or(hit, entered);
-        hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
-        hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
-        hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
-        hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
-        hit_top = SelectLanes(entered, kept_top, hit_top);
-        hit_bottom = SelectLanes(entered, kept_bottom, hit_bottom);
-        hit_wall = SelectLanes(entered, wall, hit_wall);
-        if constexpr (kGaps) {
-          hit_top_slot = SelectLanesI(entered, top_slot, hit_top_slot);
-          hit_bottom_slot = SelectLanesI(entered, bottom_slot, hit_bottom_slot);
-          hit_cell_i = SelectLanesI(entered, cell_i, hit_cell_i);
-          hit_cell_j = SelectLanesI(entered, cell_j, hit_cell_j);
-        }
-        hit_texel = SelectLanesI(entered, texel, hit_texel);
+      // Recorded at every step, with no test whether a lane entered: which step holds a lane's
+      // entry is data, and the selects cost less than that branch's mispredictions.
+      hit = Or(hit, entered);
+      hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
+      hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
+      hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
+      hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
+      hit_top = SelectLanes(entered, kept_top, hit_top);
+      hit_bottom = SelectLanes(entered, kept_bottom, hit_bottom);
+      hit_wall = SelectLanes(entered, wall, hit_wall);
+      if constexpr (kGaps) {
+        hit_top_slot = SelectLanesI(entered, top_slot, hit_top_slot);
+        hit_bottom_slot = SelectLanesI(entered, bottom_slot, hit_bottom_slot);
+        hit_cell_i = SelectLanesI(entered, cell_i, hit_cell_i);
+        hit_cell_j = SelectLanesI(entered, cell_j, hit_cell_j);
       }
+      hit_texel = SelectLanesI(entered, texel, hit_texel);
       inside = inside_after;
       const F going = Less(next, inf);  // an edge left to cross
       active = And(AndNot(entered, active), going);
