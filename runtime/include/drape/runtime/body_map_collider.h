@@ -185,9 +185,9 @@ class BodyMapCollider {
                       const ResponseParams& params, uint32_t* contact_count = nullptr) const;
 
   // With kNearest, CollideBatch takes particles eight at a time in AVX2 when the CPU has it,
-  // else four in SSE2: the same bits either way (18-22 % less time on the speed-vs-error mix at
-  // N = 256, docs/PERFORMANCE.md). AllowAvx2(false) keeps it to SSE2 (tests, measurement); the
-  // choice survives Build and sequence blending.
+  // else four in SSE2: the same bits either way (21-35 % less time on the speed-vs-error mix at
+  // N = 256 and 512 on the humans, run out-sve17 in docs/PERFORMANCE.md). AllowAvx2(false) keeps
+  // it to SSE2 (tests, measurement); the choice survives Build and sequence blending.
   void AllowAvx2(bool allow) { allow_avx2_ = allow; }
   bool uses_avx2() const;  // allowed, and the CPU (and OS) support it
 
