@@ -198,7 +198,7 @@ std::vector<MapSetting> MapSweep(bool quick) {
       quick ? std::vector<uint32_t>{256, 512} : std::vector<uint32_t>{256, 512, 1024, 2048};
   if (!quick) {
     // Below paper A's sizes, nearest only: where the misses start, and the cost floor that the
-    // fixed per-particle work sets (N = 128 saves only 6-15 % of N = 256's time).
+    // fixed per-particle work sets (N = 128 saves only 7-18 % of N = 256's time, run out-sve17).
     for (uint32_t n : {128u, 192u}) {
       MapSetting m;
       m.resolution = n;
