@@ -130,21 +130,27 @@ Options ParseOptions(int argc, char** argv) {
   return o;
 }
 
-// Imports at the detected scale; a human taller than 2.5 m (Animated_Human imports 5.25 m: its
-// FBX carries no usable unit) is rescaled to 1.75 m so that millimetres compare across people.
+// Imports at the detected scale; a human taller than 2.5 m (Animated_Human's rest pose spans
+// 5.26 m: its FBX carries no usable unit; RobotExpressive's glTF 4.46 m) is rescaled to 1.75 m
+// so that millimetres compare across people. The height is the rest pose's, the body every
+// measurement uses. The bind-pose mesh can differ from it by the armature's scale: on those two
+// it spans 8 and 2.6 cm, and an earlier version measured it and so rescaled neither.
 bake::ImportOptions ImportFor(const CharacterSpec& spec, bake::Character* character,
                               std::string* note) {
   bake::ImportOptions import;
   Status s = bake::ImportCharacter(spec.path, import, character);
   if (!s.ok()) Fail(spec.path + ": " + s.message());
+  bake::Regions rest;
+  s = bake::SplitRegions(*character, 0.99f, &rest);
+  if (!s.ok()) Fail(spec.path + ": " + s.message());
   float lo = 1e30f, hi = -1e30f;
-  for (const Float3& p : character->mesh.positions) lo = std::min(lo, p.y), hi = std::max(hi, p.y);
+  for (const Float3& p : rest.rest_positions) lo = std::min(lo, p.y), hi = std::max(hi, p.y);
   const float height = hi - lo;
   if (spec.human && height > 2.5f) {
     import.unit_scale = double(character->info.unit_scale) * 1.75 / double(height);
     s = bake::ImportCharacter(spec.path, import, character);
     if (!s.ok()) Fail(spec.path + ": " + s.message());
-    *note = "imports " + std::to_string(height) + " m tall; measured rescaled to 1.75 m";
+    *note = "its rest pose is " + std::to_string(height) + " m tall; measured rescaled to 1.75 m";
   }
   return import;
 }
