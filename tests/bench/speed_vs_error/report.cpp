@@ -269,9 +269,13 @@ std::vector<std::string> WriteCharts(const std::string& dir, const std::vector<R
     const std::string png = base + ".png";
     {
       std::ofstream gp(base + ".gp");
-      gp << "set terminal pngcairo size 1200,900 font 'sans,10'\n"
+      // noenhanced: names such as Animated_Human are text, not subscripts. In a single-quoted
+      // gnuplot string a quote is written twice.
+      std::string title;
+      for (const char c : character) title += c == '\'' ? std::string("''") : std::string(1, c);
+      gp << "set terminal pngcairo noenhanced size 1200,900 font 'sans,10'\n"
          << "set output '" << png << "'\n"
-         << "set multiplot layout 2,1 title '" << character
+         << "set multiplot layout 2,1 title '" << title
          << ": speed against error (one marker per setting; line: Pareto front)'\n"
          << "set logscale x\nset grid\nset key outside right top\n"
          << "set xrange [" << lo / 1.5 << ":" << hi * 1.5 << "]\n"
