@@ -551,6 +551,7 @@ void BodyMapCollider::Clear() {
   gap_layers_ = 0;
   gap_masks_.clear();
   gap_block_first_.clear();
+  gap_texel_bits_.clear();
   gaps_.clear();
   gap_normals_.clear();
 }
@@ -844,6 +845,26 @@ void BodyMapCollider::PackGaps(std::vector<GapTexel>* texels) {
   }
 }
 
+void BodyMapCollider::FillGapTexelBits() {
+  if (gap_layers_ == 0) {
+    gap_texel_bits_.clear();
+    return;
+  }
+  // No allocation once a blend's scratch held this grid (assign keeps the capacity).
+  gap_texel_bits_.assign((static_cast<size_t>(width_) * height_ + 31) / 32, 0u);
+  for (size_t block = 0; block < gap_masks_.size(); ++block) {
+    uint64_t mask = gap_masks_[block];
+    while (mask != 0) {
+      const int bit = std::countr_zero(mask);
+      mask &= mask - 1;
+      const size_t i = ((block % blocks_w_) << kBlockShift) + (bit & (kBlockTexels - 1));
+      const size_t j = ((block / blocks_w_) << kBlockShift) + (bit >> kBlockShift);
+      const size_t k = j * width_ + i;
+      gap_texel_bits_[k / 32] |= 1u << (k % 32);
+    }
+  }
+}
+
 void BodyMapCollider::Finish() {
   const size_t w = width_, h = height_;
   uint32_t valid = 0;
@@ -864,6 +885,7 @@ void BodyMapCollider::Finish() {
   }
   stats_.valid_texels = valid;
   stats_.gap_texels = gap_layers_ == 0 ? 0u : static_cast<uint32_t>(gaps_.size() / gap_layers_);
+  FillGapTexelBits();
   const double s = texel_size_;
   if (valid == 0) {
     bounds_min_ = {1.f, 1.f, 1.f};
@@ -962,7 +984,8 @@ bool BodyMapCollider::uses_avx2() const { return allow_avx2_ && detail::CpuHasAv
 size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
-         gap_masks_.capacity() * sizeof(uint64_t) + gap_block_first_.capacity() * sizeof(uint32_t) +
+         gap_masks_.capacity() * sizeof(uint64_t) +
+         (gap_block_first_.capacity() + gap_texel_bits_.capacity()) * sizeof(uint32_t) +
          bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds);
 }
 

@@ -101,37 +101,21 @@ struct Avx2Lanes {
     _mm256_store_si256(reinterpret_cast<__m256i*>(aligned), a);
   }
   static void Store(float* aligned, F a) { _mm256_store_ps(aligned, a); }
-  // The lanes of `which` whose texel (i, j) has its bit set in its 8x8 block's gap mask
-  // (GapBase's first test), exactly. Only those lanes are read: the others may hold texels off
-  // the grid.
-  static uint32_t LanesWithGapBit(I i, I j, const uint64_t* masks, uint32_t blocks_w,
-                                  uint32_t which) {
-    const __m256i seven = _mm256_set1_epi32(7), one = _mm256_set1_epi64x(1);
-    const __m256i block =
-        _mm256_add_epi32(_mm256_mullo_epi32(_mm256_srli_epi32(j, 3),
-                                            _mm256_set1_epi32(static_cast<int32_t>(blocks_w))),
-                         _mm256_srli_epi32(i, 3));
-    const __m256i bit = _mm256_or_si256(_mm256_slli_epi32(_mm256_and_si256(j, seven), 3),
-                                        _mm256_and_si256(i, seven));
+  // The lanes of `which` whose row-major texel index has its bit set in `bits`
+  // (BodyMapCollider::gap_texel_bits_): Sse2Lanes::LanesWithTexelBit with one gather of the
+  // bits' words.
+  static uint32_t LanesWithTexelBit(I texel, const uint32_t* bits, uint32_t which) {
     const __m256i lane_bits = LaneBitValues();
     const __m256i read = _mm256_cmpeq_epi32(
         _mm256_and_si256(_mm256_set1_epi32(static_cast<int32_t>(which)), lane_bits), lane_bits);
-    const auto half = [&](int h) {
-      const __m128i block_half =
-          h == 0 ? _mm256_castsi256_si128(block) : _mm256_extracti128_si256(block, 1);
-      const __m128i bit_half =
-          h == 0 ? _mm256_castsi256_si128(bit) : _mm256_extracti128_si256(bit, 1);
-      const __m128i read_half =
-          h == 0 ? _mm256_castsi256_si128(read) : _mm256_extracti128_si256(read, 1);
-      const __m256i mask = _mm256_mask_i32gather_epi64(
-          _mm256_setzero_si256(), reinterpret_cast<const long long*>(masks), block_half,
-          _mm256_cvtepi32_epi64(read_half), 8);
-      const __m256i set =
-          _mm256_and_si256(_mm256_srlv_epi64(mask, _mm256_cvtepu32_epi64(bit_half)), one);
-      return static_cast<uint32_t>(
-          _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(set, one))));
-    };
-    return (half(0) | half(1) << 4) & which;
+    const __m256i words =
+        _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(bits),
+                                    _mm256_srli_epi32(texel, 5), read, 4);
+    const __m256i set = _mm256_srlv_epi32(words, _mm256_and_si256(texel, _mm256_set1_epi32(31)));
+    const __m256i one = _mm256_set1_epi32(1);
+    return static_cast<uint32_t>(_mm256_movemask_ps(
+               _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(set, one), one)))) &
+           which;
   }
   // Sse2Lanes::LoadFloat3s on triples 0-3 and 4-7 at once: the 256-bit shuffles work on each
   // 128-bit half alone.

@@ -307,16 +307,12 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
     slab_b[lane] = &slabs_[texel_b[lane]];
   }
   if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
-    // Only the lanes whose texels may have gaps are asked (the walk's gap gather does the same).
-    const uint32_t maybe = P::LanesWithGapBit(i0, j0, gap_masks_.data(), blocks_w_, lanes) |
-                           P::LanesWithGapBit(i1, j1, gap_masks_.data(), blocks_w_, lanes);
-    for (int lane = 0; lane < kLanes; ++lane) {
-      if (((maybe >> lane) & 1u) &&
-          (GapBase(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane])) >= 0 ||
-           GapBase(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane])) >= 0)) {
-        lanes &= ~(1u << lane);
-      }
-    }
+    // A texel's bit is set exactly when it has gaps (GapBase >= 0).
+    const auto texel_lanes = [&](const size_t* texel) {
+      return P::FromLanesI([&](int l) { return static_cast<int32_t>(texel[l]); });
+    };
+    lanes &= ~(P::LanesWithTexelBit(texel_lanes(texel_a), gap_texel_bits_.data(), lanes) |
+               P::LanesWithTexelBit(texel_lanes(texel_b), gap_texel_bits_.data(), lanes));
   }
   if (lanes == 0) return free_lanes;
   F slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
@@ -474,24 +470,17 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   struct GapLanes {
     F top[kMaxBodyMapLayers - 1], bottom[kMaxBodyMapLayers - 1];
   };
-  const auto gather_gaps = [&](I cell_i_lanes, I cell_j_lanes, uint32_t which, GapLanes* out) {
-    // The lanes that may have gaps first (AVX2 tests the blocks' masks in lanes), so that a step
-    // without one (most steps near gaps) skips the scalar work.
-    const uint32_t maybe =
-        P::LanesWithGapBit(cell_i_lanes, cell_j_lanes, gap_masks_.data(), blocks_w_, which);
-    if (maybe == 0) return maybe;
-    alignas(32) int32_t ci[kLanes], cj[kLanes];
-    P::Store(ci, cell_i_lanes);
-    P::Store(cj, cell_j_lanes);
-    int64_t base[kLanes];
-    uint32_t with_gaps = 0;
-    for (int lane = 0; lane < kLanes; ++lane) {
-      base[lane] = ((maybe >> lane) & 1u)
-                       ? GapBase(static_cast<uint32_t>(ci[lane]), static_cast<uint32_t>(cj[lane]))
-                       : -1;
-      with_gaps |= static_cast<uint32_t>(base[lane] >= 0) << lane;
-    }
+  const auto gather_gaps = [&](I texel_lanes, uint32_t which, GapLanes* out) {
+    // The lanes with gaps first (their texels' bits, tested in lanes), so that a step without
+    // one (most steps near gaps) skips the scalar work.
+    const uint32_t with_gaps = P::LanesWithTexelBit(texel_lanes, gap_texel_bits_.data(), which);
     if (with_gaps == 0) return with_gaps;  // the callers read the gaps only when a lane has some
+    alignas(32) int32_t t[kLanes];
+    P::Store(t, texel_lanes);
+    int64_t base[kLanes];
+    for (int lane = 0; lane < kLanes; ++lane) {
+      base[lane] = ((with_gaps >> lane) & 1u) ? GapBaseAt(static_cast<uint32_t>(t[lane])) : -1;
+    }
     // Built from scalars, not stored and read back (that would stall the store forwarding).
     for (uint32_t g = 0; g < gap_layers_; ++g) {
       out->top[g] = P::FromLanes([&](int l) {
@@ -586,7 +575,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   uint32_t end_in_gap_texel = 0;
   if (gaps_near) {
     GapLanes gaps;
-    end_in_gap_texel = gather_gaps(i1, j1, lanes & p1_in_box_lanes, &gaps);
+    end_in_gap_texel = gather_gaps(P::FromLanesI([&](int l) { return texel_b[l]; }),
+                                   lanes & p1_in_box_lanes, &gaps);
     if (end_in_gap_texel != 0) {
       end_in_gap = in_a_gap(gaps, p1.z);
       const IntervalLanes around = interval_around(gaps, p1.z, slab_b_top, slab_b_bottom);
@@ -650,7 +640,6 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   // start_inside, without an entry first. The batch tests and --check hold this bit for bit.)
   F inside = start_inside;
   I texel = P::FromLanesI([&](int l) { return start[l]; });  // (written lane by lane above)
-  I cell_i = i0, cell_j = j0;                                // for the gap test
   // BodyMapWalk::Z, with the difference z1 - z0 computed once (the same bits).
   const F dz = Sub(q1.z, q0.z), half = P::Splat(0.5f);
   const auto z_at = [&](F s) {
@@ -662,9 +651,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   F hit_z_exit = zero, hit_top = zero, hit_bottom = zero, hit_wall = zero;
   I hit_texel = zero_i;
   alignas(32) int32_t at[kLanes];
-  // With gaps: the entered surfaces' slots (BodyMapCollider::Interval) and the entered texel.
+  // With gaps: the entered surfaces' slots (BodyMapCollider::Interval).
   I hit_top_slot = front_slot, hit_bottom_slot = back_slot;
-  I hit_cell_i = zero_i, hit_cell_j = zero_i;
   const auto walk_texels = [&](auto with_gaps) {
     constexpr bool kGaps = decltype(with_gaps)::value;
     for (int walked = 1;; ++walked) {
@@ -689,7 +677,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       I top_slot = front_slot, bottom_slot = back_slot;
       if constexpr (kGaps) {
         GapLanes gaps;
-        if (gather_gaps(cell_i, cell_j, LaneBits(active), &gaps) != 0) [[unlikely]] {
+        if (gather_gaps(texel, LaneBits(active), &gaps) != 0) [[unlikely]] {
           // BodyMapWalk::VisitTexelWithGaps: the inside set is the slab less the open gaps,
           // z is monotone along the piece, so the first entry is into the interval holding
           // z_enter (a side wall) or into the next interval in the direction of motion.
@@ -739,8 +727,6 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       if constexpr (kGaps) {
         hit_top_slot = SelectLanesI(entered, top_slot, hit_top_slot);
         hit_bottom_slot = SelectLanesI(entered, bottom_slot, hit_bottom_slot);
-        hit_cell_i = SelectLanesI(entered, cell_i, hit_cell_i);
-        hit_cell_j = SelectLanesI(entered, cell_j, hit_cell_j);
       }
       hit_texel = SelectLanesI(entered, texel, hit_texel);
       inside = inside_after;
@@ -758,10 +744,6 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       next_u = SelectLanes(across_u, after_u, next_u);
       next_v = SelectLanes(across_v, after_v, next_v);
       texel = Add(texel, Add(And(across_u_i, step_i), And(across_v_i, step_row)));
-      if constexpr (kGaps) {
-        cell_i = Add(cell_i, And(across_u_i, step_i));
-        cell_j = Add(cell_j, And(across_v_i, step_j));
-      }
       left_i = Add(left_i, across_u_i);  // a mask is -1
       left_j = Add(left_j, across_v_i);
       edge_u = Add(edge_u, And(across_u, step_u));
@@ -816,15 +798,13 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   const uint32_t back_lanes = LaneBits(use_back);
   const uint32_t push_lanes = LaneBits(push_out);
   alignas(32) int32_t entered_texel[kLanes], entered_slot[2][kLanes];
-  alignas(32) int32_t entered_i[kLanes], entered_j[kLanes], end_slot[2][kLanes];
+  alignas(32) int32_t end_slot[2][kLanes];
   P::Store(entered_texel, hit_texel);
   if (gaps_near) {
     P::Store(end_slot[0], end_top_slot);
     P::Store(end_slot[1], end_bottom_slot);
     P::Store(entered_slot[0], hit_top_slot);
     P::Store(entered_slot[1], hit_bottom_slot);
-    P::Store(entered_i, hit_cell_i);
-    P::Store(entered_j, hit_cell_j);
   }
   uint16_t qa[kLanes] = {}, qb[kLanes] = {};
   for (int lane = 0; lane < kLanes; ++lane) {
@@ -833,8 +813,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     const TexelNormals& n = normals_[static_cast<size_t>(t)];
     const uint16_t* q = back ? n.back : n.front;
     if (!pushed && gaps_near && entered_slot[back ? 1 : 0][lane] >= 2) {  // a gap's
-      q = SlotCode(static_cast<uint32_t>(entered_i[lane]), static_cast<uint32_t>(entered_j[lane]),
-                   entered_slot[back ? 1 : 0][lane]);
+      const uint32_t entered = static_cast<uint32_t>(t);
+      q = SlotCode(entered % width_, entered / width_, entered_slot[back ? 1 : 0][lane]);
     }
     if (pushed && ((end_in_gap_texel >> lane) & 1u) && end_slot[back ? 1 : 0][lane] >= 2) {
       q = SlotCode(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]),

@@ -1271,9 +1271,12 @@ TEST(BodyMapGaps, InsideSetIsTheSlabMinusItsGaps) {
   EXPECT_EQ(paper.stats().gap_texels, 0u);
   EXPECT_EQ(three.stats().gap_texels, 40u * 40u);  // the plate's texels
   EXPECT_EQ(two.stats().gap_texels, 40u * 40u);
-  // Stored compactly: two gap slots of 16 bytes per gap texel, 12 bytes per 8x8 block.
+  // Stored compactly: two gap slots of 16 bytes per gap texel, 12 bytes per 8x8 block and one
+  // bit per texel (the lane walk's per-step test).
   const size_t blocks = 11 * 11;
-  EXPECT_LE(three.memory_bytes() - paper.memory_bytes(), 40u * 40u * 2 * 16 + blocks * 12 + 64);
+  const size_t texel_bits = (size_t{three.width()} * three.height() + 31) / 32 * 4;
+  EXPECT_LE(three.memory_bytes() - paper.memory_bytes(),
+            40u * 40u * 2 * 16 + blocks * 12 + texel_bits + 64);
   // Under the plate only (x < 0): one gap (0.05, 0.10).
   const Float3 plate_only{-0.05f, 0.01f, 0.f}, both_plates{0.03f, 0.01f, 0.f};
   const auto at = [](Float3 p, float z) { return Float3{p.x, p.y, z}; };
@@ -1537,6 +1540,48 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
   EXPECT_NEAR(lower[0], 0.75f * 0.075f + 0.25f * 0.05f, 1e-6);
   EXPECT_FALSE(blended.IsInside({-0.05f, 0.01f, 0.08f}));
   EXPECT_TRUE(blended.IsInside({-0.05f, 0.01f, 0.115f}));
+
+  // The batch's lanes find a blend's gap texels as Query does (the blend refreshes the per-texel
+  // gap bits they test): motions in and across the plates, bit for bit, in both lane widths.
+  constexpr size_t kCount = 4000;
+  std::mt19937 rng(20261123u);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  const auto in = [&](float lo, float hi) { return lo + (hi - lo) * unit(rng); };
+  std::vector<Float3> previous(kCount), positions(kCount),
+      velocities(kCount, Float3{0.f, 0.f, -1.f});
+  for (size_t k = 0; k < kCount; ++k) {
+    previous[k] = {in(-24.f, 24.f) * kTexel, in(-24.f, 24.f) * kTexel, in(-0.12f, 0.14f)};
+    const float reach = k % 2 == 0 ? 1.f : 6.f;  // texels: short lanes, and walks
+    positions[k] = {previous[k].x + in(-reach, reach) * kTexel,
+                    previous[k].y + in(-reach, reach) * kTexel, previous[k].z + in(-0.04f, 0.04f)};
+  }
+  ResponseParams params;
+  params.friction = 0.3f;
+  std::vector<Float3> want_positions = positions, want_velocities = velocities;
+  std::vector<uint8_t> want_flags(kCount);
+  size_t gap_contacts = 0;
+  for (size_t k = 0; k < kCount; ++k) {
+    const ContactQuery q = blended.Query(previous[k], positions[k]);
+    want_flags[k] = q.contact ? static_cast<uint8_t>(kCollisionContact | q.flags)
+                              : static_cast<uint8_t>(kCollisionNone);
+    if (q.contact) ApplyResponse(q, params, &want_positions[k], &want_velocities[k]);
+    // Contacts on a gap's boundary (the plate's underside or the block's top under it).
+    gap_contacts += q.contact && (q.normal.z < 0.f && q.point.z > 0.f && q.point.z < 0.11f);
+  }
+  EXPECT_GT(gap_contacts, kCount / 50);
+  for (bool avx2 : {true, false}) {
+    SCOPED_TRACE(::testing::Message() << "AVX2 allowed: " << avx2);
+    scratch.AllowAvx2(avx2);
+    std::vector<Float3> got_positions = positions, got_velocities = velocities;
+    std::vector<uint8_t> got_flags(kCount);
+    ASSERT_TRUE(
+        blended.CollideBatch(previous, got_positions, got_velocities, got_flags, params).ok());
+    for (size_t k = 0; k < kCount; ++k) {
+      ASSERT_EQ(got_flags[k], want_flags[k]) << k;
+      ExpectSameBits(got_positions[k], want_positions[k], "position", static_cast<int>(k));
+      ExpectSameBits(got_velocities[k], want_velocities[k], "velocity", static_cast<int>(k));
+    }
+  }
 }
 
 // CollideBatch answers every particle as Query and ApplyResponse do, bit for bit, whichever of

@@ -256,6 +256,9 @@ class BodyMapCollider {
     return (static_cast<int64_t>(gap_block_first_[block]) + std::popcount(mask & (bit - 1))) *
            gap_layers_;
   }
+  int64_t GapBaseAt(uint32_t texel) const {  // GapBase of a row-major texel index
+    return GapBase(texel % width_, texel / width_);
+  }
   bool InGap(int64_t base, float z) const {
     if (base < 0) return false;
     const Slab* g = gaps_.data() + base;
@@ -385,6 +388,7 @@ class BodyMapCollider {
   // Recomputes bounds, stats.valid_texels, bilinear eligibility and the min/max blocks from
   // slabs_ (used by Build and by sequence blending).
   void Finish();
+  void FillGapTexelBits();  // gap_texel_bits_ from gap_masks_ (Finish)
   void Clear();
 
   uint32_t width_ = 0, height_ = 0;
@@ -407,6 +411,10 @@ class BodyMapCollider {
   uint32_t gap_layers_ = 0;            // BodyMapPose::layers - 1
   std::vector<uint64_t> gap_masks_;    // per 8x8 block (see GapBase); empty without gaps
   std::vector<uint32_t> gap_block_first_;  // per block: gap texels in the blocks before it
+  // The same gap texels as one bit per texel in row-major order (bit k % 32 of word k / 32), so
+  // that the lane walk tests a step's texels by their index with one gather (Finish derives it
+  // from gap_masks_; empty without gaps).
+  std::vector<uint32_t> gap_texel_bits_;
   std::vector<Slab> gaps_;                 // gap_layers_ per gap texel (see GapBase)
   std::vector<TexelNormals> gap_normals_;  // same index: front = upper, back = lower boundary
 };
