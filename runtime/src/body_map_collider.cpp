@@ -552,6 +552,7 @@ void BodyMapCollider::Clear() {
   gap_masks_.clear();
   gap_block_first_.clear();
   gap_texel_bits_.clear();
+  gap_block_sums_.clear();
   gaps_.clear();
   gap_normals_.clear();
 }
@@ -845,20 +846,27 @@ void BodyMapCollider::PackGaps(std::vector<GapTexel>* texels) {
   }
 }
 
-void BodyMapCollider::FillGapTexelBits() {
+void BodyMapCollider::FillGapLookups() {
   if (gap_layers_ == 0) {
     gap_texel_bits_.clear();
+    gap_block_sums_.clear();
     return;
   }
   // No allocation once a blend's scratch held this grid (assign keeps the capacity).
   gap_texel_bits_.assign((static_cast<size_t>(width_) * height_ + 31) / 32, 0u);
+  const size_t row = static_cast<size_t>(blocks_w_) + 1;
+  gap_block_sums_.assign(row * (static_cast<size_t>(blocks_h_) + 1), 0u);
   for (size_t block = 0; block < gap_masks_.size(); ++block) {
+    const size_t bi = block % blocks_w_, bj = block / blocks_w_;
+    gap_block_sums_[(bj + 1) * row + bi + 1] =
+        gap_block_sums_[bj * row + bi + 1] + gap_block_sums_[(bj + 1) * row + bi] -
+        gap_block_sums_[bj * row + bi] + (gap_masks_[block] != 0 ? 1u : 0u);
     uint64_t mask = gap_masks_[block];
     while (mask != 0) {
       const int bit = std::countr_zero(mask);
       mask &= mask - 1;
-      const size_t i = ((block % blocks_w_) << kBlockShift) + (bit & (kBlockTexels - 1));
-      const size_t j = ((block / blocks_w_) << kBlockShift) + (bit >> kBlockShift);
+      const size_t i = (bi << kBlockShift) + (bit & (kBlockTexels - 1));
+      const size_t j = (bj << kBlockShift) + (bit >> kBlockShift);
       const size_t k = j * width_ + i;
       gap_texel_bits_[k / 32] |= 1u << (k % 32);
     }
@@ -885,7 +893,7 @@ void BodyMapCollider::Finish() {
   }
   stats_.valid_texels = valid;
   stats_.gap_texels = gap_layers_ == 0 ? 0u : static_cast<uint32_t>(gaps_.size() / gap_layers_);
-  FillGapTexelBits();
+  FillGapLookups();
   const double s = texel_size_;
   if (valid == 0) {
     bounds_min_ = {1.f, 1.f, 1.f};
@@ -985,7 +993,8 @@ size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
          gap_masks_.capacity() * sizeof(uint64_t) +
-         (gap_block_first_.capacity() + gap_texel_bits_.capacity()) * sizeof(uint32_t) +
+         (gap_block_first_.capacity() + gap_texel_bits_.capacity() + gap_block_sums_.capacity()) *
+             sizeof(uint32_t) +
          bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds);
 }
 

@@ -536,28 +536,17 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   }
   // Whether a lane can meet a texel with gaps: a walk stays in the box of its end texels, so
   // when no 8x8 block under those boxes has one (most of a body, most of the time), the lanes
-  // run the walk without the gap tests.
+  // run the walk without the gap tests. The blocks' summed-area table answers for a box in four
+  // reads, however long the walk.
   bool gaps_near = false;
   if (gap_layers_ != 0) {
-    constexpr int kMaxBlocksTested = 64;
-    int blocks_tested = 0;
-    for (int lane = 0; lane < kLanes && !gaps_near; ++lane) {
+    for (int lane = 0; lane < kLanes; ++lane) {
       if (!((lanes >> lane) & 1u)) continue;
-      const int bi0 = std::min(ia[lane], ib[lane]) >> kBlockShift;
-      const int bi1 = std::max(ia[lane], ib[lane]) >> kBlockShift;
-      const int bj0 = std::min(ja[lane], jb[lane]) >> kBlockShift;
-      const int bj1 = std::max(ja[lane], jb[lane]) >> kBlockShift;
-      blocks_tested += (bi1 - bi0 + 1) * (bj1 - bj0 + 1);
-      if (blocks_tested > kMaxBlocksTested) {
-        gaps_near = true;  // long walks: test texel by texel
-        break;
-      }
-      for (int bj = bj0; bj <= bj1; ++bj) {
-        for (int bi = bi0; bi <= bi1; ++bi) {
-          gaps_near |=
-              gap_masks_[static_cast<size_t>(bj) * blocks_w_ + static_cast<size_t>(bi)] != 0;
-        }
-      }
+      const auto block = [](int32_t texel) { return static_cast<uint32_t>(texel) >> kBlockShift; };
+      gaps_near |=
+          GapBlocksIn(block(std::min(ia[lane], ib[lane])), block(std::min(ja[lane], jb[lane])),
+                      block(std::max(ia[lane], ib[lane])),
+                      block(std::max(ja[lane], jb[lane]))) != 0;
     }
   }
   static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");

@@ -388,7 +388,14 @@ class BodyMapCollider {
   // Recomputes bounds, stats.valid_texels, bilinear eligibility and the min/max blocks from
   // slabs_ (used by Build and by sequence blending).
   void Finish();
-  void FillGapTexelBits();  // gap_texel_bits_ from gap_masks_ (Finish)
+  void FillGapLookups();  // gap_texel_bits_ and gap_block_sums_ from gap_masks_ (Finish)
+  // Blocks with gaps among blocks bi0..bi1 x bj0..bj1 (inclusive, on the grid), by the sums.
+  uint32_t GapBlocksIn(uint32_t bi0, uint32_t bj0, uint32_t bi1, uint32_t bj1) const {
+    const size_t row = blocks_w_ + 1;
+    const uint32_t* s = gap_block_sums_.data();
+    return s[(bj1 + 1) * row + bi1 + 1] - s[bj0 * row + bi1 + 1] - s[(bj1 + 1) * row + bi0] +
+           s[bj0 * row + bi0];
+  }
   void Clear();
 
   uint32_t width_ = 0, height_ = 0;
@@ -415,6 +422,10 @@ class BodyMapCollider {
   // that the lane walk tests a step's texels by their index with one gather (Finish derives it
   // from gap_masks_; empty without gaps).
   std::vector<uint32_t> gap_texel_bits_;
+  // Summed-area table of the blocks with gaps, (blocks_w_ + 1) x (blocks_h_ + 1): entry (bi, bj)
+  // counts those with block column < bi and row < bj, so that the lane walk asks whether any
+  // block under a walk has gaps in four reads (empty without gaps).
+  std::vector<uint32_t> gap_block_sums_;
   std::vector<Slab> gaps_;                 // gap_layers_ per gap texel (see GapBase)
   std::vector<TexelNormals> gap_normals_;  // same index: front = upper, back = lower boundary
 };
