@@ -867,6 +867,27 @@ void ExpectSameBits(Float3 a, Float3 b, const char* what, int k) {
   EXPECT_EQ(Bits(a.z), Bits(b.z)) << what << " " << k;
 }
 
+// What CollideBatch must answer for these motions: Query and ApplyResponse, particle by
+// particle (the queries too, for the callers' counts).
+struct OneByOne {
+  std::vector<ContactQuery> queries;
+  std::vector<Float3> positions, velocities;
+  std::vector<uint8_t> flags;
+};
+OneByOne QueryOneByOne(const BodyMapCollider& c, const std::vector<Float3>& previous,
+                       const std::vector<Float3>& positions, const std::vector<Float3>& velocities,
+                       const ResponseParams& params) {
+  OneByOne want{{}, positions, velocities, std::vector<uint8_t>(positions.size())};
+  for (size_t k = 0; k < positions.size(); ++k) {
+    const ContactQuery q = c.Query(previous[k], positions[k]);
+    want.queries.push_back(q);
+    want.flags[k] = q.contact ? static_cast<uint8_t>(kCollisionContact | q.flags)
+                              : static_cast<uint8_t>(kCollisionNone);
+    if (q.contact) ApplyResponse(q, params, &want.positions[k], &want.velocities[k]);
+  }
+  return want;
+}
+
 // Every field of two answers, bit for bit (query k).
 void ExpectSameAnswer(const ContactQuery& a, const ContactQuery& b, int k) {
   EXPECT_EQ(a.inside_end, b.inside_end) << k;
@@ -1557,17 +1578,12 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
   }
   ResponseParams params;
   params.friction = 0.3f;
-  std::vector<Float3> want_positions = positions, want_velocities = velocities;
-  std::vector<uint8_t> want_flags(kCount);
-  size_t gap_contacts = 0;
-  for (size_t k = 0; k < kCount; ++k) {
-    const ContactQuery q = blended.Query(previous[k], positions[k]);
-    want_flags[k] = q.contact ? static_cast<uint8_t>(kCollisionContact | q.flags)
-                              : static_cast<uint8_t>(kCollisionNone);
-    if (q.contact) ApplyResponse(q, params, &want_positions[k], &want_velocities[k]);
-    // Contacts on a gap's boundary (the plate's underside or the block's top under it).
-    gap_contacts += q.contact && (q.normal.z < 0.f && q.point.z > 0.f && q.point.z < 0.11f);
-  }
+  const OneByOne want = QueryOneByOne(blended, previous, positions, velocities, params);
+  // Contacts on a gap's boundary (the plate's underside or the block's top under it).
+  const size_t gap_contacts =
+      std::count_if(want.queries.begin(), want.queries.end(), [](const ContactQuery& q) {
+        return q.contact && q.normal.z < 0.f && q.point.z > 0.f && q.point.z < 0.11f;
+      });
   EXPECT_GT(gap_contacts, kCount / 50);
   for (bool avx2 : {true, false}) {
     SCOPED_TRACE(::testing::Message() << "AVX2 allowed: " << avx2);
@@ -1577,9 +1593,9 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
     ASSERT_TRUE(
         blended.CollideBatch(previous, got_positions, got_velocities, got_flags, params).ok());
     for (size_t k = 0; k < kCount; ++k) {
-      ASSERT_EQ(got_flags[k], want_flags[k]) << k;
-      ExpectSameBits(got_positions[k], want_positions[k], "position", static_cast<int>(k));
-      ExpectSameBits(got_velocities[k], want_velocities[k], "velocity", static_cast<int>(k));
+      ASSERT_EQ(got_flags[k], want.flags[k]) << k;
+      ExpectSameBits(got_positions[k], want.positions[k], "position", static_cast<int>(k));
+      ExpectSameBits(got_velocities[k], want.velocities[k], "velocity", static_cast<int>(k));
     }
   }
 }
@@ -1635,16 +1651,9 @@ TEST(BodyMapBatch, LongWalksThroughBlockEdgeCornersAnswerAsQuery) {
                       corner.y + dv * (length - before) * texel, z1};
       velocities[k] = RandomPoint(rng, -1.f, 1.f, -1.f, 1.f);
     }
-    std::vector<Float3> want_positions = positions, want_velocities = velocities;
-    std::vector<uint8_t> want_flags(kCount);
-    size_t contacts = 0;
-    for (size_t k = 0; k < kCount; ++k) {
-      const ContactQuery q = c.Query(previous[k], positions[k]);
-      want_flags[k] = q.contact ? static_cast<uint8_t>(kCollisionContact | q.flags)
-                                : static_cast<uint8_t>(kCollisionNone);
-      if (q.contact) ApplyResponse(q, params, &want_positions[k], &want_velocities[k]);
-      contacts += q.contact;
-    }
+    const OneByOne want = QueryOneByOne(c, previous, positions, velocities, params);
+    const size_t contacts = std::count_if(want.queries.begin(), want.queries.end(),
+                                          [](const ContactQuery& q) { return q.contact; });
     EXPECT_GT(contacts, kCount / 10);
     for (bool avx2 : {true, false}) {  // eight walking lanes (where the CPU has AVX2), four
       SCOPED_TRACE(::testing::Message() << "AVX2 allowed: " << avx2);
@@ -1654,9 +1663,9 @@ TEST(BodyMapBatch, LongWalksThroughBlockEdgeCornersAnswerAsQuery) {
       ASSERT_TRUE(c.CollideBatch(previous, got_positions, got_velocities, got_flags, params).ok());
       size_t differing = 0;
       for (size_t k = 0; k < kCount; ++k) {
-        differing += got_flags[k] != want_flags[k] ||
-                     std::memcmp(&got_positions[k], &want_positions[k], sizeof(Float3)) != 0 ||
-                     std::memcmp(&got_velocities[k], &want_velocities[k], sizeof(Float3)) != 0;
+        differing += got_flags[k] != want.flags[k] ||
+                     std::memcmp(&got_positions[k], &want.positions[k], sizeof(Float3)) != 0 ||
+                     std::memcmp(&got_velocities[k], &want.velocities[k], sizeof(Float3)) != 0;
       }
       EXPECT_EQ(differing, 0u);
     }
