@@ -549,9 +549,8 @@ void BodyMapCollider::Clear() {
   bilinear_ok_.clear();
   blocks_.clear();
   gap_layers_ = 0;
-  gap_masks_.clear();
-  gap_block_first_.clear();
   gap_texel_bits_.clear();
+  gap_word_first_.clear();
   gap_block_sums_.clear();
   gaps_.clear();
   gap_normals_.clear();
@@ -814,61 +813,59 @@ void BodyMapCollider::PackGaps(std::vector<GapTexel>* texels) {
   const size_t layers = gap_layers_;
   blocks_w_ = static_cast<uint32_t>((width_ + kBlockTexels - 1) >> kBlockShift);
   blocks_h_ = static_cast<uint32_t>((height_ + kBlockTexels - 1) >> kBlockShift);
-  gap_masks_.clear();
-  gap_block_first_.clear();
+  gap_texel_bits_.clear();
+  gap_word_first_.clear();
   gaps_.clear();
   gap_normals_.clear();
   if (layers == 0) return;
-  gap_masks_.assign(static_cast<size_t>(blocks_w_) * blocks_h_, 0);
-  gap_block_first_.assign(gap_masks_.size(), 0);
-  // Block order, then the bit order within a block ((j % 8) * 8 + i % 8): GapBase's order.
-  const auto block_of = [&](const GapTexel& t) {
-    return static_cast<size_t>(t.j >> kBlockShift) * blocks_w_ + (t.i >> kBlockShift);
-  };
-  const auto bit_of = [](const GapTexel& t) {
-    return ((t.j & (kBlockTexels - 1)) << kBlockShift) | (t.i & (kBlockTexels - 1));
-  };
-  std::sort(texels->begin(), texels->end(), [&](const GapTexel& a, const GapTexel& b) {
-    const size_t block_a = block_of(a), block_b = block_of(b);
-    return block_a != block_b ? block_a < block_b : bit_of(a) < bit_of(b);
-  });
+  gap_texel_bits_.assign((static_cast<size_t>(width_) * height_ + 31) / 32, 0u);
+  const auto texel_of = [&](const GapTexel& t) { return static_cast<size_t>(t.j) * width_ + t.i; };
+  std::sort(texels->begin(), texels->end(),
+            [&](const GapTexel& a, const GapTexel& b) { return texel_of(a) < texel_of(b); });
   gaps_.reserve(texels->size() * layers);  // exactly: memory_bytes() reports what gaps need
   gap_normals_.reserve(texels->size() * layers);
   for (const GapTexel& t : *texels) {
-    gap_masks_[block_of(t)] |= uint64_t{1} << bit_of(t);
+    const size_t k = texel_of(t);
+    gap_texel_bits_[k / 32] |= 1u << (k % 32);
     gaps_.insert(gaps_.end(), t.gaps, t.gaps + layers);
     gap_normals_.insert(gap_normals_.end(), t.normals, t.normals + layers);
   }
-  uint32_t before = 0;  // gap texels in the blocks before this one
-  for (size_t block = 0; block < gap_masks_.size(); ++block) {
-    gap_block_first_[block] = before;
-    before += static_cast<uint32_t>(std::popcount(gap_masks_[block]));
+  CountGapsBeforeWords();
+}
+
+void BodyMapCollider::CountGapsBeforeWords() {
+  // No allocation once a blend's scratch held this grid (assign keeps the capacity).
+  gap_word_first_.assign(gap_texel_bits_.size(), 0u);
+  uint32_t before = 0;
+  for (size_t word = 0; word < gap_texel_bits_.size(); ++word) {
+    gap_word_first_[word] = before;
+    before += static_cast<uint32_t>(std::popcount(gap_texel_bits_[word]));
   }
 }
 
 void BodyMapCollider::FillGapLookups() {
   if (gap_layers_ == 0) {
-    gap_texel_bits_.clear();
     gap_block_sums_.clear();
     return;
   }
-  // No allocation once a blend's scratch held this grid (assign keeps the capacity).
-  gap_texel_bits_.assign((static_cast<size_t>(width_) * height_ + 31) / 32, 0u);
+  // Entry (bi + 1, bj + 1) first marks block (bi, bj) as having gaps, then becomes the sum over
+  // the blocks up to it (no allocation once a blend's scratch held this grid).
   const size_t row = static_cast<size_t>(blocks_w_) + 1;
   gap_block_sums_.assign(row * (static_cast<size_t>(blocks_h_) + 1), 0u);
-  for (size_t block = 0; block < gap_masks_.size(); ++block) {
-    const size_t bi = block % blocks_w_, bj = block / blocks_w_;
-    gap_block_sums_[(bj + 1) * row + bi + 1] =
-        gap_block_sums_[bj * row + bi + 1] + gap_block_sums_[(bj + 1) * row + bi] -
-        gap_block_sums_[bj * row + bi] + (gap_masks_[block] != 0 ? 1u : 0u);
-    uint64_t mask = gap_masks_[block];
-    while (mask != 0) {
-      const int bit = std::countr_zero(mask);
-      mask &= mask - 1;
-      const size_t i = (bi << kBlockShift) + (bit & (kBlockTexels - 1));
-      const size_t j = (bj << kBlockShift) + (bit >> kBlockShift);
-      const size_t k = j * width_ + i;
-      gap_texel_bits_[k / 32] |= 1u << (k % 32);
+  for (size_t word = 0; word < gap_texel_bits_.size(); ++word) {
+    uint32_t bits = gap_texel_bits_[word];
+    while (bits != 0) {
+      const size_t k = word * 32 + static_cast<size_t>(std::countr_zero(bits));
+      bits &= bits - 1;
+      const size_t bi = (k % width_) >> kBlockShift, bj = (k / width_) >> kBlockShift;
+      gap_block_sums_[(bj + 1) * row + bi + 1] = 1u;
+    }
+  }
+  for (size_t bj = 1; bj <= blocks_h_; ++bj) {
+    for (size_t bi = 1; bi <= blocks_w_; ++bi) {
+      gap_block_sums_[bj * row + bi] += gap_block_sums_[(bj - 1) * row + bi] +
+                                        gap_block_sums_[bj * row + bi - 1] -
+                                        gap_block_sums_[(bj - 1) * row + bi - 1];
     }
   }
 }
@@ -992,8 +989,7 @@ bool BodyMapCollider::uses_avx2() const { return allow_avx2_ && detail::CpuHasAv
 size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
-         gap_masks_.capacity() * sizeof(uint64_t) +
-         (gap_block_first_.capacity() + gap_texel_bits_.capacity() + gap_block_sums_.capacity()) *
+         (gap_texel_bits_.capacity() + gap_word_first_.capacity() + gap_block_sums_.capacity()) *
              sizeof(uint32_t) +
          bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds);
 }
@@ -1727,37 +1723,29 @@ void BodyMapSequence::BlendGaps(const BodyMapCollider& a, const BodyMapCollider&
   out->gaps_.clear();
   out->gap_normals_.clear();
   if (layers == 0) {
-    out->gap_masks_.clear();
-    out->gap_block_first_.clear();
+    out->gap_texel_bits_.clear();
+    out->gap_word_first_.clear();
     return;
   }
-  const size_t blocks = a.gap_masks_.size();
-  out->gap_masks_.assign(blocks, 0);  // no allocation once the scratch held this grid
-  out->gap_block_first_.assign(blocks, 0);
+  const size_t words = a.gap_texel_bits_.size();
+  out->gap_texel_bits_.assign(words, 0u);  // no allocation once the scratch held this grid
   // Room for both poses' gaps: a blend never keeps more gap texels than the two have together.
   out->gaps_.reserve(a.gaps_.size() + b.gaps_.size());
   out->gap_normals_.reserve(a.gap_normals_.size() + b.gap_normals_.size());
   const BodyMapCollider& nearer = w <= 0.5f ? a : b;
-  uint32_t gap_texels = 0;
-  for (size_t block = 0; block < blocks; ++block) {
-    out->gap_block_first_[block] = gap_texels;
-    uint64_t candidates = a.gap_masks_[block] | b.gap_masks_[block];
+  for (size_t word = 0; word < words; ++word) {
+    uint32_t candidates = a.gap_texel_bits_[word] | b.gap_texel_bits_[word];
     while (candidates != 0) {
       const int bit = std::countr_zero(candidates);
       candidates &= candidates - 1;
-      const uint32_t i =
-          static_cast<uint32_t>((block % a.blocks_w_) << BodyMapCollider::kBlockShift) +
-          static_cast<uint32_t>(bit & (BodyMapCollider::kBlockTexels - 1));
-      const uint32_t j =
-          static_cast<uint32_t>((block / a.blocks_w_) << BodyMapCollider::kBlockShift) +
-          static_cast<uint32_t>(bit >> BodyMapCollider::kBlockShift);
-      const size_t k = static_cast<size_t>(j) * a.width_ + i;
+      const size_t k = word * 32 + static_cast<size_t>(bit);
       const Slab slab = out->slabs_[k];
       if (!(slab.top >= slab.bottom)) continue;  // background has no gaps
       const bool both =
           a.slabs_[k].top >= a.slabs_[k].bottom && b.slabs_[k].top >= b.slabs_[k].bottom;
-      const int64_t base_a = a.GapBase(i, j), base_b = b.GapBase(i, j);
-      const int64_t base_nearer = nearer.GapBase(i, j);
+      const uint32_t texel = static_cast<uint32_t>(k);
+      const int64_t base_a = a.GapBaseAt(texel), base_b = b.GapBaseAt(texel);
+      const int64_t base_nearer = nearer.GapBaseAt(texel);
       Slab gaps[kMaxBodyMapLayers];
       bool more = true;
       for (uint32_t g = 0; g < layers; ++g) {
@@ -1778,13 +1766,13 @@ void BodyMapSequence::BlendGaps(const BodyMapCollider& a, const BodyMapCollider&
       }
       if (!(gaps[0].top > gaps[0].bottom)) continue;
       // Kept gaps exist in the nearer pose (blended ones in both), so its normals are there.
-      out->gap_masks_[block] |= uint64_t{1} << bit;
-      ++gap_texels;
+      out->gap_texel_bits_[word] |= 1u << bit;
       out->gaps_.insert(out->gaps_.end(), gaps, gaps + layers);
       out->gap_normals_.insert(out->gap_normals_.end(), nearer.gap_normals_.begin() + base_nearer,
                                nearer.gap_normals_.begin() + base_nearer + layers);
     }
   }
+  out->CountGapsBeforeWords();
 }
 
 size_t BodyMapSequence::memory_bytes() const {

@@ -477,18 +477,21 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     if (with_gaps == 0) return with_gaps;  // the callers read the gaps only when a lane has some
     alignas(32) int32_t t[kLanes];
     P::Store(t, texel_lanes);
-    int64_t base[kLanes];
+    // Each lane's gaps, or for a lane without gaps ones that hold no z (-inf, +inf): the gaps
+    // are slabs, so one LoadSlabs per layer reads them for every lane.
+    static_assert(kMaxBodyMapLayers == 4, "one absent gap per gap layer below");
+    static constexpr Slab kNoGaps[kMaxBodyMapLayers - 1] = {
+        {-kInfinity, kInfinity}, {-kInfinity, kInfinity}, {-kInfinity, kInfinity}};
+    const Slab* first[kLanes];
     for (int lane = 0; lane < kLanes; ++lane) {
-      base[lane] = ((with_gaps >> lane) & 1u) ? GapBaseAt(static_cast<uint32_t>(t[lane])) : -1;
+      first[lane] = ((with_gaps >> lane) & 1u)
+                        ? gaps_.data() + GapBaseAt(static_cast<uint32_t>(t[lane]))
+                        : kNoGaps;
     }
-    // Built from scalars, not stored and read back (that would stall the store forwarding).
     for (uint32_t g = 0; g < gap_layers_; ++g) {
-      out->top[g] = P::FromLanes([&](int l) {
-        return base[l] >= 0 ? gaps_[static_cast<size_t>(base[l]) + g].top : -kInfinity;
-      });
-      out->bottom[g] = P::FromLanes([&](int l) {
-        return base[l] >= 0 ? gaps_[static_cast<size_t>(base[l]) + g].bottom : kInfinity;
-      });
+      const void* gap[kLanes];
+      for (int lane = 0; lane < kLanes; ++lane) gap[lane] = first[lane] + g;
+      P::LoadSlabs(gap, &out->top[g], &out->bottom[g]);
     }
     return with_gaps;
   };

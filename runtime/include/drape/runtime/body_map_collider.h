@@ -116,9 +116,10 @@ class BodyMapSequence;
 // (top, bottom z as float) + 8 bytes of normals (front and back, re-encoded as oct16 whatever the
 // input encoding: float32 input loses < 0.004 degrees) + 1 byte of bilinear eligibility in
 // kBilinear mode, plus 8 bytes per 8x8 block for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB
-// (17.1 MiB bilinear). A pose with gap layers adds 12 bytes per 8x8 block and, per texel that
-// has a gap, 16 bytes per gap layer (the gaps' upper and lower z, their normals). memory_bytes()
-// reports the exact figure.
+// (17.1 MiB bilinear). A pose with gap layers adds a bit and a quarter per texel (which texels
+// have gaps, and a count per 32 of them), 4 bytes per 8x8 block (which blocks have gaps, summed)
+// and, per texel that has a gap, 16 bytes per gap layer (the gaps' upper and lower z, their
+// normals). memory_bytes() reports the exact figure.
 //
 // Air gaps (BodyMapPose::layers > 1): a texel's inside set is its slab minus its gaps, i.e. up to
 // `layers` disjoint z intervals. Every query honours them: an entry into the body below a gap is
@@ -242,23 +243,21 @@ class BodyMapCollider {
     int top_slot, bottom_slot;
   };
   static constexpr int kFrontSlot = 0, kBackSlot = 1;
-  // Gaps are stored compactly (on a character a few percent of the texels have one): per 8x8
-  // block a bit mask of its texels with gaps (bit (j % 8) * 8 + i % 8) and the number of gap
-  // texels in the blocks before it; gap texel t holds gap g at gaps_[t * gap_layers_ + g]
-  // (upper in `top`, lower in `bottom`; an absent gap holds top = -inf, bottom = +inf, which no z
-  // lies strictly between). GapBase: the index of texel (i, j)'s first gap, or -1 for none.
-  int64_t GapBase(uint32_t i, uint32_t j) const {
-    const size_t block = static_cast<size_t>(j >> kBlockShift) * blocks_w_ + (i >> kBlockShift);
-    const uint64_t bit = uint64_t{1}
-                         << (((j & (kBlockTexels - 1)) << kBlockShift) | (i & (kBlockTexels - 1)));
-    const uint64_t mask = gap_masks_[block];
-    if (!(mask & bit)) return -1;
-    return (static_cast<int64_t>(gap_block_first_[block]) + std::popcount(mask & (bit - 1))) *
+  // Gaps are stored compactly (on a character a few percent of the texels have one): one bit per
+  // texel in row-major order (bit k % 32 of gap_texel_bits_[k / 32]) and, per 32-bit word, the
+  // number of gap texels in the words before it; the n-th gap texel in row-major order holds gap
+  // g at gaps_[n * gap_layers_ + g] (upper in `top`, lower in `bottom`; an absent gap holds
+  // top = -inf, bottom = +inf, which no z lies strictly between). GapBaseAt: the index of
+  // row-major texel k's first gap, or -1 for none (shifts and a popcount: the lanes call it per
+  // step on texels with gaps, where a division by the width cost more than the rest).
+  int64_t GapBaseAt(uint32_t texel) const {
+    const uint32_t word = gap_texel_bits_[texel >> 5];
+    const uint32_t bit = 1u << (texel & 31u);
+    if (!(word & bit)) return -1;
+    return (static_cast<int64_t>(gap_word_first_[texel >> 5]) + std::popcount(word & (bit - 1u))) *
            gap_layers_;
   }
-  int64_t GapBaseAt(uint32_t texel) const {  // GapBase of a row-major texel index
-    return GapBase(texel % width_, texel / width_);
-  }
+  int64_t GapBase(uint32_t i, uint32_t j) const { return GapBaseAt(j * width_ + i); }
   bool InGap(int64_t base, float z) const {
     if (base < 0) return false;
     const Slab* g = gaps_.data() + base;
@@ -288,8 +287,8 @@ class BodyMapCollider {
     Slab gaps[kMaxBodyMapLayers - 1];
     TexelNormals normals[kMaxBodyMapLayers - 1];
   };
-  // Stores the texels' gaps compactly, in block order (sorts *texels). Needs width_, height_ and
-  // gap_layers_; sets blocks_w_ and blocks_h_ as Finish does.
+  // Stores the texels' gaps compactly, in row-major order (sorts *texels). Needs width_, height_
+  // and gap_layers_; sets blocks_w_ and blocks_h_ as Finish does.
   void PackGaps(std::vector<GapTexel>* texels);
 
   static constexpr uint32_t kBlockShift = 3;  // 8x8 texels per min/max block
@@ -388,7 +387,8 @@ class BodyMapCollider {
   // Recomputes bounds, stats.valid_texels, bilinear eligibility and the min/max blocks from
   // slabs_ (used by Build and by sequence blending).
   void Finish();
-  void FillGapLookups();  // gap_texel_bits_ and gap_block_sums_ from gap_masks_ (Finish)
+  void FillGapLookups();        // gap_block_sums_ from gap_texel_bits_ (Finish)
+  void CountGapsBeforeWords();  // gap_word_first_ from gap_texel_bits_
   // Blocks with gaps among blocks bi0..bi1 x bj0..bj1 (inclusive, on the grid), by the sums.
   uint32_t GapBlocksIn(uint32_t bi0, uint32_t bj0, uint32_t bi1, uint32_t bj1) const {
     const size_t row = blocks_w_ + 1;
@@ -416,15 +416,14 @@ class BodyMapCollider {
   std::vector<uint8_t> bilinear_ok_;   // width*height (kBilinear only): block (i, j)..(i+1, j+1)
   std::vector<BlockBounds> blocks_;    // blocks_w_ * blocks_h_
   uint32_t gap_layers_ = 0;            // BodyMapPose::layers - 1
-  std::vector<uint64_t> gap_masks_;    // per 8x8 block (see GapBase); empty without gaps
-  std::vector<uint32_t> gap_block_first_;  // per block: gap texels in the blocks before it
-  // The same gap texels as one bit per texel in row-major order (bit k % 32 of word k / 32), so
-  // that the lane walk tests a step's texels by their index with one gather (Finish derives it
-  // from gap_masks_; empty without gaps).
+  // The gap texels, one bit per texel in row-major order (see GapBaseAt), and per word of it the
+  // gap texels before that word; empty without gaps.
   std::vector<uint32_t> gap_texel_bits_;
-  // Summed-area table of the blocks with gaps, (blocks_w_ + 1) x (blocks_h_ + 1): entry (bi, bj)
-  // counts those with block column < bi and row < bj, so that the lane walk asks whether any
-  // block under a walk has gaps in four reads (empty without gaps).
+  std::vector<uint32_t> gap_word_first_;
+  // Summed-area table of the 8x8 blocks with gaps, (blocks_w_ + 1) x (blocks_h_ + 1): entry
+  // (bi, bj) counts those with block column < bi and row < bj, so that the lane walk asks whether
+  // any block under a walk has gaps in four reads (Finish derives it from the bits; empty without
+  // gaps).
   std::vector<uint32_t> gap_block_sums_;
   std::vector<Slab> gaps_;                 // gap_layers_ per gap texel (see GapBase)
   std::vector<TexelNormals> gap_normals_;  // same index: front = upper, back = lower boundary
