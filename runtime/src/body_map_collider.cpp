@@ -1473,7 +1473,6 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
                                                   flags + k, params, &long_motions)
                        : CollideFourShortMotions(previous + k, positions + k, velocities + k,
                                                  flags + k, params, &long_motions);
-        // (Lanes it declines for gaps are short: they do not count.)
         if (2 * static_cast<uint32_t>(std::popcount(long_motions)) >= width) {
           skip_short = kScalarParticles / width;
         }

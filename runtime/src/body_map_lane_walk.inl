@@ -226,6 +226,126 @@ template <class P>
 
 }  // namespace
 
+// A texel's inside set with gaps (BodyMapCollider::TexelIntervals) is its slab less the open
+// gaps, split into intervals whose surfaces have slots (BodyMapCollider::Interval): the slab's
+// front and back, and per gap g its lower boundary (an interval's top, slot 3 + 2g) and its upper
+// one (an interval's bottom, slot 2 + 2g).
+template <class P>
+struct BodyMapCollider::GapLanes {
+  using F = typename P::F;
+  using I = typename P::I;
+  uint32_t layers = 0;  // gap layers: BodyMapCollider::gap_layers_
+  F top[kMaxBodyMapLayers - 1], bottom[kMaxBodyMapLayers - 1];
+
+  // z strictly inside one of the gaps (BodyMapCollider::InGap).
+  F InGap(F z) const {
+    F in = P::Zero();
+    for (uint32_t g = 0; g < layers; ++g) in = Or(in, And(Less(z, top[g]), Greater(z, bottom[g])));
+    return in;
+  }
+  // The interval holding z (IntervalAmongGaps): bounded by the nearest gap boundary or slab
+  // surface above and below z.
+  struct Interval {
+    F top, bottom;
+    I top_slot, bottom_slot;
+  };
+  Interval Around(F z, F slab_top, F slab_bottom) const {
+    Interval in{slab_top, slab_bottom, P::SplatI(kFrontSlot), P::SplatI(kBackSlot)};
+    for (uint32_t g = 0; g < layers; ++g) {
+      const F lower_above = And(GreaterEq(bottom[g], z), Less(bottom[g], in.top));
+      in.top = SelectLanes(lower_above, bottom[g], in.top);
+      in.top_slot = SelectLanesI(lower_above, P::SplatI(3 + 2 * static_cast<int>(g)), in.top_slot);
+      const F upper_below = And(LessEq(top[g], z), Greater(top[g], in.bottom));
+      in.bottom = SelectLanes(upper_below, top[g], in.bottom);
+      in.bottom_slot =
+          SelectLanesI(upper_below, P::SplatI(2 + 2 * static_cast<int>(g)), in.bottom_slot);
+    }
+    return in;
+  }
+  // One walk visit with gaps (BodyMapWalk::VisitTexelWithGaps) of the piece z_enter -> z_exit,
+  // `inside` at its entry point. z is monotone along the piece, so the first entry is into the
+  // interval holding z_enter (a side wall) or into the next interval in the direction of motion.
+  // VisitLanes places the entry from kept_top / kept_bottom: the interval for a wall; the
+  // surface reached as `top` (front) or `bottom` (back), the other bound out of the way.
+  struct Visit {
+    F wall, front, back;  // masks: how the piece enters, if it does
+    F stays;              // inside at the entry and still at the exit (the next `inside`)
+    F kept_top, kept_bottom;
+    I top_slot, bottom_slot;  // the slots of kept_top and kept_bottom
+  };
+  Visit VisitTexel(F slab_top, F slab_bottom, F z_enter, F z_exit, F inside) const {
+    constexpr float kInfinity = std::numeric_limits<float>::infinity();
+    const F inf = P::Splat(kInfinity), minus_inf = P::Splat(-kInfinity);
+    const I front_slot = P::SplatI(kFrontSlot), back_slot = P::SplatI(kBackSlot);
+    const F in_enter =
+        AndNot(InGap(z_enter), And(LessEq(z_enter, slab_top), GreaterEq(z_enter, slab_bottom)));
+    Visit visit;
+    visit.wall = AndNot(inside, in_enter);
+    const Interval around = Around(z_enter, slab_top, slab_bottom);
+    visit.stays = And(And(inside, in_enter),
+                      And(LessEq(z_exit, around.top), GreaterEq(z_exit, around.bottom)));
+    const F search = AndNot(Or(visit.wall, visit.stays), AsFloat(P::SplatI(-1)));
+    // The nearest interval top below z_enter and bottom above it.
+    F below = SelectLanes(Less(slab_top, z_enter), slab_top, minus_inf);
+    I below_slot = front_slot;
+    F over = SelectLanes(Greater(slab_bottom, z_enter), slab_bottom, inf);
+    I over_slot = back_slot;
+    for (uint32_t g = 0; g < layers; ++g) {
+      const F lower_below = And(Less(bottom[g], z_enter), Greater(bottom[g], below));
+      below = SelectLanes(lower_below, bottom[g], below);
+      below_slot = SelectLanesI(lower_below, P::SplatI(3 + 2 * static_cast<int>(g)), below_slot);
+      const F upper_over = And(Greater(top[g], z_enter), Less(top[g], over));
+      over = SelectLanes(upper_over, top[g], over);
+      over_slot = SelectLanesI(upper_over, P::SplatI(2 + 2 * static_cast<int>(g)), over_slot);
+    }
+    visit.front = And(search, And(Less(z_exit, z_enter), LessEq(z_exit, below)));
+    visit.back = And(search, And(Greater(z_exit, z_enter), GreaterEq(z_exit, over)));
+    visit.kept_top = SelectLanes(visit.wall, around.top, SelectLanes(visit.front, below, inf));
+    visit.kept_bottom =
+        SelectLanes(visit.wall, around.bottom, SelectLanes(visit.back, over, minus_inf));
+    visit.top_slot = SelectLanesI(visit.wall, around.top_slot, below_slot);
+    visit.bottom_slot = SelectLanesI(visit.wall, around.bottom_slot, over_slot);
+    return visit;
+  }
+};
+
+template <class P>
+uint32_t BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t which,
+                                         GapLanes<P>* out) const {
+  constexpr int kLanes = P::kCount;
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  out->layers = gap_layers_;
+  // The lanes with gaps first (their texels' bits, tested in lanes), so that a step without one
+  // (most steps near gaps) skips the scalar work.
+  const uint32_t with_gaps = P::LanesWithTexelBit(texel, gap_texel_bits_.data(), which);
+  if (with_gaps == 0) {
+    for (uint32_t g = 0; g < gap_layers_; ++g) {
+      out->top[g] = P::Splat(-kInfinity);
+      out->bottom[g] = P::Splat(kInfinity);
+    }
+    return with_gaps;
+  }
+  alignas(32) int32_t t[kLanes];
+  P::Store(t, texel);
+  // Each lane's gaps, or for a lane without gaps ones that hold no z (-inf, +inf): the gaps are
+  // slabs, so one LoadSlabs per layer reads them for every lane.
+  static_assert(kMaxBodyMapLayers == 4, "one absent gap per gap layer below");
+  static constexpr Slab kNoGaps[kMaxBodyMapLayers - 1] = {
+      {-kInfinity, kInfinity}, {-kInfinity, kInfinity}, {-kInfinity, kInfinity}};
+  const Slab* first[kLanes];
+  for (int lane = 0; lane < kLanes; ++lane) {
+    first[lane] = ((with_gaps >> lane) & 1u)
+                      ? gaps_.data() + GapBaseAt(static_cast<uint32_t>(t[lane]))
+                      : kNoGaps;
+  }
+  for (uint32_t g = 0; g < gap_layers_; ++g) {
+    const void* gap[kLanes];
+    for (int lane = 0; lane < kLanes; ++lane) gap[lane] = first[lane] + g;
+    P::LoadSlabs(gap, &out->top[g], &out->bottom[g]);
+  }
+  return with_gaps;
+}
+
 template <class P>
 uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* positions,
                                             Float3* velocities, uint8_t* flags,
@@ -306,18 +426,20 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
     slab_a[lane] = &slabs_[texel_a[lane]];
     slab_b[lane] = &slabs_[texel_b[lane]];
   }
-  if (gap_layers_ != 0) {  // a texel with gaps: the walk solves its intervals
-    // A texel's bit is set exactly when it has gaps (GapBase >= 0).
-    const auto texel_lanes = [&](const size_t* texel) {
-      return P::FromLanesI([&](int l) { return static_cast<int32_t>(texel[l]); });
-    };
-    lanes &= ~(P::LanesWithTexelBit(texel_lanes(texel_a), gap_texel_bits_.data(), lanes) |
-               P::LanesWithTexelBit(texel_lanes(texel_b), gap_texel_bits_.data(), lanes));
-  }
-  if (lanes == 0) return free_lanes;
   F slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
   P::LoadSlabs(slab_a, &slab_a_top, &slab_a_bottom);
   P::LoadSlabs(slab_b, &slab_b_top, &slab_b_bottom);
+  // The gaps of texels A and B (absent ones: -inf, +inf); a group with none takes the slab-only
+  // visits below, which give the same answers for such lanes with less work.
+  GapLanes<P> gaps_a, gaps_b;
+  bool with_gaps = false;
+  if (gap_layers_ != 0) {
+    const auto texel_lanes = [&](const size_t* texel) {
+      return P::FromLanesI([&](int l) { return static_cast<int32_t>(texel[l]); });
+    };
+    with_gaps = (GatherGapLanes<P>(texel_lanes(texel_a), lanes, &gaps_a) |
+                 GatherGapLanes<P>(texel_lanes(texel_b), lanes, &gaps_b)) != 0;
+  }
 
   // The walk (BodyMapWalk::Run<1>): the crossing parameter of the edge, A over [0, s_cross],
   // then B over [s_cross, 1]. One texel: A over [0, 1], and B (the same texel) adds nothing.
@@ -335,46 +457,113 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
                           SelectLanes(across_j, crossing(j0, j1, v0, v1), one));
     z_cross = AlongLanes<P>(p0.z, p1.z, s_cross);
   }
+  // IsInside(p0) by the slab alone, as the walk starts (a start in a gap is outside every
+  // interval, which the gap visit sees at its entry point).
   const F start_inside = And(LessEq(p0.z, slab_a_top), GreaterEq(p0.z, slab_a_bottom));
-  const LaneVisit<P> in_a =
-      VisitLanes<P>(slab_a_top, slab_a_bottom, zero, s_cross, p0.z, z_cross, start_inside);
-  const F hit_a = Or(in_a.front, in_a.back);  // no wall at s = 0 without clipping
-  LaneVisit<P> in_b = in_a;                   // unused without a lane across an edge
-  F hit_b = zero;
-  if (two_lanes != 0) {
-    in_b = VisitLanes<P>(slab_b_top, slab_b_bottom, s_cross, one, z_cross, p1.z, in_a.inside_after);
-    hit_b = AndNot(hit_a, And(two, Or(in_b.wall, Or(in_b.front, in_b.back))));
+  // Each visit: whether and how it enters (VisitLanes' masks), where (s, z), and what the answer
+  // needs of the entered texel: the entered interval's or surface's bounds and, with gaps, their
+  // slots. p1's interval bounds a push-out.
+  LaneVisit<P> in_a, in_b;
+  F hit_a, hit_b = zero;
+  F entered_top, entered_bottom;  // of the entered interval (a side wall's: B's)
+  I entered_top_slot = P::SplatI(kFrontSlot), entered_bottom_slot = P::SplatI(kBackSlot);
+  F end_top = slab_b_top, end_bottom = slab_b_bottom, end_in_gap = zero;
+  I end_top_slot = entered_top_slot, end_bottom_slot = entered_bottom_slot;
+  if (!with_gaps) {
+    in_a = VisitLanes<P>(slab_a_top, slab_a_bottom, zero, s_cross, p0.z, z_cross, start_inside);
+    hit_a = Or(in_a.front, in_a.back);  // no wall at s = 0 without clipping
+    in_b = in_a;                        // unused without a lane across an edge
+    if (two_lanes != 0) {
+      in_b =
+          VisitLanes<P>(slab_b_top, slab_b_bottom, s_cross, one, z_cross, p1.z, in_a.inside_after);
+      hit_b = AndNot(hit_a, And(two, Or(in_b.wall, Or(in_b.front, in_b.back))));
+    }
+    entered_top = slab_b_top;
+    entered_bottom = slab_b_bottom;
+  } else {
+    // The walk's visits with gaps (CollideWalkLanes), then VisitLanes places each entry.
+    const F all_lanes = AsFloat(P::SplatI(-1));
+    const typename GapLanes<P>::Visit visit_a =
+        gaps_a.VisitTexel(slab_a_top, slab_a_bottom, p0.z, z_cross, start_inside);
+    hit_a = Or(visit_a.wall, Or(visit_a.front, visit_a.back));
+    in_a = VisitLanes<P>(visit_a.kept_top, visit_a.kept_bottom, zero, s_cross, p0.z, z_cross,
+                         AndNot(visit_a.wall, all_lanes));
+    typename GapLanes<P>::Visit visit_b = visit_a;
+    in_b = in_a;
+    if (two_lanes != 0) {
+      visit_b = gaps_b.VisitTexel(slab_b_top, slab_b_bottom, z_cross, p1.z, visit_a.stays);
+      hit_b = AndNot(hit_a, And(two, Or(visit_b.wall, Or(visit_b.front, visit_b.back))));
+      in_b = VisitLanes<P>(visit_b.kept_top, visit_b.kept_bottom, s_cross, one, z_cross, p1.z,
+                           AndNot(visit_b.wall, all_lanes));
+    }
+    entered_top = SelectLanes(hit_a, visit_a.kept_top, visit_b.kept_top);
+    entered_bottom = SelectLanes(hit_a, visit_a.kept_bottom, visit_b.kept_bottom);
+    entered_top_slot = SelectLanesI(hit_a, visit_a.top_slot, visit_b.top_slot);
+    entered_bottom_slot = SelectLanesI(hit_a, visit_a.bottom_slot, visit_b.bottom_slot);
+    // IsInside(p1) excludes B's gaps, and a push-out goes to the nearer surface of p1's
+    // interval (IntervalAt).
+    end_in_gap = gaps_b.InGap(p1.z);
+    const typename GapLanes<P>::Interval around = gaps_b.Around(p1.z, slab_b_top, slab_b_bottom);
+    end_top = around.top;
+    end_bottom = around.bottom;
+    end_top_slot = around.top_slot;
+    end_bottom_slot = around.bottom_slot;
   }
   const F wall = And(hit_b, in_b.wall);
-  // No entry and p1 inside (IsInside(p1): texel B's slab): pushed out along z.
-  const F inside_end = And(LessEq(p1.z, slab_b_top), GreaterEq(p1.z, slab_b_bottom));
+  // No entry and p1 inside (IsInside(p1): texel B's slab less its gaps): pushed out along z.
+  const F inside_end =
+      AndNot(end_in_gap, And(LessEq(p1.z, slab_b_top), GreaterEq(p1.z, slab_b_bottom)));
   const F push_out = AndNot(Or(hit_a, hit_b), inside_end);
   const F contact = Or(Or(hit_a, hit_b), push_out);
   const uint32_t contact_lanes = LaneBits(contact) & lanes;
   if (contact_lanes == 0) return lanes | free_lanes;  // points and motions in air
 
   // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3
-  // texel (WalkInto), or p1 moved to the nearer surface of its slab.
+  // texel (WalkInto), or p1 moved to the nearer surface of its interval.
   const F s_hit = SelectLanes(hit_a, in_a.s, in_b.s);
   const F z_hit = SelectLanes(hit_a, in_a.z, in_b.z);
   // (A lane crossing an edge moves at least a float step of u, so its length in x and y never
   // underflows; the lanes test it anyway, so that they stay the walk's operations one for one.)
   const LanePoint<P> placed = PlaceContactLanes<P>(p0, p1, s_hit, z_hit, wall, push_out, p1,
-                                                   slab_b_top, slab_b_bottom, 1e-3f * texel_size_);
-  // The normal: the entered surface's; at a side wall the nearer surface of B's slab; for the
-  // push-out the surface p1 goes to.
-  const F wall_back = Less(Sub(z_hit, slab_b_bottom), Sub(slab_b_top, z_hit));
+                                                   end_top, end_bottom, 1e-3f * texel_size_);
+  // The normal: the entered surface's; at a side wall the nearer surface of the entered
+  // interval; for the push-out the surface p1 goes to.
+  const F wall_back = Less(Sub(z_hit, entered_bottom), Sub(entered_top, z_hit));
   const F use_back =
       SelectLanes(push_out, placed.push_back,
                   SelectLanes(wall, wall_back, SelectLanes(hit_a, in_a.back, in_b.back)));
   const uint32_t back_lanes = LaneBits(use_back);
   const uint32_t from_a = LaneBits(hit_a);
   uint16_t qa[kLanes] = {}, qb[kLanes] = {};
-  for (int lane = 0; lane < kLanes; ++lane) {
-    const TexelNormals& n = normals_[(from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane]];
-    const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
-    qa[lane] = q[0];
-    qb[lane] = q[1];
+  if (!with_gaps) {
+    for (int lane = 0; lane < kLanes; ++lane) {
+      const TexelNormals& n = normals_[(from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane]];
+      const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
+      qa[lane] = q[0];
+      qb[lane] = q[1];
+    }
+  } else {
+    // A surface of a gap (slot >= 2) has its normal among the gaps' (SlotCode).
+    alignas(32) int32_t slot[2][kLanes];
+    P::Store(slot[0], SelectLanesI(push_out, end_top_slot, entered_top_slot));
+    P::Store(slot[1], SelectLanesI(push_out, end_bottom_slot, entered_bottom_slot));
+    for (int lane = 0; lane < kLanes; ++lane) {
+      const bool in_a_texel = (from_a >> lane) & 1u;  // a push-out is B's
+      const bool back = (back_lanes >> lane) & 1u;
+      const int lane_slot = slot[back ? 1 : 0][lane];
+      const uint16_t* q;
+      if (lane_slot >= 2) {
+        q = in_a_texel ? SlotCode(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane]),
+                                  lane_slot)
+                       : SlotCode(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]),
+                                  lane_slot);
+      } else {
+        const TexelNormals& n = normals_[in_a_texel ? texel_a[lane] : texel_b[lane]];
+        q = back ? n.back : n.front;
+      }
+      qa[lane] = q[0];
+      qb[lane] = q[1];
+    }
   }
   const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
   const uint32_t wall_lanes = LaneBits(wall);
@@ -461,67 +650,9 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   const I di = Sub(i1, i0), dj = Sub(j1, j0);
   I left_i = Abs(di), left_j = Abs(dj);
 
-  // Texels with gaps (maps.layers > 1): their inside set is the slab less the open gaps, split
-  // into intervals whose surfaces have slots (BodyMapCollider::Interval).
+  // Texels with gaps (maps.layers > 1): their inside set is the slab less the open gaps.
   const I front_slot = P::SplatI(kFrontSlot), back_slot = P::SplatI(kBackSlot);
-  const F all_lanes = AsFloat(P::SplatI(-1)), minus_inf = P::Splat(-kInfinity);
-  // The gaps of the lanes' texels (absent ones: top -inf, bottom +inf, which no z lies strictly
-  // between); returns the lanes (of `which`) whose texel has gaps.
-  struct GapLanes {
-    F top[kMaxBodyMapLayers - 1], bottom[kMaxBodyMapLayers - 1];
-  };
-  const auto gather_gaps = [&](I texel_lanes, uint32_t which, GapLanes* out) {
-    // The lanes with gaps first (their texels' bits, tested in lanes), so that a step without
-    // one (most steps near gaps) skips the scalar work.
-    const uint32_t with_gaps = P::LanesWithTexelBit(texel_lanes, gap_texel_bits_.data(), which);
-    if (with_gaps == 0) return with_gaps;  // the callers read the gaps only when a lane has some
-    alignas(32) int32_t t[kLanes];
-    P::Store(t, texel_lanes);
-    // Each lane's gaps, or for a lane without gaps ones that hold no z (-inf, +inf): the gaps
-    // are slabs, so one LoadSlabs per layer reads them for every lane.
-    static_assert(kMaxBodyMapLayers == 4, "one absent gap per gap layer below");
-    static constexpr Slab kNoGaps[kMaxBodyMapLayers - 1] = {
-        {-kInfinity, kInfinity}, {-kInfinity, kInfinity}, {-kInfinity, kInfinity}};
-    const Slab* first[kLanes];
-    for (int lane = 0; lane < kLanes; ++lane) {
-      first[lane] = ((with_gaps >> lane) & 1u)
-                        ? gaps_.data() + GapBaseAt(static_cast<uint32_t>(t[lane]))
-                        : kNoGaps;
-    }
-    for (uint32_t g = 0; g < gap_layers_; ++g) {
-      const void* gap[kLanes];
-      for (int lane = 0; lane < kLanes; ++lane) gap[lane] = first[lane] + g;
-      P::LoadSlabs(gap, &out->top[g], &out->bottom[g]);
-    }
-    return with_gaps;
-  };
-  // z strictly inside one of the gaps (BodyMapCollider::InGap).
-  const auto in_a_gap = [&](const GapLanes& gaps, F z) {
-    F in = zero;
-    for (uint32_t g = 0; g < gap_layers_; ++g) {
-      in = Or(in, And(Less(z, gaps.top[g]), Greater(z, gaps.bottom[g])));
-    }
-    return in;
-  };
-  // The interval of the inside set holding z (BodyMapCollider::TexelIntervals): bounded by the
-  // nearest gap boundary or slab surface above and below z.
-  struct IntervalLanes {
-    F top, bottom;
-    I top_slot, bottom_slot;
-  };
-  const auto interval_around = [&](const GapLanes& gaps, F z, F slab_top, F slab_bottom) {
-    IntervalLanes in{slab_top, slab_bottom, front_slot, back_slot};
-    for (uint32_t g = 0; g < gap_layers_; ++g) {
-      const F lower_above = And(GreaterEq(gaps.bottom[g], z), Less(gaps.bottom[g], in.top));
-      in.top = SelectLanes(lower_above, gaps.bottom[g], in.top);
-      in.top_slot = SelectLanesI(lower_above, P::SplatI(3 + 2 * static_cast<int>(g)), in.top_slot);
-      const F upper_below = And(LessEq(gaps.top[g], z), Greater(gaps.top[g], in.bottom));
-      in.bottom = SelectLanes(upper_below, gaps.top[g], in.bottom);
-      in.bottom_slot =
-          SelectLanesI(upper_below, P::SplatI(2 + 2 * static_cast<int>(g)), in.bottom_slot);
-    }
-    return in;
-  };
+  const F all_lanes = AsFloat(P::SplatI(-1));
 
   // Texel indices (row-major) of the start and of the end. With p1 in the box the end is p1's
   // texel, whose slab answers IsInside(p1); beyond the box p1 is outside.
@@ -566,12 +697,12 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   I end_top_slot = front_slot, end_bottom_slot = back_slot;
   uint32_t end_in_gap_texel = 0;
   if (gaps_near) {
-    GapLanes gaps;
-    end_in_gap_texel = gather_gaps(P::FromLanesI([&](int l) { return texel_b[l]; }),
-                                   lanes & p1_in_box_lanes, &gaps);
+    GapLanes<P> gaps;
+    end_in_gap_texel = GatherGapLanes<P>(P::FromLanesI([&](int l) { return texel_b[l]; }),
+                                         lanes & p1_in_box_lanes, &gaps);
     if (end_in_gap_texel != 0) {
-      end_in_gap = in_a_gap(gaps, p1.z);
-      const IntervalLanes around = interval_around(gaps, p1.z, slab_b_top, slab_b_bottom);
+      end_in_gap = gaps.InGap(p1.z);
+      const typename GapLanes<P>::Interval around = gaps.Around(p1.z, slab_b_top, slab_b_bottom);
       slab_b_top = around.top;
       slab_b_bottom = around.bottom;
       end_top_slot = around.top_slot;
@@ -668,42 +799,17 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       F kept_top = top, kept_bottom = bottom;
       I top_slot = front_slot, bottom_slot = back_slot;
       if constexpr (kGaps) {
-        GapLanes gaps;
-        if (gather_gaps(texel, LaneBits(active), &gaps) != 0) [[unlikely]] {
-          // BodyMapWalk::VisitTexelWithGaps: the inside set is the slab less the open gaps,
-          // z is monotone along the piece, so the first entry is into the interval holding
-          // z_enter (a side wall) or into the next interval in the direction of motion.
-          in_enter = AndNot(in_a_gap(gaps, z_enter), in_enter);
-          wall = AndNot(inside, in_enter);
-          const IntervalLanes around = interval_around(gaps, z_enter, top, bottom);
-          const F stays = And(And(inside, in_enter),
-                              And(LessEq(z_exit, around.top), GreaterEq(z_exit, around.bottom)));
-          const F search = AndNot(Or(wall, stays), all_lanes);
-          // The nearest interval top below z_enter and bottom above it.
-          F below = SelectLanes(Less(top, z_enter), top, minus_inf);
-          I below_slot = front_slot;
-          F over = SelectLanes(Greater(bottom, z_enter), bottom, inf);
-          I over_slot = back_slot;
-          for (uint32_t g = 0; g < gap_layers_; ++g) {
-            const F lower = gaps.bottom[g], upper = gaps.top[g];
-            const F lower_below = And(Less(lower, z_enter), Greater(lower, below));
-            below = SelectLanes(lower_below, lower, below);
-            below_slot =
-                SelectLanesI(lower_below, P::SplatI(3 + 2 * static_cast<int>(g)), below_slot);
-            const F upper_over = And(Greater(upper, z_enter), Less(upper, over));
-            over = SelectLanes(upper_over, upper, over);
-            over_slot = SelectLanesI(upper_over, P::SplatI(2 + 2 * static_cast<int>(g)), over_slot);
-          }
-          const F front = And(search, And(Less(z_exit, z_enter), LessEq(z_exit, below)));
-          const F back = And(search, And(Greater(z_exit, z_enter), GreaterEq(z_exit, over)));
-          entered = And(active, Or(wall, Or(front, back)));
-          inside_after = stays;
-          // VisitLanes recomputes the entry from these: the interval for a wall; the surface
-          // reached as `top` (front) or `bottom` (back), the other bound out of the way.
-          kept_top = SelectLanes(wall, around.top, SelectLanes(front, below, inf));
-          kept_bottom = SelectLanes(wall, around.bottom, SelectLanes(back, over, minus_inf));
-          top_slot = SelectLanesI(wall, around.top_slot, below_slot);
-          bottom_slot = SelectLanesI(wall, around.bottom_slot, over_slot);
+        GapLanes<P> gaps;
+        if (GatherGapLanes<P>(texel, LaneBits(active), &gaps) != 0) [[unlikely]] {
+          const typename GapLanes<P>::Visit visit =
+              gaps.VisitTexel(top, bottom, z_enter, z_exit, inside);
+          wall = visit.wall;
+          entered = And(active, Or(wall, Or(visit.front, visit.back)));
+          inside_after = visit.stays;
+          kept_top = visit.kept_top;
+          kept_bottom = visit.kept_bottom;
+          top_slot = visit.top_slot;
+          bottom_slot = visit.bottom_slot;
         }
       }
       // Recorded at every step, with no test whether a lane entered: which step holds a lane's

@@ -1686,7 +1686,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   std::mt19937 rng(20261123);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
   size_t answered_walls = 0, answered_inside = 0, answered_entries = 0;  // four-lane path
-  size_t answered_outside = 0;
+  size_t answered_outside = 0, answered_gap_contacts = 0, answered_gap_inside = 0;
   size_t walked_answered = 0, walked_walls = 0, walked_inside = 0, walked_entries = 0;
   size_t walked_clipped_entries = 0, walked_z_face = 0, walked_long = 0;  // walking lanes
   size_t walked_gap_contacts = 0, walked_gap_starts = 0;
@@ -1845,6 +1845,13 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
     // sliding motions, surface starts, in one texel or across one texel edge. Eight lanes (with
     // AVX2) answer the lanes four do, with the same bits and the same long motions.
     size_t answered = 0;
+    // Whether p's texel has gaps: the lanes solve those texels' intervals themselves.
+    const auto has_gaps = [&](Float3 p) {
+      const float u = (p.x - c.origin_x()) / texel, v = (p.y - c.origin_y()) / texel;
+      float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+      return u >= 0.f && v >= 0.f &&
+             c.TexelGaps(static_cast<uint32_t>(u), static_cast<uint32_t>(v), upper, lower) > 0;
+    };
     std::vector<Float3> scratch_positions = positions, scratch_velocities = velocities;
     std::vector<uint8_t> scratch_flags(kCount);
     std::vector<uint32_t> four_answered, four_long;
@@ -1893,6 +1900,9 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
           answered_walls += (f & kCollisionSideWall) != 0;
           answered_inside += (f & kCollisionStartedInside) != 0;
           answered_entries += f == kCollisionContact;
+          const bool at_gaps = has_gaps(previous[q]) || has_gaps(positions[q]);
+          answered_gap_contacts += at_gaps && (f & kCollisionContact) != 0;
+          answered_gap_inside += at_gaps && (f & kCollisionStartedInside) != 0;
         }
       }
     }
@@ -1957,13 +1967,6 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
           walked_long += texels >= 3 && (f & kCollisionContact) != 0;
           // Contacts where the motion starts or ends in a texel with gaps (the walk's own visit
           // and IntervalAt answer those inside the lanes).
-          const auto has_gaps = [&](Float3 p) {
-            const float u = (p.x - c.origin_x()) / texel, v = (p.y - c.origin_y()) / texel;
-            float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
-            return u >= 0.f && v >= 0.f &&
-                   c.TexelGaps(static_cast<uint32_t>(u), static_cast<uint32_t>(v), upper, lower) >
-                       0;
-          };
           walked_gap_contacts +=
               (f & kCollisionContact) != 0 && (has_gaps(previous[q]) || has_gaps(positions[q]));
           // Starts strictly inside a gap, which the lanes' start test does not look for (their
@@ -1999,6 +2002,9 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   EXPECT_GT(answered_entries, 2000u);
   EXPECT_GT(answered_inside, 10000u);
   EXPECT_GT(answered_outside, 1000u);  // points that stay outside the clip box
+  // ... in texels with gaps too (their intervals, gap surfaces' normals, push-outs among gaps).
+  EXPECT_GT(answered_gap_contacts, 1000u);
+  EXPECT_GT(answered_gap_inside, 500u);
   // ... and the walking lanes: most particles, every kind of contact, entries of motions clipped
   // to the box (through its top or bottom face among them), contacts three or more texels away.
   EXPECT_GT(walked_answered, 60000u);
@@ -2014,6 +2020,8 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   if (bodies[0].uses_avx2()) {
     EXPECT_GT(eight_lanes_answered, 300000u);
   }
+  std::printf("short-motion lanes: %zu contacts at texels with gaps, %zu of them pushed out\n",
+              answered_gap_contacts, answered_gap_inside);
   std::printf(
       "walking lanes: %zu answered, %zu walls, %zu entries (%zu clipped, %zu through the "
       "box's z face), %zu pushed out, %zu contacts >= 3 texels away, %zu at texels with gaps, "

@@ -336,7 +336,7 @@ class BodyMapCollider {
                         uint8_t* flags, size_t count, const ResponseParams& params) const;
   // CollideBatch for four particles at once (SSE2, kNearest, a non-empty map), for the lanes
   // whose motion stays in one texel or crosses one texel edge, with both ends in the clip box
-  // and no gaps in either texel, and for those whose motion keeps one coordinate outside the
+  // (gaps included), and for those whose motion keeps one coordinate outside the
   // clip box (no contact): writes their flags, positions and velocities bit for bit as
   // CollideOne would and returns their lane mask (bit l = particle l). The other lanes keep
   // their positions and velocities (written back, the same bits) and get flags the caller must
@@ -375,6 +375,14 @@ class BodyMapCollider {
   uint32_t CollideWalkLanes(const uint32_t* index, uint32_t lanes, const Float3* previous,
                             Float3* positions, Float3* velocities, uint8_t* flags,
                             const ResponseParams& params) const;
+  // The gaps of one texel per lane and what both lane paths ask of them
+  // (body_map_lane_walk.inl).
+  template <class Lanes>
+  struct GapLanes;
+  // The gaps of the lanes' row-major texels (absent ones: -inf, +inf) into *out; returns the
+  // lanes of `which` whose texel has gaps (the others' gaps are all absent).
+  template <class Lanes>
+  uint32_t GatherGapLanes(typename Lanes::I texel, uint32_t which, GapLanes<Lanes>* out) const;
   // A lane still walking after this many texels is answered one by one: a walk that long goes
   // through air, which the one-by-one walk skips 8x8 blocks at a time, and lanes in step
   // wait for the longest. Tuned on the speed-vs-error query sets (docs/PERFORMANCE.md).
