@@ -116,8 +116,8 @@ class BodyMapSequence;
 // (top, bottom z as float) + 8 bytes of normals (front and back, re-encoded as oct16 whatever the
 // input encoding: float32 input loses < 0.004 degrees) + 1 byte of bilinear eligibility in
 // kBilinear mode, plus 8 bytes per 8x8 block for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB
-// (17.1 MiB bilinear). A pose with gap layers adds a bit and a quarter per texel (which texels
-// have gaps, and a count per 32 of them), 4 bytes per 8x8 block (which blocks have gaps, summed)
+// (17.1 MiB bilinear). A pose with gap layers adds two bits per texel (which texels have gaps,
+// and a 32-bit count per 32 of them), 4 bytes per 8x8 block (which blocks have gaps, summed)
 // and, per texel that has a gap, 16 bytes per gap layer (the gaps' upper and lower z, their
 // normals). memory_bytes() reports the exact figure.
 //
