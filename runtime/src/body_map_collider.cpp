@@ -1055,16 +1055,16 @@ BodyMapCollider::Interval BodyMapCollider::IntervalAmongGaps(uint32_t i, uint32_
 
 Float3 BodyMapCollider::SlotNormal(uint32_t i, uint32_t j, int slot) const {
   if (slot < 2) return TexelNormal(i, j, slot == kBackSlot);
-  const uint16_t* q = SlotCode(i, j, slot);
+  const uint16_t* q = SlotCode(j * width_ + i, slot);
   return DecodeOct16(q[0], q[1]);
 }
 
-const uint16_t* BodyMapCollider::SlotCode(uint32_t i, uint32_t j, int slot) const {
+const uint16_t* BodyMapCollider::SlotCode(uint32_t texel, int slot) const {
   if (slot < 2) {
-    const TexelNormals& n = normals_[static_cast<size_t>(j) * width_ + i];
+    const TexelNormals& n = normals_[texel];
     return slot == kBackSlot ? n.back : n.front;
   }
-  const TexelNormals& n = gap_normals_[static_cast<size_t>(GapBase(i, j)) + (slot - 2) / 2];
+  const TexelNormals& n = gap_normals_[static_cast<size_t>(GapBaseAt(texel)) + (slot - 2) / 2];
   return slot % 2 == 1 ? n.back : n.front;
 }
 

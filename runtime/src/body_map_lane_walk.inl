@@ -429,16 +429,21 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   F slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
   P::LoadSlabs(slab_a, &slab_a_top, &slab_a_bottom);
   P::LoadSlabs(slab_b, &slab_b_top, &slab_b_bottom);
-  // The gaps of texels A and B (absent ones: -inf, +inf); a group with none takes the slab-only
-  // visits below, which give the same answers for such lanes with less work.
+  // Groups without a lane across an edge (points, resting cloth) skip the second visit.
+  const uint32_t two_lanes = LaneBits(two) & lanes;
+  // The gaps of texels A and B (absent ones: -inf, +inf; B is A without a lane across an edge);
+  // a group with none takes the slab-only visits below, which give the same answers for such
+  // lanes with less work.
   GapLanes<P> gaps_a, gaps_b;
   bool with_gaps = false;
   if (gap_layers_ != 0) {
     const auto texel_lanes = [&](const size_t* texel) {
       return P::FromLanesI([&](int l) { return static_cast<int32_t>(texel[l]); });
     };
-    with_gaps = (GatherGapLanes<P>(texel_lanes(texel_a), lanes, &gaps_a) |
-                 GatherGapLanes<P>(texel_lanes(texel_b), lanes, &gaps_b)) != 0;
+    uint32_t gap_lanes = GatherGapLanes<P>(texel_lanes(texel_a), lanes, &gaps_a);
+    gaps_b = gaps_a;
+    if (two_lanes != 0) gap_lanes |= GatherGapLanes<P>(texel_lanes(texel_b), lanes, &gaps_b);
+    with_gaps = gap_lanes != 0;
   }
 
   // The walk (BodyMapWalk::Run<1>): the crossing parameter of the edge, A over [0, s_cross],
@@ -449,8 +454,6 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
     const I edge = Or(And(Greater(b, a), b), AndNot(Greater(b, a), a));
     return StdMin(StdMax(Mul(Sub(ToFloat(edge), g0), inverse_d), zero), one);
   };
-  // Groups without a lane across an edge (points, resting cloth) skip the second visit.
-  const uint32_t two_lanes = LaneBits(two) & lanes;
   F s_cross = one, z_cross = p1.z;  // Z(1) = z1 exactly
   if (two_lanes != 0) {
     s_cross = SelectLanes(across_i, crossing(i0, i1, u0, u1),
@@ -534,36 +537,23 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
                   SelectLanes(wall, wall_back, SelectLanes(hit_a, in_a.back, in_b.back)));
   const uint32_t back_lanes = LaneBits(use_back);
   const uint32_t from_a = LaneBits(hit_a);
-  uint16_t qa[kLanes] = {}, qb[kLanes] = {};
-  if (!with_gaps) {
-    for (int lane = 0; lane < kLanes; ++lane) {
-      const TexelNormals& n = normals_[(from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane]];
-      const uint16_t* q = (back_lanes >> lane) & 1u ? n.back : n.front;
-      qa[lane] = q[0];
-      qb[lane] = q[1];
-    }
-  } else {
-    // A surface of a gap (slot >= 2) has its normal among the gaps' (SlotCode).
-    alignas(32) int32_t slot[2][kLanes];
+  // With gaps, a gap's surface (slot >= 2) has its normal among the gaps' (SlotCode).
+  alignas(32) int32_t slot[2][kLanes];
+  if (with_gaps) {
     P::Store(slot[0], SelectLanesI(push_out, end_top_slot, entered_top_slot));
     P::Store(slot[1], SelectLanesI(push_out, end_bottom_slot, entered_bottom_slot));
-    for (int lane = 0; lane < kLanes; ++lane) {
-      const bool in_a_texel = (from_a >> lane) & 1u;  // a push-out is B's
-      const bool back = (back_lanes >> lane) & 1u;
-      const int lane_slot = slot[back ? 1 : 0][lane];
-      const uint16_t* q;
-      if (lane_slot >= 2) {
-        q = in_a_texel ? SlotCode(static_cast<uint32_t>(ia[lane]), static_cast<uint32_t>(ja[lane]),
-                                  lane_slot)
-                       : SlotCode(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]),
-                                  lane_slot);
-      } else {
-        const TexelNormals& n = normals_[in_a_texel ? texel_a[lane] : texel_b[lane]];
-        q = back ? n.back : n.front;
-      }
-      qa[lane] = q[0];
-      qb[lane] = q[1];
+  }
+  uint16_t qa[kLanes] = {}, qb[kLanes] = {};
+  for (int lane = 0; lane < kLanes; ++lane) {
+    const size_t t = (from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane];  // a push-out: B
+    const bool back = (back_lanes >> lane) & 1u;
+    const TexelNormals& n = normals_[t];
+    const uint16_t* q = back ? n.back : n.front;
+    if (with_gaps && slot[back ? 1 : 0][lane] >= 2) {
+      q = SlotCode(static_cast<uint32_t>(t), slot[back ? 1 : 0][lane]);
     }
+    qa[lane] = q[0];
+    qb[lane] = q[1];
   }
   const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
   const uint32_t wall_lanes = LaneBits(wall);
@@ -695,12 +685,10 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   // surface of p1's interval (IntervalAt).
   F end_in_gap = zero;
   I end_top_slot = front_slot, end_bottom_slot = back_slot;
-  uint32_t end_in_gap_texel = 0;
   if (gaps_near) {
     GapLanes<P> gaps;
-    end_in_gap_texel = GatherGapLanes<P>(P::FromLanesI([&](int l) { return texel_b[l]; }),
-                                         lanes & p1_in_box_lanes, &gaps);
-    if (end_in_gap_texel != 0) {
+    if (GatherGapLanes<P>(P::FromLanesI([&](int l) { return texel_b[l]; }), lanes & p1_in_box_lanes,
+                          &gaps) != 0) {
       end_in_gap = gaps.InGap(p1.z);
       const typename GapLanes<P>::Interval around = gaps.Around(p1.z, slab_b_top, slab_b_bottom);
       slab_b_top = around.top;
@@ -910,14 +898,9 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     const int32_t t = pushed ? texel_b[lane] : entered_texel[lane];
     const TexelNormals& n = normals_[static_cast<size_t>(t)];
     const uint16_t* q = back ? n.back : n.front;
-    if (!pushed && gaps_near && entered_slot[back ? 1 : 0][lane] >= 2) {  // a gap's
-      const uint32_t entered = static_cast<uint32_t>(t);
-      q = SlotCode(entered % width_, entered / width_, entered_slot[back ? 1 : 0][lane]);
-    }
-    if (pushed && ((end_in_gap_texel >> lane) & 1u) && end_slot[back ? 1 : 0][lane] >= 2) {
-      q = SlotCode(static_cast<uint32_t>(ib[lane]), static_cast<uint32_t>(jb[lane]),
-                   end_slot[back ? 1 : 0][lane]);
-    }
+    // A gap's surface (slot >= 2; the slots of lanes without gaps are the slab's).
+    const int slot = gaps_near ? (pushed ? end_slot : entered_slot)[back ? 1 : 0][lane] : 0;
+    if (slot >= 2) q = SlotCode(static_cast<uint32_t>(t), slot);
     qa[lane] = q[0];
     qb[lane] = q[1];
   }

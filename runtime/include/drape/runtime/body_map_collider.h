@@ -279,8 +279,8 @@ class BodyMapCollider {
   }
   Interval IntervalAmongGaps(uint32_t i, uint32_t j, float z) const;
   Float3 SlotNormal(uint32_t i, uint32_t j, int slot) const;
-  // The oct16 code of SlotNormal (two values).
-  const uint16_t* SlotCode(uint32_t i, uint32_t j, int slot) const;
+  // The oct16 code (two values) of the surface in `slot` of row-major texel `texel` (SlotNormal's).
+  const uint16_t* SlotCode(uint32_t texel, int slot) const;
   // One texel's gaps while Build decodes them (absent gaps: top = -inf, bottom = +inf).
   struct GapTexel {
     uint32_t i, j;
