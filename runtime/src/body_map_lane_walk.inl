@@ -787,8 +787,14 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       F kept_top = top, kept_bottom = bottom;
       I top_slot = front_slot, bottom_slot = back_slot;
       if constexpr (kGaps) {
+        // Only a piece that meets the slab in z can meet its gaps, which lie within it: for a
+        // piece wholly in front of or behind the slab (every background texel too) the visit
+        // with gaps is the visit without, so such lanes skip the gather.
+        const F in_front = And(above, Greater(z_exit, top));
+        const F behind = And(Less(z_enter, bottom), Less(z_exit, bottom));
+        const F meets_slab = AndNot(Or(in_front, behind), active);
         GapLanes<P> gaps;
-        if (GatherGapLanes<P>(texel, LaneBits(active), &gaps) != 0) [[unlikely]] {
+        if (GatherGapLanes<P>(texel, LaneBits(meets_slab), &gaps) != 0) [[unlikely]] {
           const typename GapLanes<P>::Visit visit =
               gaps.VisitTexel(top, bottom, z_enter, z_exit, inside);
           wall = visit.wall;

@@ -1280,6 +1280,12 @@ BodyMapPose LayeredPose(uint8_t layers, const std::vector<ZBox>& boxes,
 }
 
 const std::vector<ZBox> kStack = {kBlock, kPlate, kMidPlate};
+// The stack with two posts off the block, one lower and one higher than the stack: the clip box
+// then reaches beyond the slabs of the texels with gaps, so a walk can leave such a slab
+// through its back or front surface within one texel.
+constexpr ZBox kLowPost{34 * kTexel, 40 * kTexel, -6 * kTexel, 0.f, -0.2f, -0.15f};
+constexpr ZBox kHighPost{34 * kTexel, 40 * kTexel, kTexel, 6 * kTexel, 0.15f, 0.2f};
+const std::vector<ZBox> kStackAndPosts = {kBlock, kPlate, kMidPlate, kLowPost, kHighPost};
 
 }  // namespace
 
@@ -1676,7 +1682,7 @@ TEST(BodyMapBatch, LongWalksThroughBlockEdgeCornersAnswerAsQuery) {
 TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   BodyMapCollider bodies[4] = {
       BuildOrDie(MakePose(SphereGrid(), Sphere)), BuildOrDie(MakePose(BoxGrid(), Box)),
-      BuildOrDie(MakePose(SphereGrid(), ThinSlab)), BuildOrDie(LayeredPose(3, kStack))};
+      BuildOrDie(MakePose(SphereGrid(), ThinSlab)), BuildOrDie(LayeredPose(3, kStackAndPosts))};
   ResponseParams params;
   params.friction = 0.3f;
   params.restitution = 0.25f;
@@ -1726,10 +1732,12 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
           p1 = p0 + Float3{(unit(rng) - 0.5f) * 0.8f * texel, (unit(rng) - 0.5f) * 0.8f * texel,
                            (unit(rng) - 0.5f) * 0.05f};
           break;
-        case 3:  // a few texels
+        case 3: {  // a few texels; a quarter of them steep, through a whole part in one texel
+          const float rise = unit(rng) < 0.25f ? 1.f : 0.02f;
           p1 = p0 + Float3{(unit(rng) - 0.5f) * 6.f * texel, (unit(rng) - 0.5f) * 6.f * texel,
-                           (unit(rng) - 0.5f) * 0.02f};
+                           (unit(rng) - 0.5f) * rise};
           break;
+        }
         case 4:  // beyond the clip box in z, or off the grid
           p0.z = unit(rng) < 0.5f ? hi.z + 0.01f : lo.z - 0.01f;
           p1 = unit(rng) < 0.5f ? Float3{p0.x, p0.y, 0.f} : point(0.3f);
