@@ -1728,10 +1728,13 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
           }
           break;
         }
-        case 2:  // sliding: under half a texel, along z through a surface
+        case 2: {  // sliding: under half a texel, along z through a surface; a quarter of them
+                   // steep, through a whole part
+          const float rise = unit(rng) < 0.25f ? 1.f : 0.05f;
           p1 = p0 + Float3{(unit(rng) - 0.5f) * 0.8f * texel, (unit(rng) - 0.5f) * 0.8f * texel,
-                           (unit(rng) - 0.5f) * 0.05f};
+                           (unit(rng) - 0.5f) * rise};
           break;
+        }
         case 3: {  // a few texels; a quarter of them steep, through a whole part in one texel
           const float rise = unit(rng) < 0.25f ? 1.f : 0.02f;
           p1 = p0 + Float3{(unit(rng) - 0.5f) * 6.f * texel, (unit(rng) - 0.5f) * 6.f * texel,
