@@ -1696,6 +1696,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   size_t walked_answered = 0, walked_walls = 0, walked_inside = 0, walked_entries = 0;
   size_t walked_clipped_entries = 0, walked_z_face = 0, walked_long = 0;  // walking lanes
   size_t walked_gap_contacts = 0, walked_gap_starts = 0;
+  size_t steep_short = 0, steep_walked = 0;  // from a gap through the start texel's whole slab
   size_t eight_lanes_answered = 0;
   for (int body = 0; body < 4; ++body) {
     SCOPED_TRACE(::testing::Message() << "body " << body);
@@ -1804,6 +1805,23 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
       positions[k] = p1;
       velocities[k] = RandomPoint(rng, -1.f, 1.f, -1.f, 1.f);
       if (k % 8 == 6 && k % 24 == 22) velocities[k].y = nan;
+      // Motions from a gap out through the whole slab of their start texel, where that slab
+      // ends inside the clip box (so the clipped motion leaves it too): the lanes must not take
+      // a texel's slab for its gaps there.
+      const float u = (p0.x - c.origin_x()) / texel, v = (p0.y - c.origin_y()) / texel;
+      float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers], top = 0.f, bottom = 0.f;
+      if (u >= 0.f && v >= 0.f && IsFinite(p1) &&
+          c.TexelSlab(static_cast<uint32_t>(u), static_cast<uint32_t>(v), &top, &bottom)) {
+        const uint32_t gaps =
+            c.TexelGaps(static_cast<uint32_t>(u), static_cast<uint32_t>(v), upper, lower);
+        bool in_gap = false;
+        for (uint32_t g = 0; g < gaps; ++g) in_gap |= p0.z < upper[g] && p0.z > lower[g];
+        if (in_gap && ((p1.z > top && top < hi.z) || (p1.z < bottom && bottom > lo.z))) {
+          const float edges = std::fabs(std::floor((p1.x - c.origin_x()) / texel) - std::floor(u)) +
+                              std::fabs(std::floor((p1.y - c.origin_y()) / texel) - std::floor(v));
+          (edges <= 1.f ? steep_short : steep_walked) += 1;
+        }
+      }
     }
     // The reference: one particle at a time through the documented contract.
     std::vector<Float3> want_positions = positions, want_velocities = velocities;
@@ -2016,6 +2034,9 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   // ... in texels with gaps too (their intervals, gap surfaces' normals, push-outs among gaps).
   EXPECT_GT(answered_gap_contacts, 1000u);
   EXPECT_GT(answered_gap_inside, 500u);
+  // The layered body's posts and the steep motions make these (see kStackAndPosts).
+  EXPECT_GT(steep_short, 10u);
+  EXPECT_GT(steep_walked, 50u);
   // ... and the walking lanes: most particles, every kind of contact, entries of motions clipped
   // to the box (through its top or bottom face among them), contacts three or more texels away.
   EXPECT_GT(walked_answered, 60000u);
@@ -2033,6 +2054,8 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   }
   std::printf("short-motion lanes: %zu contacts at texels with gaps, %zu of them pushed out\n",
               answered_gap_contacts, answered_gap_inside);
+  std::printf("motions from a gap through the whole slab: %zu within one texel edge, %zu walked\n",
+              steep_short, steep_walked);
   std::printf(
       "walking lanes: %zu answered, %zu walls, %zu entries (%zu clipped, %zu through the "
       "box's z face), %zu pushed out, %zu contacts >= 3 texels away, %zu at texels with gaps, "

@@ -336,7 +336,7 @@ class BodyMapCollider {
                         uint8_t* flags, size_t count, const ResponseParams& params) const;
   // CollideBatch for four particles at once (SSE2, kNearest, a non-empty map), for the lanes
   // whose motion stays in one texel or crosses one texel edge, with both ends in the clip box
-  // (gaps included), and for those whose motion keeps one coordinate outside the
+  // (texels with gaps included), and for those whose motion keeps one coordinate outside the
   // clip box (no contact): writes their flags, positions and velocities bit for bit as
   // CollideOne would and returns their lane mask (bit l = particle l). The other lanes keep
   // their positions and velocities (written back, the same bits) and get flags the caller must
@@ -433,7 +433,7 @@ class BodyMapCollider {
   // any block under a walk has gaps in four reads (Finish derives it from the bits; empty without
   // gaps).
   std::vector<uint32_t> gap_block_sums_;
-  std::vector<Slab> gaps_;                 // gap_layers_ per gap texel (see GapBase)
+  std::vector<Slab> gaps_;                 // gap_layers_ per gap texel (see GapBaseAt)
   std::vector<TexelNormals> gap_normals_;  // same index: front = upper, back = lower boundary
 };
 
