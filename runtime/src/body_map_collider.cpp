@@ -870,7 +870,24 @@ void BodyMapCollider::FillGapLookups() {
   }
 }
 
+void BodyMapCollider::MarkGapTexels() {
+  if (gap_layers_ == 0) return;
+  for (size_t k = 0; k < slabs_.size(); ++k) {
+    Slab& slab = slabs_[k];
+    if (!(slab.top >= slab.bottom)) continue;  // background: -inf, no gaps, low bit clear
+    const uint32_t has_gaps = (gap_texel_bits_[k >> 5] >> (k & 31u)) & 1u;
+    if ((std::bit_cast<uint32_t>(slab.top) & 1u) == has_gaps) continue;
+    // The next float up (out of the body, above the gaps), in bits: + 0.f makes -0 into +0,
+    // whose next float up is the least denormal (bits 1). Down instead from the largest float.
+    const uint32_t bits = std::bit_cast<uint32_t>(slab.top + 0.f);
+    const uint32_t up = static_cast<int32_t>(bits) >= 0 ? bits + 1u : bits - 1u;
+    const uint32_t down = static_cast<int32_t>(bits) >= 0 ? bits - 1u : bits + 1u;
+    slab.top = std::bit_cast<float>(up == std::bit_cast<uint32_t>(kInf) ? down : up);
+  }
+}
+
 void BodyMapCollider::Finish() {
+  MarkGapTexels();
   const size_t w = width_, h = height_;
   uint32_t valid = 0;
   size_t i_lo = w, i_hi = 0, j_lo = h, j_hi = 0;  // valid texel range, [lo, hi)

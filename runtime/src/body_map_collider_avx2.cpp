@@ -102,22 +102,6 @@ struct Avx2Lanes {
     _mm256_store_si256(reinterpret_cast<__m256i*>(aligned), a);
   }
   static void Store(float* aligned, F a) { _mm256_store_ps(aligned, a); }
-  // The lanes of `which` whose row-major texel index has its bit set in `bits`
-  // (BodyMapCollider::gap_texel_bits_): Sse2Lanes::LanesWithTexelBit with one gather of the
-  // bits' words.
-  static uint32_t LanesWithTexelBit(I texel, const uint32_t* bits, uint32_t which) {
-    const __m256i lane_bits = LaneBitValues();
-    const __m256i read = _mm256_cmpeq_epi32(
-        _mm256_and_si256(_mm256_set1_epi32(static_cast<int32_t>(which)), lane_bits), lane_bits);
-    const __m256i words =
-        _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(bits),
-                                    _mm256_srli_epi32(texel, 5), read, 4);
-    const __m256i set = _mm256_srlv_epi32(words, _mm256_and_si256(texel, _mm256_set1_epi32(31)));
-    const __m256i one = _mm256_set1_epi32(1);
-    return static_cast<uint32_t>(_mm256_movemask_ps(
-               _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(set, one), one)))) &
-           which;
-  }
   // Sse2Lanes::LoadFloat3s on triples 0-3 and 4-7 at once: the 256-bit shuffles work on each
   // 128-bit half alone.
   static void LoadFloat3s(const void* triples, F* x, F* y, F* z) {

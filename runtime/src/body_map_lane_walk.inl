@@ -310,14 +310,15 @@ struct BodyMapCollider::GapLanes {
 };
 
 template <class P>
-uint32_t BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t which,
+uint32_t BodyMapCollider::GatherGapLanes(typename P::I texel, typename P::F top, uint32_t which,
                                          GapLanes<P>* out) const {
   constexpr int kLanes = P::kCount;
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   out->layers = gap_layers_;
-  // The lanes with gaps first (their texels' bits, tested in lanes), so that a step without one
-  // (most steps near gaps) skips the scalar work.
-  const uint32_t with_gaps = P::LanesWithTexelBit(texel, gap_texel_bits_.data(), which);
+  // The lanes with gaps first, from the gap flag in their slabs' tops (MarkGapTexels), so that a
+  // step without one (most steps near gaps) skips the scalar work.
+  const typename P::I flag = P::SplatI(1);
+  const uint32_t with_gaps = which & LaneBits(AsFloat(Equal(And(AsInt(top), flag), flag)));
   if (with_gaps == 0) {
     for (uint32_t g = 0; g < gap_layers_; ++g) {
       out->top[g] = P::Splat(-kInfinity);
@@ -440,9 +441,11 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
     const auto texel_lanes = [&](const size_t* texel) {
       return P::FromLanesI([&](int l) { return static_cast<int32_t>(texel[l]); });
     };
-    uint32_t gap_lanes = GatherGapLanes<P>(texel_lanes(texel_a), lanes, &gaps_a);
+    uint32_t gap_lanes = GatherGapLanes<P>(texel_lanes(texel_a), slab_a_top, lanes, &gaps_a);
     gaps_b = gaps_a;
-    if (two_lanes != 0) gap_lanes |= GatherGapLanes<P>(texel_lanes(texel_b), lanes, &gaps_b);
+    if (two_lanes != 0) {
+      gap_lanes |= GatherGapLanes<P>(texel_lanes(texel_b), slab_b_top, lanes, &gaps_b);
+    }
     with_gaps = gap_lanes != 0;
   }
 
@@ -687,8 +690,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   I end_top_slot = front_slot, end_bottom_slot = back_slot;
   if (gaps_near) {
     GapLanes<P> gaps;
-    if (GatherGapLanes<P>(P::FromLanesI([&](int l) { return texel_b[l]; }), lanes & p1_in_box_lanes,
-                          &gaps) != 0) {
+    if (GatherGapLanes<P>(P::FromLanesI([&](int l) { return texel_b[l]; }), slab_b_top,
+                          lanes & p1_in_box_lanes, &gaps) != 0) {
       end_in_gap = gaps.InGap(p1.z);
       const typename GapLanes<P>::Interval around = gaps.Around(p1.z, slab_b_top, slab_b_bottom);
       slab_b_top = around.top;
@@ -794,7 +797,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
         const F behind = And(Less(z_enter, bottom), Less(z_exit, bottom));
         const F meets_slab = AndNot(Or(in_front, behind), active);
         GapLanes<P> gaps;
-        if (GatherGapLanes<P>(texel, LaneBits(meets_slab), &gaps) != 0) [[unlikely]] {
+        if (GatherGapLanes<P>(texel, top, LaneBits(meets_slab), &gaps) != 0) [[unlikely]] {
           const typename GapLanes<P>::Visit visit =
               gaps.VisitTexel(top, bottom, z_enter, z_exit, inside);
           wall = visit.wall;

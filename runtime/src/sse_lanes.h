@@ -96,19 +96,6 @@ struct Sse2Lanes {
     _mm_store_si128(reinterpret_cast<__m128i*>(aligned), a);
   }
   static void Store(float* aligned, F a) { _mm_store_ps(aligned, a); }
-  // The lanes of `which` whose row-major texel index has its bit set in `bits`
-  // (BodyMapCollider::gap_texel_bits_), lane by lane. Only those lanes are read.
-  static uint32_t LanesWithTexelBit(I texel, const uint32_t* bits, uint32_t which) {
-    alignas(16) int32_t t[4];
-    Store(t, texel);
-    uint32_t set = 0;
-    for (int lane = 0; lane < 4; ++lane) {
-      if (!((which >> lane) & 1u)) continue;
-      const uint32_t k = static_cast<uint32_t>(t[lane]);
-      set |= ((bits[k / 32] >> (k % 32)) & 1u) << lane;
-    }
-    return set;
-  }
   // Four consecutive (x, y, z) float triples (48 packed bytes) as lanes: three loads and a
   // transpose.
   static void LoadFloat3s(const void* triples, F* x, F* y, F* z) {

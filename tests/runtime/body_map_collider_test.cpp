@@ -8,6 +8,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -1604,6 +1605,75 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
       ExpectSameBits(got_positions[k], want.positions[k], "position", static_cast<int>(k));
       ExpectSameBits(got_velocities[k], want.velocities[k], "velocity", static_cast<int>(k));
     }
+  }
+}
+
+// With gap layers the lanes read whether a texel has gaps from its slab's top (its lowest mantissa
+// bit, MarkGapTexels), not from a second table: the bit must mark exactly the texels with gaps,
+// after Build and after a blend, and move a top by at most one ulp, upward. Without gap layers
+// the tops are the maps' own values.
+TEST(BodyMapGaps, SlabTopsCarryTheGapFlagWithinOneUlp) {
+  const auto flag = [](float top) { return (std::bit_cast<uint32_t>(top) & 1u) != 0u; };
+  const auto check = [&](const BodyMapCollider& c, const BodyMapPose* pose) {
+    float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers];
+    size_t valid = 0, with_gaps = 0, moved = 0, moved_below_zero = 0;
+    for (uint32_t j = 0; j < c.height(); ++j) {
+      for (uint32_t i = 0; i < c.width(); ++i) {
+        float top = 0.f, bottom = 0.f;
+        if (!c.TexelSlab(i, j, &top, &bottom)) continue;
+        ++valid;
+        const bool gaps = c.TexelGaps(i, j, upper, lower) != 0u;
+        with_gaps += gaps;
+        if (c.layers() > 1) {
+          EXPECT_EQ(flag(top), gaps) << i << ", " << j;
+        }
+        if (pose == nullptr) continue;
+        const float map_top = pose->front_z - pose->depth_f32[0][size_t{j} * c.width() + i];
+        if (c.layers() == 1) {
+          EXPECT_EQ(std::bit_cast<uint32_t>(top), std::bit_cast<uint32_t>(map_top));
+        } else {
+          EXPECT_TRUE(top == map_top || top == std::nextafter(map_top, 1.f)) << i << ", " << j;
+        }
+        moved += top != map_top;
+        moved_below_zero += top != map_top && map_top < 0.f;
+      }
+    }
+    return std::array<size_t, 4>{valid, with_gaps, moved, moved_below_zero};
+  };
+  // The stack, and eight stacks of two posts below z = 0 (a gap between them, tops a millimetre
+  // apart): moving a negative top up is a step the other way in its bits.
+  std::vector<ZBox> boxes = kStackAndPosts;
+  for (int m = 0; m < 8; ++m) {
+    const float y = static_cast<float>(10 + 4 * m) * kTexel;
+    const float top = -0.15f - 0.001f * static_cast<float>(m);
+    boxes.push_back({34 * kTexel, 38 * kTexel, y, y + 3 * kTexel, -0.2f, -0.18f});
+    boxes.push_back({34 * kTexel, 38 * kTexel, y, y + 3 * kTexel, -0.17f, top});
+  }
+  const BodyMapPose paper_pose = LayeredPose(1, boxes);
+  const BodyMapPose layered_pose = LayeredPose(3, boxes);
+  const std::array<size_t, 4> paper = check(BuildOrDie(paper_pose), &paper_pose);
+  EXPECT_EQ(paper[1], 0u);
+  EXPECT_EQ(paper[2], 0u);
+  const std::array<size_t, 4> layered = check(BuildOrDie(layered_pose), &layered_pose);
+  EXPECT_EQ(layered[1], 40u * 40u + 8u * 4u * 3u);  // under the plate, and the posts
+  // Tops that held the other bit are moved, some of them below z = 0 (a test that moved none
+  // would test nothing).
+  EXPECT_GT(layered[2], 0u);
+  EXPECT_GT(layered[3], 0u);
+  // A blend: the plate rises and the mid plate goes, so texels gain and lose gaps between poses.
+  ZBox raised = kPlate;
+  raised.z_lo += 0.04f;
+  raised.z_hi += 0.04f;
+  std::vector<BodyMapPose> poses = {layered_pose, LayeredPose(3, {kBlock, raised, kLowPost})};
+  poses[0].time = 0.f;
+  poses[1].time = 1.f;
+  BodyMapSequence sequence;
+  ASSERT_TRUE(sequence.Build(poses, DepthSampling::kNearest, PoseBlend::kBracket).ok());
+  BodyMapCollider scratch;
+  for (float t : {0.25f, 0.75f, 0.4f}) {
+    SCOPED_TRACE(::testing::Message() << "t = " << t);
+    const std::array<size_t, 4> blended = check(sequence.At(t, &scratch), nullptr);
+    EXPECT_GT(blended[1], 0u);
   }
 }
 

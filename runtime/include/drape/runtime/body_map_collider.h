@@ -225,7 +225,7 @@ class BodyMapCollider {
   friend struct BodyMapColliderTestAccess;  // tests: QueryWalk against Query's quick paths
 
   struct Slab {
-    float top;     // z of the front surface; -inf on background
+    float top;     // z of the front surface; -inf on background (see MarkGapTexels)
     float bottom;  // z of the back surface; +inf on background
   };
   struct TexelNormals {
@@ -379,10 +379,12 @@ class BodyMapCollider {
   // (body_map_lane_walk.inl).
   template <class Lanes>
   struct GapLanes;
-  // The gaps of the lanes' row-major texels (absent ones: -inf, +inf) into *out; returns the
-  // lanes of `which` whose texel has gaps (the others' gaps are all absent).
+  // The gaps of the lanes' row-major texels (absent ones: -inf, +inf) into *out, `top` being
+  // their slabs' tops as loaded (which texels have gaps: MarkGapTexels); returns the lanes of
+  // `which` whose texel has gaps (the others' gaps are all absent).
   template <class Lanes>
-  uint32_t GatherGapLanes(typename Lanes::I texel, uint32_t which, GapLanes<Lanes>* out) const;
+  uint32_t GatherGapLanes(typename Lanes::I texel, typename Lanes::F top, uint32_t which,
+                          GapLanes<Lanes>* out) const;
   // A lane still walking after this many texels is answered one by one: a walk that long goes
   // through air, which the one-by-one walk skips 8x8 blocks at a time, and lanes in step
   // wait for the longest. Tuned on the speed-vs-error query sets (docs/PERFORMANCE.md).
@@ -397,6 +399,11 @@ class BodyMapCollider {
   void Finish();
   void FillGapLookups();        // gap_block_sums_ from gap_texel_bits_ (Finish)
   void CountGapsBeforeWords();  // gap_word_first_ from gap_texel_bits_
+  // With gap layers, the lowest mantissa bit of each valid slab's top is set exactly on the
+  // texels with gaps (gap_texel_bits_), so that the lanes read it from the slab they load
+  // anyway instead of a second lookup per step (GatherGapLanes). A top moves up by at most one
+  // ulp to carry it: about 3e-8 m at z = 0.5 m, out of the body. Finish calls it first.
+  void MarkGapTexels();
   // Blocks with gaps among blocks bi0..bi1 x bj0..bj1 (inclusive, on the grid), by the sums.
   uint32_t GapBlocksIn(uint32_t bi0, uint32_t bj0, uint32_t bi1, uint32_t bj1) const {
     const size_t row = blocks_w_ + 1;
