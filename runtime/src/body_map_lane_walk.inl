@@ -224,6 +224,14 @@ template <class P>
   }
 }
 
+// The lanes of `which` whose texel has gaps, from the flag in their slabs' tops as loaded
+// (BodyMapCollider::MarkGapTexels).
+template <class P>
+uint32_t LanesWithGaps(typename P::F top, uint32_t which) {
+  const typename P::I flag = P::SplatI(1);
+  return which & LaneBits(AsFloat(Equal(And(AsInt(top), flag), flag)));
+}
+
 }  // namespace
 
 // A texel's inside set with gaps (BodyMapCollider::TexelIntervals) is its slab less the open
@@ -310,21 +318,17 @@ struct BodyMapCollider::GapLanes {
 };
 
 template <class P>
-uint32_t BodyMapCollider::GatherGapLanes(typename P::I texel, typename P::F top, uint32_t which,
-                                         GapLanes<P>* out) const {
+void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
+                                     GapLanes<P>* out) const {
   constexpr int kLanes = P::kCount;
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   out->layers = gap_layers_;
-  // The lanes with gaps first, from the gap flag in their slabs' tops (MarkGapTexels), so that a
-  // step without one (most steps near gaps) skips the scalar work.
-  const typename P::I flag = P::SplatI(1);
-  const uint32_t with_gaps = which & LaneBits(AsFloat(Equal(And(AsInt(top), flag), flag)));
   if (with_gaps == 0) {
     for (uint32_t g = 0; g < gap_layers_; ++g) {
       out->top[g] = P::Splat(-kInfinity);
       out->bottom[g] = P::Splat(kInfinity);
     }
-    return with_gaps;
+    return;
   }
   alignas(32) int32_t t[kLanes];
   P::Store(t, texel);
@@ -344,7 +348,6 @@ uint32_t BodyMapCollider::GatherGapLanes(typename P::I texel, typename P::F top,
     for (int lane = 0; lane < kLanes; ++lane) gap[lane] = first[lane] + g;
     P::LoadSlabs(gap, &out->top[g], &out->bottom[g]);
   }
-  return with_gaps;
 }
 
 template <class P>
@@ -441,12 +444,14 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
     const auto texel_lanes = [&](const size_t* texel) {
       return P::FromLanesI([&](int l) { return static_cast<int32_t>(texel[l]); });
     };
-    uint32_t gap_lanes = GatherGapLanes<P>(texel_lanes(texel_a), slab_a_top, lanes, &gaps_a);
-    gaps_b = gaps_a;
-    if (two_lanes != 0) {
-      gap_lanes |= GatherGapLanes<P>(texel_lanes(texel_b), slab_b_top, lanes, &gaps_b);
+    const uint32_t gap_lanes_a = LanesWithGaps<P>(slab_a_top, lanes);
+    const uint32_t gap_lanes_b = two_lanes != 0 ? LanesWithGaps<P>(slab_b_top, lanes) : 0u;
+    with_gaps = (gap_lanes_a | gap_lanes_b) != 0;
+    if (with_gaps) {
+      GatherGapLanes<P>(texel_lanes(texel_a), gap_lanes_a, &gaps_a);
+      gaps_b = gaps_a;
+      if (two_lanes != 0) GatherGapLanes<P>(texel_lanes(texel_b), gap_lanes_b, &gaps_b);
     }
-    with_gaps = gap_lanes != 0;
   }
 
   // The walk (BodyMapWalk::Run<1>): the crossing parameter of the edge, A over [0, s_cross],
@@ -689,9 +694,10 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   F end_in_gap = zero;
   I end_top_slot = front_slot, end_bottom_slot = back_slot;
   if (gaps_near) {
-    GapLanes<P> gaps;
-    if (GatherGapLanes<P>(P::FromLanesI([&](int l) { return texel_b[l]; }), slab_b_top,
-                          lanes & p1_in_box_lanes, &gaps) != 0) {
+    const uint32_t end_gap_lanes = LanesWithGaps<P>(slab_b_top, lanes & p1_in_box_lanes);
+    if (end_gap_lanes != 0) {
+      GapLanes<P> gaps;
+      GatherGapLanes<P>(P::FromLanesI([&](int l) { return texel_b[l]; }), end_gap_lanes, &gaps);
       end_in_gap = gaps.InGap(p1.z);
       const typename GapLanes<P>::Interval around = gaps.Around(p1.z, slab_b_top, slab_b_bottom);
       slab_b_top = around.top;
@@ -796,8 +802,10 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
         const F in_front = And(above, Greater(z_exit, top));
         const F behind = And(Less(z_enter, bottom), Less(z_exit, bottom));
         const F meets_slab = AndNot(Or(in_front, behind), active);
-        GapLanes<P> gaps;
-        if (GatherGapLanes<P>(texel, top, LaneBits(meets_slab), &gaps) != 0) [[unlikely]] {
+        const uint32_t gap_lanes = LanesWithGaps<P>(top, LaneBits(meets_slab));
+        if (gap_lanes != 0) [[unlikely]] {
+          GapLanes<P> gaps;
+          GatherGapLanes<P>(texel, gap_lanes, &gaps);
           const typename GapLanes<P>::Visit visit =
               gaps.VisitTexel(top, bottom, z_enter, z_exit, inside);
           wall = visit.wall;

@@ -379,12 +379,11 @@ class BodyMapCollider {
   // (body_map_lane_walk.inl).
   template <class Lanes>
   struct GapLanes;
-  // The gaps of the lanes' row-major texels (absent ones: -inf, +inf) into *out, `top` being
-  // their slabs' tops as loaded (which texels have gaps: MarkGapTexels); returns the lanes of
-  // `which` whose texel has gaps (the others' gaps are all absent).
+  // The gaps of the lanes' row-major texels into *out: of the lanes in `with_gaps`, whose
+  // texels have gaps (LanesWithGaps in body_map_lane_walk.inl); absent ones (-inf, +inf) for
+  // the others.
   template <class Lanes>
-  uint32_t GatherGapLanes(typename Lanes::I texel, typename Lanes::F top, uint32_t which,
-                          GapLanes<Lanes>* out) const;
+  void GatherGapLanes(typename Lanes::I texel, uint32_t with_gaps, GapLanes<Lanes>* out) const;
   // A lane still walking after this many texels is answered one by one: a walk that long goes
   // through air, which the one-by-one walk skips 8x8 blocks at a time, and lanes in step
   // wait for the longest. Tuned on the speed-vs-error query sets (docs/PERFORMANCE.md).
