@@ -766,13 +766,16 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     return SelectLanes(Less(s, half), Add(q0.z, Mul(dz, s)), Sub(q1.z, Mul(dz, Sub(one, s))));
   };
   F s_enter = zero, z_enter = z_at(zero);
-  // At the entered texel: the piece [s_enter, s_exit], its z, the slab, a side-wall entry.
-  F hit = zero, hit_s_enter = zero, hit_s_exit = zero, hit_z_enter = zero;
-  F hit_z_exit = zero, hit_top = zero, hit_bottom = zero, hit_wall = zero;
+  // At the entered texel: the piece [s_enter, s_exit] (its z is z_at of its ends: z_enter is
+  // z_at(s_enter) at every step, so it is not kept), a side-wall entry, the texel. What the
+  // answer needs of that texel (VisitLanes' top and bottom, the surfaces' slots) is its slab
+  // and the slab's surfaces, read again after the walk, except for an entry in a step that ran
+  // the visit with gaps (hit_in_gap_visit), which records its own: fewer vectors live per step.
+  F hit = zero, hit_s_enter = zero, hit_s_exit = zero, hit_wall = zero;
   I hit_texel = zero_i;
+  F hit_in_gap_visit = zero, hit_top = zero, hit_bottom = zero;
+  I hit_top_slot = front_slot, hit_bottom_slot = back_slot;  // BodyMapCollider::Interval
   alignas(32) int32_t at[kLanes];
-  // With gaps: the entered surfaces' slots (BodyMapCollider::Interval).
-  I hit_top_slot = front_slot, hit_bottom_slot = back_slot;
   const auto walk_texels = [&](auto with_gaps) {
     constexpr bool kGaps = decltype(with_gaps)::value;
     for (int walked = 1;; ++walked) {
@@ -791,10 +794,6 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       F entered = And(active, Or(wall, AndNot(in_enter, reaches)));
       F inside_after =
           And(And(inside, in_enter), And(LessEq(z_exit, top), GreaterEq(z_exit, bottom)));
-      // What the answer needs of the entered texel: VisitLanes' top and bottom (the entered
-      // interval, or the surface reached), and with gaps the surfaces' slots.
-      F kept_top = top, kept_bottom = bottom;
-      I top_slot = front_slot, bottom_slot = back_slot;
       if constexpr (kGaps) {
         // Only a piece that meets the slab in z can meet its gaps, which lie within it: for a
         // piece wholly in front of or behind the slab (every background texel too) the visit
@@ -811,10 +810,13 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
           wall = visit.wall;
           entered = And(active, Or(wall, Or(visit.front, visit.back)));
           inside_after = visit.stays;
-          kept_top = visit.kept_top;
-          kept_bottom = visit.kept_bottom;
-          top_slot = visit.top_slot;
-          bottom_slot = visit.bottom_slot;
+          // What the answer needs of the texel entered here: VisitLanes' top and bottom (the
+          // entered interval, or the surface reached) and the surfaces' slots.
+          hit_top = SelectLanes(entered, visit.kept_top, hit_top);
+          hit_bottom = SelectLanes(entered, visit.kept_bottom, hit_bottom);
+          hit_top_slot = SelectLanesI(entered, visit.top_slot, hit_top_slot);
+          hit_bottom_slot = SelectLanesI(entered, visit.bottom_slot, hit_bottom_slot);
+          hit_in_gap_visit = Or(hit_in_gap_visit, entered);
         }
       }
       // Recorded at every step, with no test whether a lane entered: which step holds a lane's
@@ -822,15 +824,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       hit = Or(hit, entered);
       hit_s_enter = SelectLanes(entered, s_enter, hit_s_enter);
       hit_s_exit = SelectLanes(entered, s_exit, hit_s_exit);
-      hit_z_enter = SelectLanes(entered, z_enter, hit_z_enter);
-      hit_z_exit = SelectLanes(entered, z_exit, hit_z_exit);
-      hit_top = SelectLanes(entered, kept_top, hit_top);
-      hit_bottom = SelectLanes(entered, kept_bottom, hit_bottom);
       hit_wall = SelectLanes(entered, wall, hit_wall);
-      if constexpr (kGaps) {
-        hit_top_slot = SelectLanesI(entered, top_slot, hit_top_slot);
-        hit_bottom_slot = SelectLanesI(entered, bottom_slot, hit_bottom_slot);
-      }
       hit_texel = SelectLanesI(entered, texel, hit_texel);
       inside = inside_after;
       const F going = Less(next, inf);  // an edge left to cross
@@ -865,10 +859,18 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     walk_texels(std::false_type{});
   }
   if (lanes == 0) return answered_misses;
+  {
+    P::Store(at, hit_texel);
+    F slab_top, slab_bottom;
+    load_slabs(at, &slab_top, &slab_bottom);
+    hit_top = SelectLanes(hit_in_gap_visit, hit_top, slab_top);
+    hit_bottom = SelectLanes(hit_in_gap_visit, hit_bottom, slab_bottom);
+  }
   // The entry in its texel: VisitLanes again on the kept piece (a side-wall entry is one where
   // the walk was not inside at the texel's entry point).
-  const LaneVisit<P> entry = VisitLanes<P>(hit_top, hit_bottom, hit_s_enter, hit_s_exit,
-                                           hit_z_enter, hit_z_exit, AndNot(hit_wall, all_lanes));
+  const LaneVisit<P> entry =
+      VisitLanes<P>(hit_top, hit_bottom, hit_s_enter, hit_s_exit, z_at(hit_s_enter),
+                    z_at(hit_s_exit), AndNot(hit_wall, all_lanes));
   // A side-wall entry at the clipped start on the box's top or bottom face is through that face:
   // the front surface moving down, the back moving up (BodyMapWalk::HitAtStart).
   const F z_face = And(And(hit_wall, MaskOfLanes<P>(start_on_z_face)), Equal(hit_s_enter, zero));
