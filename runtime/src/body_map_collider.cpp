@@ -16,6 +16,19 @@ namespace drape {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// `top` with its lowest mantissa bit equal to `has_gaps` (0 or 1): itself, or the next float up
+// (out of the body, above any gap), or down from the largest float. Without a branch on the
+// bit, which is data. In bits: + 0.f makes -0 into +0, whose next float up is the least
+// denormal (bits 1).
+float WithGapFlag(float top, uint32_t has_gaps) {
+  const uint32_t bits = std::bit_cast<uint32_t>(top + 0.f);
+  const uint32_t up = static_cast<int32_t>(bits) >= 0 ? bits + 1u : bits - 1u;
+  const uint32_t down = static_cast<int32_t>(bits) >= 0 ? bits - 1u : bits + 1u;
+  const uint32_t moved = up == std::bit_cast<uint32_t>(kInf) ? down : up;
+  const bool keep = (std::bit_cast<uint32_t>(top) & 1u) == has_gaps;
+  return std::bit_cast<float>(keep ? std::bit_cast<uint32_t>(top) : moved);
+}
 constexpr uint32_t kMaxMapSide = 1u << 16;  // texels per side accepted by Build
 // Bilinear depth only where the four corner depths spread less than this many texel sizes
 // (notes/algorithms.md §5.1 step 4): larger spreads are silhouettes or steps, where bilinear
@@ -870,32 +883,19 @@ void BodyMapCollider::FillGapLookups() {
   }
 }
 
-void BodyMapCollider::MarkGapTexels() {
-  if (gap_layers_ == 0) return;
-  for (size_t k = 0; k < slabs_.size(); ++k) {
-    Slab& slab = slabs_[k];
-    if (!(slab.top >= slab.bottom)) continue;  // background: -inf, no gaps, low bit clear
-    const uint32_t has_gaps = (gap_texel_bits_[k >> 5] >> (k & 31u)) & 1u;
-    if ((std::bit_cast<uint32_t>(slab.top) & 1u) == has_gaps) continue;
-    // The next float up (out of the body, above the gaps), in bits: + 0.f makes -0 into +0,
-    // whose next float up is the least denormal (bits 1). Down instead from the largest float.
-    const uint32_t bits = std::bit_cast<uint32_t>(slab.top + 0.f);
-    const uint32_t up = static_cast<int32_t>(bits) >= 0 ? bits + 1u : bits - 1u;
-    const uint32_t down = static_cast<int32_t>(bits) >= 0 ? bits - 1u : bits + 1u;
-    slab.top = std::bit_cast<float>(up == std::bit_cast<uint32_t>(kInf) ? down : up);
-  }
-}
-
 void BodyMapCollider::Finish() {
-  MarkGapTexels();
   const size_t w = width_, h = height_;
   uint32_t valid = 0;
   size_t i_lo = w, i_hi = 0, j_lo = h, j_hi = 0;  // valid texel range, [lo, hi)
   float z_lo = kInf, z_hi = -kInf;
   for (size_t j = 0; j < h; ++j) {
     for (size_t i = 0; i < w; ++i) {
-      const Slab& s = slabs_[j * w + i];
-      if (!(s.top >= s.bottom)) continue;
+      Slab& s = slabs_[j * w + i];
+      if (!(s.top >= s.bottom)) continue;  // background: top -inf, no gaps, its low bit clear
+      if (gap_layers_ != 0) {
+        const size_t k = j * w + i;
+        s.top = WithGapFlag(s.top, (gap_texel_bits_[k >> 5] >> (k & 31u)) & 1u);
+      }
       ++valid;
       i_lo = std::min(i_lo, i);
       i_hi = std::max(i_hi, i + 1);

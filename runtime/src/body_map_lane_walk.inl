@@ -225,7 +225,7 @@ template <class P>
 }
 
 // The lanes of `which` whose texel has gaps, from the flag in their slabs' tops as loaded
-// (BodyMapCollider::MarkGapTexels).
+// (BodyMapCollider::Finish).
 template <class P>
 uint32_t LanesWithGaps(typename P::F top, uint32_t which) {
   const typename P::I flag = P::SplatI(1);

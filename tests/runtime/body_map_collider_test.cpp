@@ -1609,7 +1609,7 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
 }
 
 // With gap layers the lanes read whether a texel has gaps from its slab's top (its lowest mantissa
-// bit, MarkGapTexels), not from a second table: the bit must mark exactly the texels with gaps,
+// bit, set by Finish), not from a second table: the bit must mark exactly the texels with gaps,
 // after Build and after a blend, and move a top by at most one ulp, upward. Without gap layers
 // the tops are the maps' own values.
 TEST(BodyMapGaps, SlabTopsCarryTheGapFlagWithinOneUlp) {

@@ -225,7 +225,7 @@ class BodyMapCollider {
   friend struct BodyMapColliderTestAccess;  // tests: QueryWalk against Query's quick paths
 
   struct Slab {
-    float top;     // z of the front surface; -inf on background (see MarkGapTexels)
+    float top;     // z of the front surface; -inf on background (see Finish)
     float bottom;  // z of the back surface; +inf on background
   };
   struct TexelNormals {
@@ -394,15 +394,14 @@ class BodyMapCollider {
   bool BilinearBlock(int i0, int j0) const;  // block with texel (i0, j0) as its lower corner
   Float3 SampleNormal(int ci, int cj, float u, float v, bool back) const;
   // Recomputes bounds, stats.valid_texels, bilinear eligibility and the min/max blocks from
-  // slabs_ (used by Build and by sequence blending).
+  // slabs_ (used by Build and by sequence blending). First, with gap layers, it marks the texels
+  // with gaps in their slabs: the lowest mantissa bit of each valid slab's top is set exactly on
+  // the texels with gaps (gap_texel_bits_), so that the lanes read it from the slab they load
+  // anyway instead of a second lookup per step (GatherGapLanes). A top moves up by at most one
+  // ulp to carry it: about 3e-8 m at z = 0.5 m, out of the body.
   void Finish();
   void FillGapLookups();        // gap_block_sums_ from gap_texel_bits_ (Finish)
   void CountGapsBeforeWords();  // gap_word_first_ from gap_texel_bits_
-  // With gap layers, the lowest mantissa bit of each valid slab's top is set exactly on the
-  // texels with gaps (gap_texel_bits_), so that the lanes read it from the slab they load
-  // anyway instead of a second lookup per step (GatherGapLanes). A top moves up by at most one
-  // ulp to carry it: about 3e-8 m at z = 0.5 m, out of the body. Finish calls it first.
-  void MarkGapTexels();
   // Blocks with gaps among blocks bi0..bi1 x bj0..bj1 (inclusive, on the grid), by the sums.
   uint32_t GapBlocksIn(uint32_t bi0, uint32_t bj0, uint32_t bi1, uint32_t bj1) const {
     const size_t row = blocks_w_ + 1;
