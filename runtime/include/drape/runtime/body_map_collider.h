@@ -212,7 +212,9 @@ class BodyMapCollider {
   const BodyMapStats& stats() const { return stats_; }
   size_t memory_bytes() const;
 
-  // Per-texel access (tests, tools): false for background; top/bottom are asset-frame z.
+  // Per-texel access (tests, tools): false for background; top/bottom are asset-frame z. With
+  // gap layers a top can be one ulp above the maps' value (its lowest bit flags the texels with
+  // gaps for the batch; see Finish).
   bool TexelSlab(uint32_t i, uint32_t j, float* top, float* bottom) const;
   Float3 TexelNormal(uint32_t i, uint32_t j, bool back) const;
   // The air gaps of texel (i, j), from the front: writes upper[g], lower[g] (asset-frame z) for
