@@ -859,10 +859,12 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     walk_texels(std::false_type{});
   }
   if (lanes == 0) return answered_misses;
+  // The entered texels, lane by lane: their slabs now, their normals at the end.
+  alignas(32) int32_t entered_texel[kLanes];
+  P::Store(entered_texel, hit_texel);
   {
-    P::Store(at, hit_texel);
     F slab_top, slab_bottom;
-    load_slabs(at, &slab_top, &slab_bottom);
+    load_slabs(entered_texel, &slab_top, &slab_bottom);
     hit_top = SelectLanes(hit_in_gap_visit, hit_top, slab_top);
     hit_bottom = SelectLanes(hit_in_gap_visit, hit_bottom, slab_bottom);
   }
@@ -902,9 +904,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
       SelectLanes(push_out, placed.push_back, SelectLanes(wall, wall_back, hit_back));
   const uint32_t back_lanes = LaneBits(use_back);
   const uint32_t push_lanes = LaneBits(push_out);
-  alignas(32) int32_t entered_texel[kLanes], entered_slot[2][kLanes];
-  alignas(32) int32_t end_slot[2][kLanes];
-  P::Store(entered_texel, hit_texel);
+  alignas(32) int32_t entered_slot[2][kLanes], end_slot[2][kLanes];
   if (gaps_near) {
     P::Store(end_slot[0], end_top_slot);
     P::Store(end_slot[1], end_bottom_slot);
