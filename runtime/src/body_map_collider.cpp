@@ -4,6 +4,7 @@
 #include <bit>
 #include <cfloat>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <new>
 #include <string>
@@ -30,6 +31,14 @@ float WithGapFlag(float top, uint32_t has_gaps) {
   return std::bit_cast<float>(keep ? std::bit_cast<uint32_t>(top) : moved);
 }
 constexpr uint32_t kMaxMapSide = 1u << 16;  // texels per side accepted by Build
+// The set bits among the low eight of a lane mask, in a few operations: std::popcount is a
+// library call where the baseline x86-64 lacks popcnt, and CollideRange counts once per group.
+constexpr uint32_t CountLaneBits(uint32_t lanes) {
+  lanes = lanes - ((lanes >> 1) & 0x55u);
+  lanes = (lanes & 0x33u) + ((lanes >> 2) & 0x33u);
+  return (lanes + (lanes >> 4)) & 0x0fu;
+}
+static_assert(CountLaneBits(0xffu) == 8 && CountLaneBits(0xa5u) == 4 && CountLaneBits(0) == 0);
 // Bilinear depth only where the four corner depths spread less than this many texel sizes
 // (notes/algorithms.md §5.1 step 4): larger spreads are silhouettes or steps, where bilinear
 // would invent a slope through air.
@@ -1490,7 +1499,7 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
                                                   flags + k, params, &long_motions)
                        : CollideFourShortMotions(previous + k, positions + k, velocities + k,
                                                  flags + k, params, &long_motions);
-        if (2 * static_cast<uint32_t>(std::popcount(long_motions)) >= width) {
+        if (2 * CountLaneBits(long_motions) >= width) {
           skip_short = kScalarParticles / width;
         }
       }

@@ -7,8 +7,10 @@
 // its copies by the linker) keep the baseline instruction set; the file therefore needs no
 // -mavx2, which would compile those too.
 #include <algorithm>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <type_traits>
 
@@ -117,6 +119,23 @@ struct Avx2Lanes {
     *x = _mm256_shuffle_ps(a, b2c1, _MM_SHUFFLE(2, 0, 3, 0));
     *y = _mm256_shuffle_ps(a1b0, b3c2, _MM_SHUFFLE(2, 0, 2, 0));
     *z = _mm256_shuffle_ps(a2b1, c0c3, _MM_SHUFFLE(2, 0, 2, 0));
+  }
+  // Sse2Lanes::StoreFloat3s on each half, the halves then put in memory order.
+  static void StoreFloat3s(void* triples, F x, F y, F z) {
+    float* f = static_cast<float*>(triples);
+    const __m256 x0y0x1y1 = _mm256_unpacklo_ps(x, y);
+    const __m256 x2y2x3y3 = _mm256_unpackhi_ps(x, y);
+    const __m256 z0x1 = _mm256_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0));
+    const __m256 y1z1 = _mm256_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1));
+    const __m256 z2x3 = _mm256_shuffle_ps(z, x, _MM_SHUFFLE(3, 3, 2, 2));
+    const __m256 y3z3 = _mm256_shuffle_ps(y, z, _MM_SHUFFLE(3, 3, 3, 3));
+    const __m256 a =
+        _mm256_shuffle_ps(x0y0x1y1, z0x1, _MM_SHUFFLE(2, 0, 1, 0));  // triples 0-1, 4-5
+    const __m256 b = _mm256_shuffle_ps(y1z1, x2y2x3y3, _MM_SHUFFLE(1, 0, 2, 0));
+    const __m256 c = _mm256_shuffle_ps(z2x3, y3z3, _MM_SHUFFLE(2, 0, 2, 0));
+    _mm256_storeu_ps(f, _mm256_permute2f128_ps(a, b, 0x20));       // low halves of a, b
+    _mm256_storeu_ps(f + 8, _mm256_permute2f128_ps(c, a, 0x30));   // low of c, high of a
+    _mm256_storeu_ps(f + 16, _mm256_permute2f128_ps(b, c, 0x31));  // high halves of b, c
   }
   // Sse2Lanes::LoadSlabs on each half.
   static void LoadSlabs(const void* const* slab, F* top, F* bottom) {

@@ -30,8 +30,6 @@ Lanes3<P> LoadFloat3Lanes(const Float3* p) {
   return lanes;
 }
 
-constexpr uint32_t kConsecutiveLanes[8] = {0, 1, 2, 3, 4, 5, 6, 7};
-
 // The mask of the lanes whose bit is set in `bits`.
 template <class P>
 typename P::F MaskOfLanes(uint32_t bits) {
@@ -172,20 +170,21 @@ template <class P>
   return placed;
 }
 
-// The lanes' answers, written to element index[l] of the arrays for each lane l in `lanes`:
-// ApplyResponse (collision_types.h) at `point` with `normal` for the lanes in contact, and the
-// flags CollideOne gives. `p` and `v` hold the lanes' positions and velocities as read: a lane
-// without contact writes them back, the same bits, so that no write waits on a branch over the
-// contact (which lanes touch the body is data, and a mispredicted branch costs more than the
-// store).
+// The lanes' answers: ApplyResponse (collision_types.h) at `point` with `normal` for the lanes
+// in contact, and the flags CollideOne gives. `p` and `v` hold the lanes' positions and
+// velocities as read: a lane without contact gets them back, the same bits, so that no write
+// waits on a branch over the contact (which lanes touch the body is data, and a mispredicted
+// branch costs more than the store).
 template <class P>
-[[gnu::always_inline]] inline void WriteLaneAnswers(const uint32_t* index, uint32_t lanes,
-                                                    uint32_t contact_lanes, uint32_t wall_lanes,
-                                                    uint32_t started_inside_lanes,
-                                                    const Lanes3<P>& point, const Lanes3<P>& normal,
-                                                    const Lanes3<P>& p, const Lanes3<P>& v,
-                                                    const ResponseParams& params, Float3* positions,
-                                                    Float3* velocities, uint8_t* flags) {
+struct LaneAnswers {
+  Lanes3<P> position, velocity;
+};
+template <class P>
+[[gnu::always_inline]] inline LaneAnswers<P> RespondLanes(uint32_t contact_lanes,
+                                                          const Lanes3<P>& point,
+                                                          const Lanes3<P>& normal,
+                                                          const Lanes3<P>& p, const Lanes3<P>& v,
+                                                          const ResponseParams& params) {
   using F = typename P::F;
   // The position on the surface plus the separation; the velocity only where it points into
   // the body.
@@ -206,21 +205,72 @@ template <class P>
     const F changed = Sub(Mul(Sub(velocity, normal_part), keep), Mul(normal_part, restitution));
     return SelectLanes(into, changed, velocity);
   };
-  const Lanes3<P> velocity = {respond(v.x, normal.x), respond(v.y, normal.y),
-                              respond(v.z, normal.z)};
+  return {position, {respond(v.x, normal.x), respond(v.y, normal.y), respond(v.z, normal.z)}};
+}
 
+// Byte l of the result is bit l of `bits` (l < 8): a copy of the eight bits in every byte
+// (no carries), byte l keeps its bit l, and adding 0x7f carries any set bit into bit 7 of the
+// same byte (at most 0x80 + 0x7f: no carry out of it).
+constexpr uint64_t SpreadLaneBits(uint32_t bits) {
+  const uint64_t kept =
+      (static_cast<uint64_t>(bits & 0xffu) * 0x0101010101010101ull) & 0x8040201008040201ull;
+  return ((kept + 0x7f7f7f7f7f7f7f7full) >> 7) & 0x0101010101010101ull;
+}
+constexpr bool SpreadsEveryLaneMask() {
+  for (uint32_t bits = 0; bits < 256; ++bits) {
+    for (uint32_t lane = 0; lane < 8; ++lane) {
+      if (((SpreadLaneBits(bits) >> (8 * lane)) & 0xffu) != ((bits >> lane) & 1u)) return false;
+    }
+  }
+  return true;
+}
+static_assert(SpreadsEveryLaneMask());
+
+// The flags CollideOne gives, lane l in byte l.
+inline uint64_t LaneFlagBytes(uint32_t contact_lanes, uint32_t wall_lanes,
+                              uint32_t started_inside_lanes) {
+  const uint32_t wall = wall_lanes & contact_lanes;
+  const uint32_t started_inside = started_inside_lanes & ~wall_lanes & contact_lanes;
+  return SpreadLaneBits(contact_lanes) * kCollisionContact |
+         SpreadLaneBits(wall) * kCollisionSideWall |
+         SpreadLaneBits(started_inside) * kCollisionStartedInside;
+}
+
+// The answers of every lane, to P::kCount consecutive elements of the arrays: two stores of
+// triples and one of the flag bytes.
+template <class P>
+[[gnu::always_inline]] inline void WriteConsecutiveLaneAnswers(
+    uint32_t contact_lanes, uint32_t wall_lanes, uint32_t started_inside_lanes,
+    const Lanes3<P>& point, const Lanes3<P>& normal, const Lanes3<P>& p, const Lanes3<P>& v,
+    const ResponseParams& params, Float3* positions, Float3* velocities, uint8_t* flags) {
+  static_assert(sizeof(Float3) == 3 * sizeof(float), "StoreFloat3s writes packed triples");
+  static_assert(std::endian::native == std::endian::little, "lane l's flag in byte l");
+  const LaneAnswers<P> answers = RespondLanes<P>(contact_lanes, point, normal, p, v, params);
+  P::StoreFloat3s(positions, answers.position.x, answers.position.y, answers.position.z);
+  P::StoreFloat3s(velocities, answers.velocity.x, answers.velocity.y, answers.velocity.z);
+  const uint64_t bytes = LaneFlagBytes(contact_lanes, wall_lanes, started_inside_lanes);
+  std::memcpy(flags, &bytes, P::kCount);
+}
+
+// The answers of the lanes in `lanes`, to element index[l] of the arrays for lane l.
+template <class P>
+[[gnu::always_inline]] inline void WriteLaneAnswers(const uint32_t* index, uint32_t lanes,
+                                                    uint32_t contact_lanes, uint32_t wall_lanes,
+                                                    uint32_t started_inside_lanes,
+                                                    const Lanes3<P>& point, const Lanes3<P>& normal,
+                                                    const Lanes3<P>& p, const Lanes3<P>& v,
+                                                    const ResponseParams& params, Float3* positions,
+                                                    Float3* velocities, uint8_t* flags) {
+  const LaneAnswers<P> answers = RespondLanes<P>(contact_lanes, point, normal, p, v, params);
   alignas(32) float out[6][P::kCount];
-  StoreLanes<P>(position, velocity, out);
+  StoreLanes<P>(answers.position, answers.velocity, out);
+  const uint64_t bytes = LaneFlagBytes(contact_lanes, wall_lanes, started_inside_lanes);
   for (int lane = 0; lane < P::kCount; ++lane) {
     if (!((lanes >> lane) & 1u)) continue;
     const uint32_t k = index[lane];
     positions[k] = Float3{out[0][lane], out[1][lane], out[2][lane]};
     velocities[k] = Float3{out[3][lane], out[4][lane], out[5][lane]};
-    const uint32_t contact = (contact_lanes >> lane) & 1u;
-    const uint32_t wall = (wall_lanes >> lane) & 1u;
-    const uint32_t started_inside = (started_inside_lanes >> lane) & 1u & (wall ^ 1u);
-    flags[k] = static_cast<uint8_t>(contact * (kCollisionContact | wall * kCollisionSideWall |
-                                               started_inside * kCollisionStartedInside));
+    flags[k] = static_cast<uint8_t>(bytes >> (8 * lane));
   }
 }
 
@@ -337,11 +387,13 @@ void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
   static_assert(kMaxBodyMapLayers == 4, "one absent gap per gap layer below");
   static constexpr Slab kNoGaps[kMaxBodyMapLayers - 1] = {
       {-kInfinity, kInfinity}, {-kInfinity, kInfinity}, {-kInfinity, kInfinity}};
+  // (The lanes with gaps taken bit by bit: one unpredictable loop exit per call, where a test
+  // of each lane's bit mispredicts up to once per lane.)
   const Slab* first[kLanes];
-  for (int lane = 0; lane < kLanes; ++lane) {
-    first[lane] = ((with_gaps >> lane) & 1u)
-                      ? gaps_.data() + GapBaseAt(static_cast<uint32_t>(t[lane]))
-                      : kNoGaps;
+  for (int lane = 0; lane < kLanes; ++lane) first[lane] = kNoGaps;
+  for (uint32_t bits = with_gaps; bits != 0; bits &= bits - 1u) {
+    const int lane = std::countr_zero(bits);
+    first[lane] = gaps_.data() + GapBaseAt(static_cast<uint32_t>(t[lane]));
   }
   for (uint32_t g = 0; g < gap_layers_; ++g) {
     const void* gap[kLanes];
@@ -422,11 +474,14 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   const void* slab_a[kLanes];
   const void* slab_b[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
-    const bool used = (lanes >> lane) & 1u;
+    // Masked, not branched on: which lanes are used is data. (Unsigned: an unused lane's
+    // indices are whatever its coordinates truncated to.)
+    const uint32_t keep = 0u - ((lanes >> lane) & 1u);
+    const uint32_t row = width_;
     texel_a[lane] =
-        used ? static_cast<size_t>(ja[lane]) * width_ + static_cast<size_t>(ia[lane]) : 0;
+        keep & (static_cast<uint32_t>(ja[lane]) * row + static_cast<uint32_t>(ia[lane]));
     texel_b[lane] =
-        used ? static_cast<size_t>(jb[lane]) * width_ + static_cast<size_t>(ib[lane]) : 0;
+        keep & (static_cast<uint32_t>(jb[lane]) * row + static_cast<uint32_t>(ib[lane]));
     slab_a[lane] = &slabs_[texel_a[lane]];
     slab_b[lane] = &slabs_[texel_b[lane]];
   }
@@ -554,23 +609,22 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   uint16_t qa[kLanes] = {}, qb[kLanes] = {};
   for (int lane = 0; lane < kLanes; ++lane) {
     const size_t t = (from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane];  // a push-out: B
-    const bool back = (back_lanes >> lane) & 1u;
-    const TexelNormals& n = normals_[t];
-    const uint16_t* q = back ? n.back : n.front;
-    if (with_gaps && slot[back ? 1 : 0][lane] >= 2) {
-      q = SlotCode(static_cast<uint32_t>(t), slot[back ? 1 : 0][lane]);
+    const uint32_t back = (back_lanes >> lane) & 1u;
+    uint32_t code = SideCode(t, back);
+    if (with_gaps && slot[back][lane] >= 2) [[unlikely]] {
+      const uint16_t* q = SlotCode(static_cast<uint32_t>(t), slot[back][lane]);
+      code = q[0] | static_cast<uint32_t>(q[1]) << 16;
     }
-    qa[lane] = q[0];
-    qb[lane] = q[1];
+    qa[lane] = static_cast<uint16_t>(code);
+    qb[lane] = static_cast<uint16_t>(code >> 16);
   }
   const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
   const uint32_t wall_lanes = LaneBits(wall);
   const uint32_t started_inside_lanes = LaneBits(And(push_out, start_inside));
   // Every lane is written, with no branch on which are answered: the others get their own
   // position and velocity back and a flag the walk or the one-by-one query replaces.
-  WriteLaneAnswers<P>(kConsecutiveLanes, (1u << kLanes) - 1u, contact_lanes, wall_lanes,
-                      started_inside_lanes, placed.point, normal, p1, v, params, positions,
-                      velocities, flags);
+  WriteConsecutiveLaneAnswers<P>(contact_lanes, wall_lanes, started_inside_lanes, placed.point,
+                                 normal, p1, v, params, positions, velocities, flags);
   return lanes | free_lanes;
 }
 
@@ -662,9 +716,13 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   int32_t texel_b[kLanes];
   const uint32_t p1_in_box_lanes = LaneBits(p1_in_box);
   for (int lane = 0; lane < kLanes; ++lane) {
-    const bool used = (lanes >> lane) & 1u;
-    start[lane] = used ? ja[lane] * static_cast<int32_t>(width_) + ia[lane] : 0;
-    texel_b[lane] = used ? jb[lane] * static_cast<int32_t>(width_) + ib[lane] : 0;
+    // Masked, not branched on, as in CollideShortLanes.
+    const uint32_t keep = 0u - ((lanes >> lane) & 1u);
+    const uint32_t row = width_;
+    start[lane] = static_cast<int32_t>(
+        keep & (static_cast<uint32_t>(ja[lane]) * row + static_cast<uint32_t>(ia[lane])));
+    texel_b[lane] = static_cast<int32_t>(
+        keep & (static_cast<uint32_t>(jb[lane]) * row + static_cast<uint32_t>(ib[lane])));
   }
   // Whether a lane can meet a texel with gaps: a walk stays in the box of its end texels, so
   // when no 8x8 block under those boxes has one (most of a body, most of the time), the lanes
@@ -913,15 +971,18 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   }
   uint16_t qa[kLanes] = {}, qb[kLanes] = {};
   for (int lane = 0; lane < kLanes; ++lane) {
-    const bool pushed = (push_lanes >> lane) & 1u, back = (back_lanes >> lane) & 1u;
+    const bool pushed = (push_lanes >> lane) & 1u;
+    const uint32_t back = (back_lanes >> lane) & 1u;
     const int32_t t = pushed ? texel_b[lane] : entered_texel[lane];
-    const TexelNormals& n = normals_[static_cast<size_t>(t)];
-    const uint16_t* q = back ? n.back : n.front;
+    uint32_t code = SideCode(static_cast<size_t>(t), back);
     // A gap's surface (slot >= 2; the slots of lanes without gaps are the slab's).
-    const int slot = gaps_near ? (pushed ? end_slot : entered_slot)[back ? 1 : 0][lane] : 0;
-    if (slot >= 2) q = SlotCode(static_cast<uint32_t>(t), slot);
-    qa[lane] = q[0];
-    qb[lane] = q[1];
+    const int slot = gaps_near ? (pushed ? end_slot : entered_slot)[back][lane] : 0;
+    if (slot >= 2) [[unlikely]] {
+      const uint16_t* q = SlotCode(static_cast<uint32_t>(t), slot);
+      code = q[0] | static_cast<uint32_t>(q[1]) << 16;
+    }
+    qa[lane] = static_cast<uint16_t>(code);
+    qb[lane] = static_cast<uint16_t>(code >> 16);
   }
   const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
   const uint32_t wall_lanes = LaneBits(wall);

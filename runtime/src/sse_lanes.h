@@ -112,6 +112,19 @@ struct Sse2Lanes {
     *y = _mm_shuffle_ps(a1b0, b3c2, _MM_SHUFFLE(2, 0, 2, 0));
     *z = _mm_shuffle_ps(a2b1, c0c3, _MM_SHUFFLE(2, 0, 2, 0));
   }
+  // LoadFloat3s' inverse: the lanes as four consecutive triples, three stores.
+  static void StoreFloat3s(void* triples, F x, F y, F z) {
+    float* f = static_cast<float*>(triples);
+    const __m128 x0y0x1y1 = _mm_unpacklo_ps(x, y);
+    const __m128 x2y2x3y3 = _mm_unpackhi_ps(x, y);
+    const __m128 z0x1 = _mm_shuffle_ps(z, x, _MM_SHUFFLE(1, 1, 0, 0));
+    const __m128 y1z1 = _mm_shuffle_ps(y, z, _MM_SHUFFLE(1, 1, 1, 1));
+    const __m128 z2x3 = _mm_shuffle_ps(z, x, _MM_SHUFFLE(3, 3, 2, 2));
+    const __m128 y3z3 = _mm_shuffle_ps(y, z, _MM_SHUFFLE(3, 3, 3, 3));
+    _mm_storeu_ps(f, _mm_shuffle_ps(x0y0x1y1, z0x1, _MM_SHUFFLE(2, 0, 1, 0)));      // x0 y0 z0 x1
+    _mm_storeu_ps(f + 4, _mm_shuffle_ps(y1z1, x2y2x3y3, _MM_SHUFFLE(1, 0, 2, 0)));  // y1 z1 x2 y2
+    _mm_storeu_ps(f + 8, _mm_shuffle_ps(z2x3, y3z3, _MM_SHUFFLE(2, 0, 2, 0)));      // z2 x3 y3 z3
+  }
   // The slabs (two floats, 8 bytes: top then bottom) at slab[0..3] as lanes: 8-byte loads into
   // halves and two shuffles.
   static void LoadSlabs(const void* const* slab, F* top, F* bottom) {
