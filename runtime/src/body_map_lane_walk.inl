@@ -46,14 +46,14 @@ typename P::F AlongLanes(typename P::F a, typename P::F b, typename P::F s) {
   return SelectLanes(Less(s, P::Splat(0.5f)), from_a, from_b);
 }
 
-// DecodeOct16 of one code per lane.
+// DecodeOct16 of one code per lane (its two values, the first in the low 16 bits).
 template <class P>
-[[gnu::always_inline]] inline Lanes3<P> DecodeOct16Lanes(const uint16_t* qa, const uint16_t* qb) {
+[[gnu::always_inline]] inline Lanes3<P> DecodeOct16Lanes(typename P::I code) {
   using F = typename P::F;
   const F one = P::Splat(1.f);
   const F scale = P::Splat(2.f / 65535.f);
-  F x = Sub(Mul(P::FromLanes([&](int l) { return static_cast<float>(qa[l]); }), scale), one);
-  F y = Sub(Mul(P::FromLanes([&](int l) { return static_cast<float>(qb[l]); }), scale), one);
+  F x = Sub(Mul(ToFloat(And(code, P::SplatI(0xffff))), scale), one);
+  F y = Sub(Mul(ToFloat(High16(code)), scale), one);
   const F z = Sub(Sub(one, AbsLanes(x)), AbsLanes(y));
   const F minus_one = P::Splat(-1.f), zero = P::Zero();
   const F sign_x = SelectLanes(GreaterEq(x, zero), one, minus_one);
@@ -402,6 +402,39 @@ void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
   }
 }
 
+// The normal codes of the lanes' texels: front and back loaded as a slab's two floats are, then
+// chosen by the mask. Which side each lane reads is data: a branch per lane would mispredict.
+template <class P>
+typename P::I BodyMapCollider::NormalCodes(const size_t* texel, typename P::F use_back) const {
+  static_assert(sizeof(TexelNormals) == sizeof(Slab), "LoadSlabs loads both codes as 8 bytes");
+  static_assert(std::endian::native == std::endian::little, "a code's first value in the low half");
+  constexpr int kLanes = P::kCount;
+  const void* normals[kLanes];
+  for (int lane = 0; lane < kLanes; ++lane) normals[lane] = &normals_[texel[lane]];
+  typename P::F front, back;
+  P::LoadSlabs(normals, &front, &back);
+  return AsInt(SelectLanes(use_back, back, front));
+}
+
+// `code` with the lanes whose surface is a gap's (slot >= 2) replaced by that surface's code
+// (SlotCode): few lanes, so one by one, and only when there is one.
+template <class P>
+typename P::I BodyMapCollider::GapSurfaceCodes(const size_t* texel, typename P::I slot,
+                                               typename P::I code) const {
+  constexpr int kLanes = P::kCount;
+  const uint32_t gap_lanes = LaneBits(AsFloat(Greater(slot, P::SplatI(1))));
+  if (gap_lanes == 0) return code;
+  alignas(32) int32_t codes[kLanes], slots[kLanes];
+  P::Store(codes, code);
+  P::Store(slots, slot);
+  for (uint32_t bits = gap_lanes; bits != 0; bits &= bits - 1u) {
+    const int lane = std::countr_zero(bits);
+    const uint16_t* q = SlotCode(static_cast<uint32_t>(texel[lane]), slots[lane]);
+    codes[lane] = static_cast<int32_t>(q[0] | static_cast<uint32_t>(q[1]) << 16);
+  }
+  return P::FromLanesI([&](int l) { return codes[l]; });
+}
+
 template <class P>
 uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* positions,
                                             Float3* velocities, uint8_t* flags,
@@ -598,27 +631,21 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   const F use_back =
       SelectLanes(push_out, placed.push_back,
                   SelectLanes(wall, wall_back, SelectLanes(hit_a, in_a.back, in_b.back)));
-  const uint32_t back_lanes = LaneBits(use_back);
   const uint32_t from_a = LaneBits(hit_a);
   // With gaps, a gap's surface (slot >= 2) has its normal among the gaps' (SlotCode).
-  alignas(32) int32_t slot[2][kLanes];
-  if (with_gaps) {
-    P::Store(slot[0], SelectLanesI(push_out, end_top_slot, entered_top_slot));
-    P::Store(slot[1], SelectLanesI(push_out, end_bottom_slot, entered_bottom_slot));
-  }
-  uint16_t qa[kLanes] = {}, qb[kLanes] = {};
+  size_t normal_texel[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
-    const size_t t = (from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane];  // a push-out: B
-    const uint32_t back = (back_lanes >> lane) & 1u;
-    uint32_t code = SideCode(t, back);
-    if (with_gaps && slot[back][lane] >= 2) [[unlikely]] {
-      const uint16_t* q = SlotCode(static_cast<uint32_t>(t), slot[back][lane]);
-      code = q[0] | static_cast<uint32_t>(q[1]) << 16;
-    }
-    qa[lane] = static_cast<uint16_t>(code);
-    qb[lane] = static_cast<uint16_t>(code >> 16);
+    normal_texel[lane] = (from_a >> lane) & 1u ? texel_a[lane] : texel_b[lane];  // push-out: B
   }
-  const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
+  I code = NormalCodes<P>(normal_texel, use_back);
+  if (with_gaps) {
+    code = GapSurfaceCodes<P>(
+        normal_texel,
+        SelectLanesI(push_out, SelectLanesI(use_back, end_bottom_slot, end_top_slot),
+                     SelectLanesI(use_back, entered_bottom_slot, entered_top_slot)),
+        code);
+  }
+  const Lanes3<P> normal = DecodeOct16Lanes<P>(code);
   const uint32_t wall_lanes = LaneBits(wall);
   const uint32_t started_inside_lanes = LaneBits(And(push_out, start_inside));
   // Every lane is written, with no branch on which are answered: the others get their own
@@ -960,31 +987,21 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   const F wall_back = Less(Sub(hit_z, hit_bottom), Sub(hit_top, hit_z));
   const F use_back =
       SelectLanes(push_out, placed.push_back, SelectLanes(wall, wall_back, hit_back));
-  const uint32_t back_lanes = LaneBits(use_back);
   const uint32_t push_lanes = LaneBits(push_out);
-  alignas(32) int32_t entered_slot[2][kLanes], end_slot[2][kLanes];
-  if (gaps_near) {
-    P::Store(end_slot[0], end_top_slot);
-    P::Store(end_slot[1], end_bottom_slot);
-    P::Store(entered_slot[0], hit_top_slot);
-    P::Store(entered_slot[1], hit_bottom_slot);
-  }
-  uint16_t qa[kLanes] = {}, qb[kLanes] = {};
+  size_t normal_texel[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
-    const bool pushed = (push_lanes >> lane) & 1u;
-    const uint32_t back = (back_lanes >> lane) & 1u;
-    const int32_t t = pushed ? texel_b[lane] : entered_texel[lane];
-    uint32_t code = SideCode(static_cast<size_t>(t), back);
-    // A gap's surface (slot >= 2; the slots of lanes without gaps are the slab's).
-    const int slot = gaps_near ? (pushed ? end_slot : entered_slot)[back][lane] : 0;
-    if (slot >= 2) [[unlikely]] {
-      const uint16_t* q = SlotCode(static_cast<uint32_t>(t), slot);
-      code = q[0] | static_cast<uint32_t>(q[1]) << 16;
-    }
-    qa[lane] = static_cast<uint16_t>(code);
-    qb[lane] = static_cast<uint16_t>(code >> 16);
+    normal_texel[lane] =
+        static_cast<size_t>((push_lanes >> lane) & 1u ? texel_b[lane] : entered_texel[lane]);
   }
-  const Lanes3<P> normal = DecodeOct16Lanes<P>(qa, qb);
+  I code = NormalCodes<P>(normal_texel, use_back);
+  if (gaps_near) {  // a gap's surface (slot >= 2; lanes without gaps hold the slab's slots)
+    code = GapSurfaceCodes<P>(
+        normal_texel,
+        SelectLanesI(push_out, SelectLanesI(use_back, end_bottom_slot, end_top_slot),
+                     SelectLanesI(use_back, hit_bottom_slot, hit_top_slot)),
+        code);
+  }
+  const Lanes3<P> normal = DecodeOct16Lanes<P>(code);
   const uint32_t wall_lanes = LaneBits(wall);
   const uint32_t started_inside_lanes = push_lanes & LaneBits(start_inside);
   WriteLaneAnswers<P>(index, lanes, contact_lanes, wall_lanes, started_inside_lanes, placed.point,

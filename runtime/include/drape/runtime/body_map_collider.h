@@ -283,17 +283,6 @@ class BodyMapCollider {
   Float3 SlotNormal(uint32_t i, uint32_t j, int slot) const;
   // The oct16 code (two values) of the surface in `slot` of row-major texel `texel` (SlotNormal's).
   const uint16_t* SlotCode(uint32_t texel, int slot) const;
-  // The front (back = 0) or back (back = 1) oct16 code of row-major texel `texel` as one word,
-  // the first value in the low half. The lanes pick the side with a mask, not a branch on
-  // `back`: which side each lane touches is data, and a branch per lane mispredicts.
-  uint32_t SideCode(size_t texel, uint32_t back) const {
-    static_assert(sizeof(TexelNormals) == 4 * sizeof(uint16_t), "front then back, no padding");
-    const TexelNormals& n = normals_[texel];
-    const uint32_t front = n.front[0] | static_cast<uint32_t>(n.front[1]) << 16;
-    const uint32_t back_code = n.back[0] | static_cast<uint32_t>(n.back[1]) << 16;
-    const uint32_t take_back = 0u - back;  // all ones or zero
-    return (front & ~take_back) | (back_code & take_back);
-  }
   // One texel's gaps while Build decodes them (absent gaps: top = -inf, bottom = +inf).
   struct GapTexel {
     uint32_t i, j;
@@ -397,6 +386,14 @@ class BodyMapCollider {
   // the others.
   template <class Lanes>
   void GatherGapLanes(typename Lanes::I texel, uint32_t with_gaps, GapLanes<Lanes>* out) const;
+  // The lanes' oct16 codes (two values per word, the first in the low half) of the front or,
+  // where use_back, the back normal at texel[lane]; then the gaps' surfaces (slot >= 2,
+  // SlotCode) put in (body_map_lane_walk.inl).
+  template <class Lanes>
+  typename Lanes::I NormalCodes(const size_t* texel, typename Lanes::F use_back) const;
+  template <class Lanes>
+  typename Lanes::I GapSurfaceCodes(const size_t* texel, typename Lanes::I slot,
+                                    typename Lanes::I code) const;
   // A lane still walking after this many texels is answered one by one: a walk that long goes
   // through air, which the one-by-one walk skips 8x8 blocks at a time, and lanes in step
   // wait for the longest. Tuned on the speed-vs-error query sets (docs/PERFORMANCE.md).
