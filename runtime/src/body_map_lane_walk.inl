@@ -755,16 +755,27 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   // when no 8x8 block under those boxes has one (most of a body, most of the time), the lanes
   // run the walk without the gap tests. The blocks' summed-area table answers for a box in four
   // reads, however long the walk.
+  // (Every lane's box is looked up, an unused lane's as block 0: which lanes are used is data,
+  // and a branch per lane would mispredict.)
   bool gaps_near = false;
   if (gap_layers_ != 0) {
+    const I keep = AsInt(MaskOfLanes<P>(lanes));
+    const auto block = [&](I texel) { return And(keep, ShiftRight<kBlockShift>(texel)); };
+    const auto min_i = [&](I a, I b) { return SelectLanesI(AsFloat(Greater(a, b)), b, a); };
+    const auto max_i = [&](I a, I b) { return SelectLanesI(AsFloat(Greater(a, b)), a, b); };
+    alignas(32) int32_t block_lo_i[kLanes], block_lo_j[kLanes], block_hi_i[kLanes],
+        block_hi_j[kLanes];
+    P::Store(block_lo_i, block(min_i(i0, i1)));
+    P::Store(block_lo_j, block(min_i(j0, j1)));
+    P::Store(block_hi_i, block(max_i(i0, i1)));
+    P::Store(block_hi_j, block(max_i(j0, j1)));
+    uint32_t blocks_with_gaps = 0;
     for (int lane = 0; lane < kLanes; ++lane) {
-      if (!((lanes >> lane) & 1u)) continue;
-      const auto block = [](int32_t texel) { return static_cast<uint32_t>(texel) >> kBlockShift; };
-      gaps_near |=
-          GapBlocksIn(block(std::min(ia[lane], ib[lane])), block(std::min(ja[lane], jb[lane])),
-                      block(std::max(ia[lane], ib[lane])),
-                      block(std::max(ja[lane], jb[lane]))) != 0;
+      blocks_with_gaps |= GapBlocksIn(
+          static_cast<uint32_t>(block_lo_i[lane]), static_cast<uint32_t>(block_lo_j[lane]),
+          static_cast<uint32_t>(block_hi_i[lane]), static_cast<uint32_t>(block_hi_j[lane]));
     }
+    gaps_near = blocks_with_gaps != 0;
   }
   static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
   const auto load_slabs = [&](const int32_t* at, F* top, F* bottom) {
