@@ -1303,9 +1303,12 @@ bool BodyMapCollider::ClipMotion(Float3 p0, Float3 p1, ClippedMotion* out) const
       if (a[k] < clip_lo_[k] || a[k] > clip_hi_[k]) return false;
       continue;
     }
-    double t_lo = (clip_lo_[k] - a[k]) / d[k];
-    double t_hi = (clip_hi_[k] - a[k]) / d[k];
-    if (t_lo > t_hi) std::swap(t_lo, t_hi);
+    // The planes' parameters in order along the motion (min and max, not a branch on the
+    // direction, which is data).
+    const double t_low_plane = (clip_lo_[k] - a[k]) / d[k];
+    const double t_high_plane = (clip_hi_[k] - a[k]) / d[k];
+    const double t_lo = std::min(t_low_plane, t_high_plane);
+    const double t_hi = std::max(t_low_plane, t_high_plane);
     if (t_lo > t_start) {
       t_start = t_lo;
       start_axis = k;

@@ -693,8 +693,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   if (clipped_lanes != 0) {
     alignas(32) float ends[6][kLanes];
     StoreLanes<P>(q0, q1, ends);
-    for (int lane = 0; lane < kLanes; ++lane) {
-      if (!((clipped_lanes >> lane) & 1u)) continue;
+    for (uint32_t bits = clipped_lanes; bits != 0; bits &= bits - 1u) {  // one exit to predict
+      const int lane = std::countr_zero(bits);
       ClippedMotion clip;
       if (!ClipMotion(previous[index[lane]], positions[index[lane]], &clip)) {
         flags[index[lane]] = kCollisionNone;  // misses the box: no contact, ends outside
