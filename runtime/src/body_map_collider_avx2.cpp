@@ -144,12 +144,16 @@ struct Avx2Lanes {
   }
   // Sse2Lanes::LoadSlabs on each half.
   static void LoadSlabs(const void* const* slab, F* top, F* bottom) {
-    const auto pair = [](const void* s) { return static_cast<const __m64*>(s); };
+    LoadSlabsAt([slab](int lane) { return slab[lane]; }, top, bottom);
+  }
+  template <class Address>
+  static void LoadSlabsAt(const Address& address, F* top, F* bottom) {
+    const auto pair = [&](int lane) {
+      return static_cast<const __m64*>(static_cast<const void*>(address(lane)));
+    };
     const auto half = [&](int l, __m128* half_top, __m128* half_bottom) {
-      const __m128 slabs01 =
-          _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab[l])), pair(slab[l + 1]));
-      const __m128 slabs23 =
-          _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab[l + 2])), pair(slab[l + 3]));
+      const __m128 slabs01 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(l)), pair(l + 1));
+      const __m128 slabs23 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(l + 2)), pair(l + 3));
       *half_top = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(2, 0, 2, 0));
       *half_bottom = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(3, 1, 3, 1));
     };

@@ -778,10 +778,9 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     gaps_near = blocks_with_gaps != 0;
   }
   static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
+  const Slab* const slabs = slabs_.data();
   const auto load_slabs = [&](const int32_t* at, F* top, F* bottom) {
-    const void* slab[kLanes];
-    for (int lane = 0; lane < kLanes; ++lane) slab[lane] = &slabs_[static_cast<size_t>(at[lane])];
-    P::LoadSlabs(slab, top, bottom);
+    P::LoadSlabsAt([slabs, at](int lane) { return slabs + at[lane]; }, top, bottom);
   };
   F slab_b_top, slab_b_bottom;
   load_slabs(texel_b, &slab_b_top, &slab_b_bottom);

@@ -133,11 +133,16 @@ struct Sse2Lanes {
   // The slabs (two floats, 8 bytes: top then bottom) at slab[0..3] as lanes: 8-byte loads into
   // halves and two shuffles.
   static void LoadSlabs(const void* const* slab, F* top, F* bottom) {
-    const auto pair = [](const void* s) { return static_cast<const __m64*>(s); };
-    const __m128 slabs01 =
-        _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab[0])), pair(slab[1]));
-    const __m128 slabs23 =
-        _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(slab[2])), pair(slab[3]));
+    LoadSlabsAt([slab](int lane) { return slab[lane]; }, top, bottom);
+  }
+  // LoadSlabs of lane l's slab at address(l): no array of addresses is stored and read back.
+  template <class Address>
+  static void LoadSlabsAt(const Address& address, F* top, F* bottom) {
+    const auto pair = [&](int lane) {
+      return static_cast<const __m64*>(static_cast<const void*>(address(lane)));
+    };
+    const __m128 slabs01 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(0)), pair(1));
+    const __m128 slabs23 = _mm_loadh_pi(_mm_loadl_pi(_mm_setzero_ps(), pair(2)), pair(3));
     *top = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(2, 0, 2, 0));
     *bottom = _mm_shuffle_ps(slabs01, slabs23, _MM_SHUFFLE(3, 1, 3, 1));
   }
