@@ -1469,7 +1469,7 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
     uint32_t skip_short = 0;  // groups
     // The particles waiting for the walking lanes: fewer than `width` between groups, so a group
     // adds at most `width` more.
-    uint32_t queued[16];
+    uint32_t queued[16] = {};
     uint32_t queued_count = 0;
     // Walks the first `width` queued particles (all of them, padded, for the last group).
     const auto walk_queued = [&] {
@@ -1484,7 +1484,9 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
         const uint32_t q = queued[std::countr_zero(left)];
         flags[q] = CollideOne(previous[q], &positions[q], &velocities[q], params);
       }
-      for (uint32_t i = walked; i < queued_count; ++i) queued[i - walked] = queued[i];
+      // The rest (fewer than `width`) to the front: a fixed copy, not a loop of data-dependent
+      // length (walked + 8 <= 16; entries past queued_count are never read).
+      for (uint32_t i = 0; i < 8; ++i) queued[i] = queued[walked + i];  // forward: dest <= src
       queued_count -= walked;
     };
     for (; k + width <= count; k += width) {

@@ -396,9 +396,8 @@ void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
     first[lane] = gaps_.data() + GapBaseAt(static_cast<uint32_t>(t[lane]));
   }
   for (uint32_t g = 0; g < gap_layers_; ++g) {
-    const void* gap[kLanes];
-    for (int lane = 0; lane < kLanes; ++lane) gap[lane] = first[lane] + g;
-    P::LoadSlabs(gap, &out->top[g], &out->bottom[g]);
+    P::LoadSlabsAt([&first, g](int lane) { return first[lane] + g; }, &out->top[g],
+                   &out->bottom[g]);
   }
 }
 
@@ -408,11 +407,9 @@ template <class P>
 typename P::I BodyMapCollider::NormalCodes(const size_t* texel, typename P::F use_back) const {
   static_assert(sizeof(TexelNormals) == sizeof(Slab), "LoadSlabs loads both codes as 8 bytes");
   static_assert(std::endian::native == std::endian::little, "a code's first value in the low half");
-  constexpr int kLanes = P::kCount;
-  const void* normals[kLanes];
-  for (int lane = 0; lane < kLanes; ++lane) normals[lane] = &normals_[texel[lane]];
+  const TexelNormals* const normals = normals_.data();
   typename P::F front, back;
-  P::LoadSlabs(normals, &front, &back);
+  P::LoadSlabsAt([normals, texel](int lane) { return normals + texel[lane]; }, &front, &back);
   return AsInt(SelectLanes(use_back, back, front));
 }
 
@@ -504,8 +501,6 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   // by lane just before would stall the store forwarding.)
   static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
   size_t texel_a[kLanes], texel_b[kLanes];
-  const void* slab_a[kLanes];
-  const void* slab_b[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
     // Masked, not branched on: which lanes are used is data. (Unsigned: an unused lane's
     // indices are whatever its coordinates truncated to.)
@@ -515,12 +510,13 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
         keep & (static_cast<uint32_t>(ja[lane]) * row + static_cast<uint32_t>(ia[lane]));
     texel_b[lane] =
         keep & (static_cast<uint32_t>(jb[lane]) * row + static_cast<uint32_t>(ib[lane]));
-    slab_a[lane] = &slabs_[texel_a[lane]];
-    slab_b[lane] = &slabs_[texel_b[lane]];
   }
+  const Slab* const slabs = slabs_.data();
   F slab_a_top, slab_a_bottom, slab_b_top, slab_b_bottom;
-  P::LoadSlabs(slab_a, &slab_a_top, &slab_a_bottom);
-  P::LoadSlabs(slab_b, &slab_b_top, &slab_b_bottom);
+  P::LoadSlabsAt([slabs, &texel_a](int lane) { return slabs + texel_a[lane]; }, &slab_a_top,
+                 &slab_a_bottom);
+  P::LoadSlabsAt([slabs, &texel_b](int lane) { return slabs + texel_b[lane]; }, &slab_b_top,
+                 &slab_b_bottom);
   // Groups without a lane across an edge (points, resting cloth) skip the second visit.
   const uint32_t two_lanes = LaneBits(two) & lanes;
   // The gaps of texels A and B (absent ones: -inf, +inf; B is A without a lane across an edge);
