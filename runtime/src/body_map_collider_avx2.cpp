@@ -142,10 +142,7 @@ struct Avx2Lanes {
     _mm256_storeu_ps(f + 8, _mm256_permute2f128_ps(c, a, 0x30));   // low of c, high of a
     _mm256_storeu_ps(f + 16, _mm256_permute2f128_ps(b, c, 0x31));  // high halves of b, c
   }
-  // Sse2Lanes::LoadSlabs on each half.
-  static void LoadSlabs(const void* const* slab, F* top, F* bottom) {
-    LoadSlabsAt([slab](int lane) { return slab[lane]; }, top, bottom);
-  }
+  // Sse2Lanes::LoadSlabsAt on each half.
   template <class Address>
   static void LoadSlabsAt(const Address& address, F* top, F* bottom) {
     const auto pair = [&](int lane) {

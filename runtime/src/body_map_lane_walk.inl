@@ -383,7 +383,7 @@ void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
   alignas(32) int32_t t[kLanes];
   P::Store(t, texel);
   // Each lane's gaps, or for a lane without gaps ones that hold no z (-inf, +inf): the gaps are
-  // slabs, so one LoadSlabs per layer reads them for every lane.
+  // slabs, so one LoadSlabsAt per layer reads them for every lane.
   static_assert(kMaxBodyMapLayers == 4, "one absent gap per gap layer below");
   static constexpr Slab kNoGaps[kMaxBodyMapLayers - 1] = {
       {-kInfinity, kInfinity}, {-kInfinity, kInfinity}, {-kInfinity, kInfinity}};
@@ -405,7 +405,7 @@ void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
 // chosen by the mask. Which side each lane reads is data: a branch per lane would mispredict.
 template <class P>
 typename P::I BodyMapCollider::NormalCodes(const size_t* texel, typename P::F use_back) const {
-  static_assert(sizeof(TexelNormals) == sizeof(Slab), "LoadSlabs loads both codes as 8 bytes");
+  static_assert(sizeof(TexelNormals) == sizeof(Slab), "LoadSlabsAt loads both codes as 8 bytes");
   static_assert(std::endian::native == std::endian::little, "a code's first value in the low half");
   const TexelNormals* const normals = normals_.data();
   typename P::F front, back;
@@ -499,7 +499,7 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   P::Store(jb, j1);
   // (The slab addresses are taken in the same loop: a vector read of the indices written lane
   // by lane just before would stall the store forwarding.)
-  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
+  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabsAt loads a slab as 8 bytes");
   size_t texel_a[kLanes], texel_b[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
     // Masked, not branched on: which lanes are used is data. (Unsigned: an unused lane's
@@ -773,7 +773,7 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     }
     gaps_near = blocks_with_gaps != 0;
   }
-  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabs loads a slab as 8 bytes");
+  static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabsAt loads a slab as 8 bytes");
   const Slab* const slabs = slabs_.data();
   const auto load_slabs = [&](const int32_t* at, F* top, F* bottom) {
     P::LoadSlabsAt([slabs, at](int lane) { return slabs + at[lane]; }, top, bottom);

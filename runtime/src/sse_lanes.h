@@ -130,12 +130,9 @@ struct Sse2Lanes {
     _mm_storeu_ps(f + 4, _mm_shuffle_ps(y1z1, x2y2x3y3, _MM_SHUFFLE(1, 0, 2, 0)));  // y1 z1 x2 y2
     _mm_storeu_ps(f + 8, _mm_shuffle_ps(z2x3, y3z3, _MM_SHUFFLE(2, 0, 2, 0)));      // z2 x3 y3 z3
   }
-  // The slabs (two floats, 8 bytes: top then bottom) at slab[0..3] as lanes: 8-byte loads into
-  // halves and two shuffles.
-  static void LoadSlabs(const void* const* slab, F* top, F* bottom) {
-    LoadSlabsAt([slab](int lane) { return slab[lane]; }, top, bottom);
-  }
-  // LoadSlabs of lane l's slab at address(l): no array of addresses is stored and read back.
+  // The slabs (two floats, 8 bytes: top then bottom; the normals' two codes load the same way)
+  // at address(0..3) as lanes: 8-byte loads into halves and two shuffles. A function of the lane,
+  // not an array of addresses, so that no array is stored only to be read back.
   template <class Address>
   static void LoadSlabsAt(const Address& address, F* top, F* bottom) {
     const auto pair = [&](int lane) {
