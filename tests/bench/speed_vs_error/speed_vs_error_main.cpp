@@ -11,18 +11,21 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
+#include "../replay_maps/motions_file.h"
 #include "cloth_peer_comparison.h"
 #include "drape/bake/bake_pipeline.h"
 #include "drape/bake/body_map_baker.h"
@@ -52,6 +55,7 @@ struct Options {
   uint32_t queries = 4000;
   bool quick = false;
   bool check = false;
+  bool dump_maps = false;  // --dump-maps: each rest-pose body-map setting and the mix, for replays
 };
 
 [[noreturn]] void Fail(const std::string& message) {
@@ -116,10 +120,16 @@ Options ParseOptions(int argc, char** argv) {
       o.quick = true;
     } else if (arg == "--check") {
       o.check = true;
+    } else if (arg == "--dump-maps") {
+      o.dump_maps = true;
     } else if (arg == "--help" || arg == "-h") {
       std::printf(
           "drape-speed-vs-error --out DIR [--character builtin|all|PATH]... [--queries N] "
-          "[--quick] [--check]\n");
+          "[--quick] [--check] [--dump-maps]\n"
+          "  --dump-maps  also write DIR/replay/<character>_mix.motions and, per rest-pose "
+          "body-map\n"
+          "               setting, <character>_<setting>.drape: drape-replay-maps runs them "
+          "alone\n");
       std::exit(0);
     } else {
       Fail(arg + ": unknown option (see --help)");
@@ -431,6 +441,7 @@ class Measurement {
       bake::BodyMapPoseStats stats;
       const Status baked = bake::BakeBodyMapPose(positions, triangles, o, &pose, &stats);
       if (!baked.ok()) Fail(spec.label + " maps " + Describe(m) + ": " + baked.message());
+      if (options_.dump_maps) DumpMaps(spec, m, pose, context.sets.back());
       Measure(context,
               *MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes, !m.sse2_lanes));
       const bool combo = m.sampling == DepthSampling::kBilinear && !m.fitted &&
@@ -667,6 +678,35 @@ class Measurement {
   }
 
  private:
+  // --dump-maps: the pose as an asset holding only its body maps, and (once per character) the
+  // mix's motions, for drape-replay-maps (tests/bench/replay_maps).
+  void DumpMaps(const CharacterSpec& spec, const MapSetting& m, const BodyMapPose& pose,
+                const QuerySet& mix) {
+    const std::filesystem::path dir = std::filesystem::path(options_.out_dir) / "replay";
+    std::error_code error;
+    std::filesystem::create_directories(dir, error);
+    if (error) Fail(dir.string() + ": cannot create (" + error.message() + ")");
+    const auto slug = [](std::string text) {
+      for (char& c : text) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+      return text;
+    };
+    const std::string stem = (dir / slug(spec.label)).string();
+    CharacterAsset asset;
+    asset.info.source_name = std::filesystem::path(spec.path).filename().string();
+    asset.body_maps.resolution = m.resolution;
+    asset.body_maps.epsilon = m.epsilon;
+    asset.body_maps.fitted_window = m.fitted;
+    asset.body_maps.poses.push_back(pose);
+    const std::string asset_path = stem + "_" + slug(Describe(m)) + ".drape";
+    if (const Status s = WriteAssetFile(asset_path, asset); !s.ok()) Fail(s.message());
+    const std::string motions_path = stem + "_mix.motions";
+    if (dumped_.count(motions_path) != 0) return;
+    if (const Status s = WriteFileAtomically(motions_path, EncodeMotions(mix)); !s.ok()) {
+      Fail(s.message());
+    }
+    dumped_.insert(motions_path);
+  }
+
   struct Context {
     CharacterSpec spec;
     size_t triangles = 0;
@@ -880,6 +920,7 @@ class Measurement {
   std::vector<std::string> set_violations_;
   std::vector<Section> sections_;
   std::vector<std::string> notes_;
+  std::set<std::string> dumped_;  // motions files written by DumpMaps
 };
 
 }  // namespace

@@ -1,0 +1,150 @@
+// drape-replay-maps: one baked body-map pose against one file of motions, through
+// BodyMapCollider::CollideBatch and nothing else, so that a profiler or a simulator (perf,
+// callgrind --branch-sim=yes) sees only the collider. drape-speed-vs-error --dump-maps writes
+// both inputs. Prints the best time per particle over the repetitions and a hash of every
+// output bit (positions, velocities, flags), so that two builds can be checked to agree.
+//
+//   drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--sse2] [--bilinear] [--threads N]
+//
+// Sampling and lane width are the runtime's choices, not the asset's: a dumped setting named
+// "bilinear" or "SSE2 lanes" replays as such with --bilinear or --sse2.
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "drape/formats/asset_file.h"
+#include "drape/runtime/body_map_collider.h"
+#include "motions_file.h"
+
+namespace {
+
+using namespace drape;
+
+[[noreturn]] void Fail(const std::string& message) {
+  std::fprintf(stderr, "drape-replay-maps: %s\n", message.c_str());
+  std::exit(2);
+}
+
+uint32_t ParseCount(const std::string& option, const std::string& text, uint32_t limit) {
+  char* end = nullptr;
+  const unsigned long n = std::strtoul(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || n == 0 || n > limit) {
+    Fail(option + " " + text + ": not in [1, " + std::to_string(limit) + "]");
+  }
+  return static_cast<uint32_t>(n);
+}
+
+// FNV-1a over bytes.
+uint64_t Hash(uint64_t h, const void* data, size_t size) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> paths;
+  uint32_t repetitions = 5, threads = 1;
+  bool sse2 = false, bilinear = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) Fail(arg + ": needs a value");
+      return argv[++i];
+    };
+    if (arg == "--repetitions") {
+      repetitions = ParseCount(arg, value(), 1000000);
+    } else if (arg == "--threads") {
+      threads = ParseCount(arg, value(), 256);
+    } else if (arg == "--sse2") {
+      sse2 = true;
+    } else if (arg == "--bilinear") {
+      bilinear = true;
+    } else if (arg == "--help" || arg == "-h") {
+      std::printf(
+          "drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--sse2] [--bilinear] "
+          "[--threads N]\n");
+      return 0;
+    } else if (!arg.empty() && arg[0] == '-') {
+      Fail(arg + ": unknown option (see --help)");
+    } else {
+      paths.push_back(arg);
+    }
+  }
+  if (paths.size() != 2) Fail("needs ASSET.drape and MOTIONS (see --help)");
+
+  CharacterAsset asset;
+  if (const Status s = ReadAssetFile(paths[0], &asset); !s.ok()) Fail(s.message());
+  if (asset.body_maps.poses.empty()) Fail(paths[0] + ": holds no body-map pose");
+  BodyMapCollider collider;
+  collider.AllowAvx2(!sse2);
+  if (const Status s = collider.Build(
+          asset.body_maps.poses[0], bilinear ? DepthSampling::kBilinear : DepthSampling::kNearest);
+      !s.ok()) {
+    Fail(paths[0] + ": " + s.message());
+  }
+
+  std::ifstream in(paths[1], std::ios::binary);
+  if (!in) Fail(paths[1] + ": cannot open (missing or unreadable)");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  bench::Motions motions;
+  if (const std::string why = bench::DecodeMotions(bytes, &motions); !why.empty()) {
+    Fail(paths[1] + ": " + why);
+  }
+
+  // The speed-vs-error tool's step and response (its methods.h): 60 Hz, friction 0.2, no
+  // restitution, 0.1 mm separation.
+  constexpr float kStepSeconds = 1.f / 60.f;
+  const size_t count = motions.current.size();
+  std::vector<Float3> start_velocities(count), positions(count), velocities(count);
+  for (size_t k = 0; k < count; ++k) {
+    start_velocities[k] = (motions.current[k] - motions.previous[k]) * (1.f / kStepSeconds);
+  }
+  std::vector<uint8_t> flags(count);
+  ResponseParams params;
+  params.friction = 0.2f;
+  params.restitution = 0.f;
+  params.separation = 1e-4f;
+  omp_set_num_threads(static_cast<int>(threads));
+  double best = std::numeric_limits<double>::infinity();
+  uint64_t hash = 1469598103934665603ull;
+  for (uint32_t r = 0; r <= repetitions; ++r) {  // the first run warms caches, not counted
+    positions = motions.current;
+    velocities = start_velocities;
+    const auto begin = std::chrono::steady_clock::now();
+    if (const Status s =
+            collider.CollideBatch(motions.previous, positions, velocities, flags, params);
+        !s.ok()) {
+      Fail(s.message());
+    }
+    const auto end = std::chrono::steady_clock::now();
+    if (r > 0) best = std::min(best, std::chrono::duration<double, std::nano>(end - begin).count());
+    if (r == 0) {
+      hash = Hash(hash, positions.data(), count * sizeof(Float3));
+      hash = Hash(hash, velocities.data(), count * sizeof(Float3));
+      hash = Hash(hash, flags.data(), count);
+    }
+  }
+  size_t contacts = 0;
+  for (uint8_t f : flags) contacts += (f & kCollisionContact) != 0;
+  std::printf(
+      "%zu motions, %zu contacts, %.2f ns per particle (best of %u, %s lanes, %u thread%s), "
+      "output hash %016llx\n",
+      count, contacts, best / static_cast<double>(count), repetitions,
+      bilinear                        ? "no"
+      : sse2 || !collider.uses_avx2() ? "SSE2"
+                                      : "AVX2",
+      threads, threads == 1 ? "" : "s", static_cast<unsigned long long>(hash));
+  return 0;
+}
