@@ -497,8 +497,8 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   P::Store(ja, j0);
   P::Store(ib, i1);
   P::Store(jb, j1);
-  // (The slab addresses are taken in the same loop: a vector read of the indices written lane
-  // by lane just before would stall the store forwarding.)
+  // (The indices are formed lane by lane and the slabs read at them lane by lane: a vector read
+  // of indices just written lane by lane would stall the store forwarding.)
   static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabsAt loads a slab as 8 bytes");
   size_t texel_a[kLanes], texel_b[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) {
