@@ -70,10 +70,11 @@ inline __m256i Less(__m256i a, __m256i b) { return _mm256_cmpgt_epi32(b, a); }
 inline __m256i Greater(__m256i a, __m256i b) { return _mm256_cmpgt_epi32(a, b); }
 inline __m256i Equal(__m256i a, __m256i b) { return _mm256_cmpeq_epi32(a, b); }
 inline __m256i High16(__m256i a) { return _mm256_srli_epi32(a, 16); }  // logical shift: 0 .. 65535
+// Shifted right by kBits, zeros shifted in.
 template <int kBits>
 inline __m256i ShiftRight(__m256i a) {
   return _mm256_srli_epi32(a, kBits);
-}  // logical
+}
 inline __m256i Abs(__m256i x) { return _mm256_abs_epi32(x); }  // INT32_MIN stays, as in SSE2
 
 inline __m256i TruncateToInt(__m256 a) { return _mm256_cvttps_epi32(a); }
