@@ -5,6 +5,10 @@
 // output bit (positions, velocities, flags), so that two builds can be checked to agree.
 //
 //   drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--sse2] [--bilinear] [--threads N]
+//                     [--check]
+//
+// --check also answers the motions with the other lane width and one by one (Query, then
+// ApplyResponse), and exits 1 unless every way gives the same bits.
 //
 // Sampling and lane width are the runtime's choices, not the asset's: a dumped setting named
 // "bilinear" or "SSE2 lanes" replays as such with --bilinear or --sse2.
@@ -51,12 +55,21 @@ uint64_t Hash(uint64_t h, const void* data, size_t size) {
   return h;
 }
 
+// Every output bit of one pass: positions, velocities, flags.
+uint64_t HashOutputs(const std::vector<Float3>& positions, const std::vector<Float3>& velocities,
+                     const std::vector<uint8_t>& flags) {
+  uint64_t h = 1469598103934665603ull;
+  h = Hash(h, positions.data(), positions.size() * sizeof(Float3));
+  h = Hash(h, velocities.data(), velocities.size() * sizeof(Float3));
+  return Hash(h, flags.data(), flags.size());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> paths;
   uint32_t repetitions = 5, threads = 1;
-  bool sse2 = false, bilinear = false;
+  bool sse2 = false, bilinear = false, check = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const auto value = [&]() -> std::string {
@@ -71,10 +84,12 @@ int main(int argc, char** argv) {
       sse2 = true;
     } else if (arg == "--bilinear") {
       bilinear = true;
+    } else if (arg == "--check") {
+      check = true;
     } else if (arg == "--help" || arg == "-h") {
       std::printf(
           "drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--sse2] [--bilinear] "
-          "[--threads N]\n");
+          "[--threads N] [--check]\n");
       return 0;
     } else if (!arg.empty() && arg[0] == '-') {
       Fail(arg + ": unknown option (see --help)");
@@ -103,22 +118,17 @@ int main(int argc, char** argv) {
     Fail(paths[1] + ": " + why);
   }
 
-  // The speed-vs-error tool's step and response (its methods.h): 60 Hz, friction 0.2, no
-  // restitution, 0.1 mm separation.
-  constexpr float kStepSeconds = 1.f / 60.f;
+  // The step and the response the motions were measured with (the file holds them).
   const size_t count = motions.current.size();
   std::vector<Float3> start_velocities(count), positions(count), velocities(count);
   for (size_t k = 0; k < count; ++k) {
-    start_velocities[k] = (motions.current[k] - motions.previous[k]) * (1.f / kStepSeconds);
+    start_velocities[k] = (motions.current[k] - motions.previous[k]) * (1.f / motions.step_seconds);
   }
   std::vector<uint8_t> flags(count);
-  ResponseParams params;
-  params.friction = 0.2f;
-  params.restitution = 0.f;
-  params.separation = 1e-4f;
+  const ResponseParams params = motions.response;
   omp_set_num_threads(static_cast<int>(threads));
   double best = std::numeric_limits<double>::infinity();
-  uint64_t hash = 1469598103934665603ull;
+  uint64_t hash = 0;
   for (uint32_t r = 0; r <= repetitions; ++r) {  // the first run warms caches, not counted
     positions = motions.current;
     velocities = start_velocities;
@@ -130,11 +140,7 @@ int main(int argc, char** argv) {
     }
     const auto end = std::chrono::steady_clock::now();
     if (r > 0) best = std::min(best, std::chrono::duration<double, std::nano>(end - begin).count());
-    if (r == 0) {
-      hash = Hash(hash, positions.data(), count * sizeof(Float3));
-      hash = Hash(hash, velocities.data(), count * sizeof(Float3));
-      hash = Hash(hash, flags.data(), count);
-    }
+    if (r == 0) hash = HashOutputs(positions, velocities, flags);
   }
   size_t contacts = 0;
   for (uint8_t f : flags) contacts += (f & kCollisionContact) != 0;
@@ -146,5 +152,44 @@ int main(int argc, char** argv) {
       : sse2 || !collider.uses_avx2() ? "SSE2"
                                       : "AVX2",
       threads, threads == 1 ? "" : "s", static_cast<unsigned long long>(hash));
+  if (!check) return 0;
+
+  // The same motions the other ways: the other lane width, and one by one.
+  uint64_t other_width = hash;
+  if (!bilinear) {
+    BodyMapCollider other;
+    other.AllowAvx2(sse2);  // the width not timed above (SSE2 again on a CPU without AVX2)
+    if (const Status s = other.Build(asset.body_maps.poses[0], DepthSampling::kNearest); !s.ok()) {
+      Fail(paths[0] + ": " + s.message());
+    }
+    positions = motions.current;
+    velocities = start_velocities;
+    if (const Status s = other.CollideBatch(motions.previous, positions, velocities, flags, params);
+        !s.ok()) {
+      Fail(s.message());
+    }
+    other_width = HashOutputs(positions, velocities, flags);
+  }
+  positions = motions.current;
+  velocities = start_velocities;
+  for (size_t k = 0; k < count; ++k) {
+    if (!IsFinite(motions.previous[k]) || !IsFinite(positions[k]) || !IsFinite(velocities[k])) {
+      flags[k] = kCollisionInvalidInput;
+      continue;
+    }
+    const ContactQuery c = collider.Query(motions.previous[k], positions[k]);
+    flags[k] = c.contact ? static_cast<uint8_t>(kCollisionContact | c.flags)
+                         : static_cast<uint8_t>(kCollisionNone);
+    if (c.contact) ApplyResponse(c, params, &positions[k], &velocities[k]);
+  }
+  const uint64_t one_by_one = HashOutputs(positions, velocities, flags);
+  std::printf("check: other lane width %016llx, one by one %016llx\n",
+              static_cast<unsigned long long>(other_width),
+              static_cast<unsigned long long>(one_by_one));
+  if (other_width != hash || one_by_one != hash) {
+    std::fprintf(stderr, "drape-replay-maps: %s: the answers differ between the ways\n",
+                 paths[0].c_str());
+    return 1;
+  }
   return 0;
 }

@@ -18,7 +18,6 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
-#include <set>
 #include <sstream>
 #include <string>
 #include <unordered_map>
@@ -433,6 +432,8 @@ class Measurement {
     const bake::MeshReference reference(positions, triangles);
     Context context = MakeContext(spec, positions, triangles, reference);
 
+    if (options_.dump_maps) DumpMix(spec, context.sets.back());
+
     // Paper A: body maps of the rest pose.
     std::unique_ptr<Method> default_maps;
     for (const MapSetting& m : MapSweep(options_.quick)) {
@@ -441,7 +442,7 @@ class Measurement {
       bake::BodyMapPoseStats stats;
       const Status baked = bake::BakeBodyMapPose(positions, triangles, o, &pose, &stats);
       if (!baked.ok()) Fail(spec.label + " maps " + Describe(m) + ": " + baked.message());
-      if (options_.dump_maps) DumpMaps(spec, m, pose, context.sets.back());
+      if (options_.dump_maps) DumpMaps(spec, m, pose);
       Measure(context,
               *MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes, !m.sse2_lanes));
       const bool combo = m.sampling == DepthSampling::kBilinear && !m.fitted &&
@@ -678,33 +679,37 @@ class Measurement {
   }
 
  private:
-  // --dump-maps: the pose as an asset holding only its body maps, and (once per character) the
-  // mix's motions, for drape-replay-maps (tests/bench/replay_maps).
-  void DumpMaps(const CharacterSpec& spec, const MapSetting& m, const BodyMapPose& pose,
-                const QuerySet& mix) {
+  // --dump-maps: DIR/replay/<character>_..., the directory made on first use.
+  std::string ReplayStem(const CharacterSpec& spec) const {
     const std::filesystem::path dir = std::filesystem::path(options_.out_dir) / "replay";
     std::error_code error;
     std::filesystem::create_directories(dir, error);
     if (error) Fail(dir.string() + ": cannot create (" + error.message() + ")");
-    const auto slug = [](std::string text) {
-      for (char& c : text) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-      return text;
-    };
-    const std::string stem = (dir / slug(spec.label)).string();
+    return (dir / Slug(spec.label)).string();
+  }
+  // The mix's motions with the step and response every method is timed with.
+  void DumpMix(const CharacterSpec& spec, const QuerySet& mix) const {
+    const std::string path = ReplayStem(spec) + "_mix.motions";
+    if (const Status s =
+            WriteFileAtomically(path, EncodeMotions(mix, kStepSeconds, BenchResponse()));
+        !s.ok()) {
+      Fail(s.message());
+    }
+  }
+  // One rest-pose setting's pose, as an asset holding only its body maps.
+  void DumpMaps(const CharacterSpec& spec, const MapSetting& m, const BodyMapPose& pose) const {
     CharacterAsset asset;
     asset.info.source_name = std::filesystem::path(spec.path).filename().string();
     asset.body_maps.resolution = m.resolution;
     asset.body_maps.epsilon = m.epsilon;
     asset.body_maps.fitted_window = m.fitted;
     asset.body_maps.poses.push_back(pose);
-    const std::string asset_path = stem + "_" + slug(Describe(m)) + ".drape";
-    if (const Status s = WriteAssetFile(asset_path, asset); !s.ok()) Fail(s.message());
-    const std::string motions_path = stem + "_mix.motions";
-    if (dumped_.count(motions_path) != 0) return;
-    if (const Status s = WriteFileAtomically(motions_path, EncodeMotions(mix)); !s.ok()) {
-      Fail(s.message());
-    }
-    dumped_.insert(motions_path);
+    const std::string path = ReplayStem(spec) + "_" + Slug(Describe(m)) + ".drape";
+    if (const Status s = WriteAssetFile(path, asset); !s.ok()) Fail(s.message());
+  }
+  static std::string Slug(std::string text) {  // letters and digits kept, the rest '_'
+    for (char& c : text) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    return text;
   }
 
   struct Context {
@@ -920,7 +925,6 @@ class Measurement {
   std::vector<std::string> set_violations_;
   std::vector<Section> sections_;
   std::vector<std::string> notes_;
-  std::set<std::string> dumped_;  // motions files written by DumpMaps
 };
 
 }  // namespace
