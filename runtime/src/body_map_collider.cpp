@@ -1012,6 +1012,14 @@ void BodyMapCollider::Finish() {
 
 bool BodyMapCollider::uses_avx2() const { return allow_avx2_ && detail::CpuHasAvx2(); }
 
+bool BodyMapCollider::uses_avx512() const {
+  return allow_avx512_ && uses_avx2() && detail::CpuHasAvx512();
+}
+
+BodyMapCollider::LaneKernel BodyMapCollider::lane_kernel() const {
+  return uses_avx512() ? LaneKernel::kAvx512 : uses_avx2() ? LaneKernel::kAvx2 : LaneKernel::kSse2;
+}
+
 size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
@@ -1459,13 +1467,21 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
   if (sampling_ == DepthSampling::kNearest && stats_.valid_texels != 0) {
     // Groups of consecutive particles go through the short-motion lanes first; the particles
     // they do not answer queue for the walking lanes, and what those do not answer goes one by
-    // one. Eight lanes in AVX2 when the CPU has it, else four: the same bits. Where particles
-    // move a texel or more per step the short lanes answer few and their work is wasted: after a
-    // group with half or more of its motions across more than one texel edge, the next
-    // kScalarParticles particles queue directly. Every path gives the same bits.
+    // one. Eight lanes in AVX2 (or AVX2 with AVX-512) when the CPU has it, else four: the same
+    // bits. Where particles move a texel or more per step the short lanes answer few and their work
+    // is wasted: after a group with half or more of its motions across more than one texel edge,
+    // the next kScalarParticles particles queue directly. Every path gives the same bits.
     constexpr uint32_t kScalarParticles = 16;
-    const bool eight_lanes = uses_avx2();
-    const uint32_t width = eight_lanes ? 8u : 4u;
+    const LaneKernel kernel = lane_kernel();
+    const uint32_t width = kernel == LaneKernel::kSse2 ? 4u : 8u;
+    const auto short_lanes =
+        kernel == LaneKernel::kAvx512 ? &BodyMapCollider::CollideEightShortMotionsAvx512
+        : kernel == LaneKernel::kAvx2 ? &BodyMapCollider::CollideEightShortMotionsAvx2
+                                      : &BodyMapCollider::CollideFourShortMotions;
+    const auto walk_lanes = kernel == LaneKernel::kAvx512
+                                ? &BodyMapCollider::CollideEightWalksAvx512
+                            : kernel == LaneKernel::kAvx2 ? &BodyMapCollider::CollideEightWalksAvx2
+                                                          : &BodyMapCollider::CollideFourWalks;
     uint32_t skip_short = 0;  // groups
     // The particles waiting for the walking lanes: fewer than `width` between groups, so a group
     // adds at most `width` more.
@@ -1477,9 +1493,7 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
       for (uint32_t lane = walked; lane < width; ++lane) queued[lane] = queued[0];
       const uint32_t lanes = (1u << walked) - 1u;
       const uint32_t answered =
-          eight_lanes
-              ? CollideEightWalks(queued, lanes, previous, positions, velocities, flags, params)
-              : CollideFourWalks(queued, lanes, previous, positions, velocities, flags, params);
+          (this->*walk_lanes)(queued, lanes, previous, positions, velocities, flags, params);
       for (uint32_t left = lanes & ~answered; left != 0; left &= left - 1u) {
         const uint32_t q = queued[std::countr_zero(left)];
         flags[q] = CollideOne(previous[q], &positions[q], &velocities[q], params);
@@ -1494,11 +1508,8 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
       if (skip_short > 0) {
         --skip_short;
       } else {
-        answered = eight_lanes
-                       ? CollideEightShortMotions(previous + k, positions + k, velocities + k,
-                                                  flags + k, params, &long_motions)
-                       : CollideFourShortMotions(previous + k, positions + k, velocities + k,
-                                                 flags + k, params, &long_motions);
+        answered = (this->*short_lanes)(previous + k, positions + k, velocities + k, flags + k,
+                                        params, &long_motions);
         if (2 * CountLaneBits(long_motions) >= width) {
           skip_short = kScalarParticles / width;
         }

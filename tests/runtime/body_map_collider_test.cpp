@@ -21,6 +21,16 @@
 
 namespace drape {
 
+// The lanes CollideBatch can take with kNearest (BodyMapCollider::LaneKernel): four in SSE2,
+// eight in AVX2, eight in AVX2 with AVX-512.
+enum class TestLanes { kSse2, kAvx2, kAvx512 };
+constexpr TestLanes kEveryLanes[] = {TestLanes::kSse2, TestLanes::kAvx2, TestLanes::kAvx512};
+const char* LanesName(TestLanes lanes) {
+  return lanes == TestLanes::kSse2   ? "four SSE2 lanes"
+         : lanes == TestLanes::kAvx2 ? "eight AVX2 lanes"
+                                     : "eight AVX-512 lanes";
+}
+
 // Reaches the collider's general path (clip and walk), which Query skips for motions that stay
 // in one texel or clearly pass through air.
 struct BodyMapColliderTestAccess {
@@ -36,25 +46,38 @@ struct BodyMapColliderTestAccess {
   static bool ClearlyFree(const BodyMapCollider& c, Float3 p0, Float3 p1) {
     return c.ClearlyFree(p0, p1, c.ToTexels(p0, p1));
   }
+  // Sets c (and so CollideBatch) to take `lanes`; false, with c unchanged, where the CPU lacks
+  // them (a test skips those).
+  static bool UseLanes(BodyMapCollider* c, TestLanes lanes) {
+    BodyMapCollider probe;
+    probe.AllowAvx2(lanes != TestLanes::kSse2);
+    probe.AllowAvx512(lanes == TestLanes::kAvx512);
+    if (static_cast<int>(probe.lane_kernel()) != static_cast<int>(lanes)) return false;
+    c->AllowAvx2(lanes != TestLanes::kSse2);
+    c->AllowAvx512(lanes == TestLanes::kAvx512);
+    return true;
+  }
+  static int LaneWidth(TestLanes lanes) { return lanes == TestLanes::kSse2 ? 4 : 8; }
 #if defined(__SSE2__)
-  // CollideBatch's short-motion lanes alone, `width` (4 or 8) of them (which lanes they answer
-  // is not visible through the batch).
-  static uint32_t CollideShort(const BodyMapCollider& c, int width, const Float3* previous,
+  // CollideBatch's short-motion lanes alone, those `lanes` (which lanes they answer is not visible
+  // through the batch). Call only where UseLanes gave true.
+  static uint32_t CollideShort(const BodyMapCollider& c, TestLanes lanes, const Float3* previous,
                                Float3* positions, Float3* velocities, uint8_t* flags,
                                const ResponseParams& params, uint32_t* long_motions) {
-    return width == 8 ? c.CollideEightShortMotions(previous, positions, velocities, flags, params,
-                                                   long_motions)
-                      : c.CollideFourShortMotions(previous, positions, velocities, flags, params,
-                                                  long_motions);
+    const auto short_lanes =
+        lanes == TestLanes::kAvx512 ? &BodyMapCollider::CollideEightShortMotionsAvx512
+        : lanes == TestLanes::kAvx2 ? &BodyMapCollider::CollideEightShortMotionsAvx2
+                                    : &BodyMapCollider::CollideFourShortMotions;
+    return (c.*short_lanes)(previous, positions, velocities, flags, params, long_motions);
   }
-  // CollideBatch's walking lanes alone, `width` (4 or 8) of them, on particles index[l] for l in
-  // `lanes`.
-  static uint32_t CollideWalks(const BodyMapCollider& c, int width, const uint32_t* index,
-                               uint32_t lanes, const Float3* previous, Float3* positions,
+  // CollideBatch's walking lanes alone, on particles index[l] for l in the mask `lanes_in_use`.
+  static uint32_t CollideWalks(const BodyMapCollider& c, TestLanes lanes, const uint32_t* index,
+                               uint32_t lanes_in_use, const Float3* previous, Float3* positions,
                                Float3* velocities, uint8_t* flags, const ResponseParams& params) {
-    return width == 8
-               ? c.CollideEightWalks(index, lanes, previous, positions, velocities, flags, params)
-               : c.CollideFourWalks(index, lanes, previous, positions, velocities, flags, params);
+    const auto walk_lanes = lanes == TestLanes::kAvx512 ? &BodyMapCollider::CollideEightWalksAvx512
+                            : lanes == TestLanes::kAvx2 ? &BodyMapCollider::CollideEightWalksAvx2
+                                                        : &BodyMapCollider::CollideFourWalks;
+    return (c.*walk_lanes)(index, lanes_in_use, previous, positions, velocities, flags, params);
   }
 #endif
 };
@@ -1571,7 +1594,7 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
   EXPECT_TRUE(blended.IsInside({-0.05f, 0.01f, 0.115f}));
 
   // The batch's lanes find a blend's gap texels as Query does (the blend refreshes the per-texel
-  // gap bits they test): motions in and across the plates, bit for bit, in both lane widths.
+  // gap bits they test): motions in and across the plates, bit for bit, on every lane path.
   constexpr size_t kCount = 4000;
   std::mt19937 rng(20261123u);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
@@ -1593,9 +1616,9 @@ TEST(BodyMapGaps, SequenceBlendsGapsWhereBothPosesHaveThem) {
         return q.contact && q.normal.z < 0.f && q.point.z > 0.f && q.point.z < 0.11f;
       });
   EXPECT_GT(gap_contacts, kCount / 50);
-  for (bool avx2 : {true, false}) {
-    SCOPED_TRACE(::testing::Message() << "AVX2 allowed: " << avx2);
-    scratch.AllowAvx2(avx2);  // (scratch is the blend)
+  for (TestLanes lanes : kEveryLanes) {
+    if (!BodyMapColliderTestAccess::UseLanes(&scratch, lanes)) continue;  // (scratch is the blend)
+    SCOPED_TRACE(LanesName(lanes));
     std::vector<Float3> got_positions = positions, got_velocities = velocities;
     std::vector<uint8_t> got_flags(kCount);
     ASSERT_TRUE(
@@ -1732,9 +1755,9 @@ TEST(BodyMapBatch, LongWalksThroughBlockEdgeCornersAnswerAsQuery) {
     const size_t contacts = std::count_if(want.queries.begin(), want.queries.end(),
                                           [](const ContactQuery& q) { return q.contact; });
     EXPECT_GT(contacts, kCount / 10);
-    for (bool avx2 : {true, false}) {  // eight walking lanes (where the CPU has AVX2), four
-      SCOPED_TRACE(::testing::Message() << "AVX2 allowed: " << avx2);
-      c.AllowAvx2(avx2);
+    for (TestLanes lanes : kEveryLanes) {  // each the CPU has
+      if (!BodyMapColliderTestAccess::UseLanes(&c, lanes)) continue;
+      SCOPED_TRACE(LanesName(lanes));
       std::vector<Float3> got_positions = positions, got_velocities = velocities;
       std::vector<uint8_t> got_flags(kCount);
       ASSERT_TRUE(c.CollideBatch(previous, got_positions, got_velocities, got_flags, params).ok());
@@ -1767,7 +1790,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   size_t walked_clipped_entries = 0, walked_z_face = 0, walked_long = 0;  // walking lanes
   size_t walked_gap_contacts = 0, walked_gap_starts = 0;
   size_t steep_short = 0, steep_walked = 0;  // from a gap through the start texel's whole slab
-  size_t eight_lanes_answered = 0;
+  size_t eight_lanes_answered[3] = {};       // by TestLanes: AVX2, AVX-512
   for (int body = 0; body < 4; ++body) {
     SCOPED_TRACE(::testing::Message() << "body " << body);
     BodyMapCollider& c = bodies[body];
@@ -1912,11 +1935,11 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
       ++want_contacts;
     }
     EXPECT_GT(want_contacts, kCount / 10);
-    for (int run = 0; run < 4; ++run) {  // 1 and 2 threads; eight walking lanes, and four
+    for (int run = 0; run < 6; ++run) {  // 1 and 2 threads; each lane path the CPU has
       const int threads = 1 + run % 2;
-      const bool avx2 = run < 2;
-      SCOPED_TRACE(::testing::Message() << threads << " thread(s), AVX2 allowed: " << avx2);
-      c.AllowAvx2(avx2);
+      const TestLanes lanes = kEveryLanes[run / 2];
+      if (!BodyMapColliderTestAccess::UseLanes(&c, lanes)) continue;
+      SCOPED_TRACE(::testing::Message() << threads << " thread(s), " << LanesName(lanes));
       const int saved_threads = omp_get_max_threads();
       omp_set_num_threads(threads);
       std::vector<Float3> got_positions = positions, got_velocities = velocities;
@@ -1954,21 +1977,21 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
     std::vector<Float3> scratch_positions = positions, scratch_velocities = velocities;
     std::vector<uint8_t> scratch_flags(kCount);
     std::vector<uint32_t> four_answered, four_long;
-    c.AllowAvx2(true);
-    for (int width : {4, 8}) {
-      if (width == 8 && !c.uses_avx2()) {
-        std::printf("this CPU has no AVX2: the eight short-motion lanes are not tested\n");
+    for (TestLanes kind : kEveryLanes) {
+      if (!BodyMapColliderTestAccess::UseLanes(&c, kind)) {
+        std::printf("this CPU lacks the %s: their short motions are not tested\n", LanesName(kind));
         continue;
       }
-      SCOPED_TRACE(::testing::Message() << width << " short-motion lanes");
+      const int width = BodyMapColliderTestAccess::LaneWidth(kind);
+      SCOPED_TRACE(::testing::Message() << LanesName(kind) << ", short motions");
       scratch_positions = positions;
       scratch_velocities = velocities;
       for (size_t k = 0; k + static_cast<size_t>(width) <= kCount;
            k += static_cast<size_t>(width)) {
         uint32_t long_motions = 0;
         const uint32_t lanes = BodyMapColliderTestAccess::CollideShort(
-            c, width, &previous[k], &scratch_positions[k], &scratch_velocities[k],
-            &scratch_flags[k], params, &long_motions);
+            c, kind, &previous[k], &scratch_positions[k], &scratch_velocities[k], &scratch_flags[k],
+            params, &long_motions);
         if (width == 4) {
           four_answered.push_back(lanes);
           four_long.push_back(long_motions);
@@ -2013,12 +2036,13 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
     // spread over the set (and on partial groups): every lane they answer is the reference bit
     // for bit, and lanes they do not answer (or that are not in the mask) are untouched. The
     // counts below are of the four lanes.
-    for (int width : {4, 8}) {
-      if (width == 8 && !c.uses_avx2()) {
-        std::printf("this CPU has no AVX2: the eight walking lanes are not tested\n");
+    for (TestLanes kind : kEveryLanes) {
+      if (!BodyMapColliderTestAccess::UseLanes(&c, kind)) {
+        std::printf("this CPU lacks the %s: their walks are not tested\n", LanesName(kind));
         continue;
       }
-      SCOPED_TRACE(::testing::Message() << width << " walking lanes");
+      const int width = BodyMapColliderTestAccess::LaneWidth(kind);
+      SCOPED_TRACE(::testing::Message() << LanesName(kind) << ", walks");
       const bool count = width == 4;
       scratch_positions = positions;
       scratch_velocities = velocities;
@@ -2032,7 +2056,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
         const uint32_t mask =
             k % 7 == 3 ? 0x5u : (k % 7 == 5 ? 0x2u : (k % 7 == 6 ? 0xa6u & all : all));
         const uint32_t lanes = BodyMapColliderTestAccess::CollideWalks(
-            c, width, index, mask, previous.data(), scratch_positions.data(),
+            c, kind, index, mask, previous.data(), scratch_positions.data(),
             scratch_velocities.data(), scratch_flags.data(), params);
         ASSERT_EQ(lanes & ~mask, 0u);
         for (int lane = 0; lane < width; ++lane) {
@@ -2091,7 +2115,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
           scratch_flags[q] = 0xee;
         }
       }
-      (count ? walked_answered : eight_lanes_answered) += answered_here;
+      (count ? walked_answered : eight_lanes_answered[static_cast<int>(kind)]) += answered_here;
     }
 #endif
   }
@@ -2119,8 +2143,10 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   EXPECT_GT(walked_gap_contacts, 500u);
   EXPECT_GT(walked_gap_starts, 100u);
   // Eight lanes answer about as many as four: the walks they give up on are the same.
-  if (bodies[0].uses_avx2()) {
-    EXPECT_GT(eight_lanes_answered, 300000u);
+  for (TestLanes kind : {TestLanes::kAvx2, TestLanes::kAvx512}) {
+    if (BodyMapColliderTestAccess::UseLanes(&bodies[0], kind)) {
+      EXPECT_GT(eight_lanes_answered[static_cast<int>(kind)], 300000u) << LanesName(kind);
+    }
   }
   std::printf("short-motion lanes: %zu contacts at texels with gaps, %zu of them pushed out\n",
               answered_gap_contacts, answered_gap_inside);
@@ -2129,9 +2155,10 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   std::printf(
       "walking lanes: %zu answered, %zu walls, %zu entries (%zu clipped, %zu through the "
       "box's z face), %zu pushed out, %zu contacts >= 3 texels away, %zu at texels with gaps, "
-      "%zu starts in a gap; eight lanes: %zu answered\n",
+      "%zu starts in a gap; eight lanes: %zu answered (AVX2), %zu (AVX-512)\n",
       walked_answered, walked_walls, walked_entries, walked_clipped_entries, walked_z_face,
-      walked_inside, walked_long, walked_gap_contacts, walked_gap_starts, eight_lanes_answered);
+      walked_inside, walked_long, walked_gap_contacts, walked_gap_starts, eight_lanes_answered[1],
+      eight_lanes_answered[2]);
 #endif
 }
 

@@ -4,14 +4,16 @@
 // both inputs. Prints the best time per particle over the repetitions and a hash of every
 // output bit (positions, velocities, flags), so that two builds can be checked to agree.
 //
-//   drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--sse2] [--bilinear] [--threads N]
-//                     [--check]
+//   drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--lanes sse2|avx2|avx512]
+//                     [--bilinear] [--threads N] [--check]
 //
-// --check also answers the motions with the other lane width and one by one (Query, then
-// ApplyResponse), and exits 1 unless every way gives the same bits.
+// --lanes caps the batch's lanes (BodyMapCollider::AllowAvx2, AllowAvx512); by default they are
+// the widest the CPU has. --check also answers the motions with every other lane path the CPU
+// has and one by one (Query, then ApplyResponse), and exits 1 unless every way gives the same
+// bits.
 //
-// Sampling and lane width are the runtime's choices, not the asset's: a dumped setting named
-// "bilinear" or "SSE2 lanes" replays as such with --bilinear or --sse2.
+// Sampling and lanes are the runtime's choices, not the asset's: a dumped setting named
+// "bilinear" or "SSE2 lanes" replays as such with --bilinear or --lanes sse2.
 
 #include <omp.h>
 
@@ -37,6 +39,20 @@ using namespace drape;
 [[noreturn]] void Fail(const std::string& message) {
   std::fprintf(stderr, "drape-replay-maps: %s\n", message.c_str());
   std::exit(2);
+}
+
+// The lanes a collider may take, capped at `lanes` ("sse2", "avx2", "avx512").
+void CapLanes(BodyMapCollider* collider, const std::string& lanes) {
+  collider->AllowAvx2(lanes != "sse2");
+  collider->AllowAvx512(lanes == "avx512");
+}
+
+// What the batch of `collider` takes.
+const char* LanesName(const BodyMapCollider& collider, bool bilinear) {
+  return bilinear                 ? "no"
+         : collider.uses_avx512() ? "eight AVX-512"
+         : collider.uses_avx2()   ? "eight AVX2"
+                                  : "four SSE2";
 }
 
 uint32_t ParseCount(const std::string& option, const std::string& text, uint32_t limit) {
@@ -69,7 +85,8 @@ uint64_t HashOutputs(const std::vector<Float3>& positions, const std::vector<Flo
 int main(int argc, char** argv) {
   std::vector<std::string> paths;
   uint32_t repetitions = 5, threads = 1;
-  bool sse2 = false, bilinear = false, check = false;
+  std::string lanes = "avx512";
+  bool bilinear = false, check = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const auto value = [&]() -> std::string {
@@ -80,16 +97,19 @@ int main(int argc, char** argv) {
       repetitions = ParseCount(arg, value(), 1000000);
     } else if (arg == "--threads") {
       threads = ParseCount(arg, value(), 256);
-    } else if (arg == "--sse2") {
-      sse2 = true;
+    } else if (arg == "--lanes") {
+      lanes = value();
+      if (lanes != "sse2" && lanes != "avx2" && lanes != "avx512") {
+        Fail("--lanes " + lanes + ": not sse2, avx2 or avx512");
+      }
     } else if (arg == "--bilinear") {
       bilinear = true;
     } else if (arg == "--check") {
       check = true;
     } else if (arg == "--help" || arg == "-h") {
       std::printf(
-          "drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--sse2] [--bilinear] "
-          "[--threads N] [--check]\n");
+          "drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--lanes sse2|avx2|avx512] "
+          "[--bilinear] [--threads N] [--check]\n");
       return 0;
     } else if (!arg.empty() && arg[0] == '-') {
       Fail(arg + ": unknown option (see --help)");
@@ -103,7 +123,7 @@ int main(int argc, char** argv) {
   if (const Status s = ReadAssetFile(paths[0], &asset); !s.ok()) Fail(s.message());
   if (asset.body_maps.poses.empty()) Fail(paths[0] + ": holds no body-map pose");
   BodyMapCollider collider;
-  collider.AllowAvx2(!sse2);
+  CapLanes(&collider, lanes);
   if (const Status s = collider.Build(
           asset.body_maps.poses[0], bilinear ? DepthSampling::kBilinear : DepthSampling::kNearest);
       !s.ok()) {
@@ -148,17 +168,16 @@ int main(int argc, char** argv) {
       "%zu motions, %zu contacts, %.2f ns per particle (best of %u, %s lanes, %u thread%s), "
       "output hash %016llx\n",
       count, contacts, best / static_cast<double>(count), repetitions,
-      bilinear                        ? "no"
-      : sse2 || !collider.uses_avx2() ? "SSE2"
-                                      : "AVX2",
-      threads, threads == 1 ? "" : "s", static_cast<unsigned long long>(hash));
+      LanesName(collider, bilinear), threads, threads == 1 ? "" : "s",
+      static_cast<unsigned long long>(hash));
   if (!check) return 0;
 
-  // The same motions the other ways: the other lane width, and one by one.
-  uint64_t other_width = hash;
-  if (!bilinear) {
+  // The same motions the other ways: every lane path the CPU has, and one by one.
+  bool agree = true;
+  for (const char* other_lanes : {"sse2", "avx2", "avx512"}) {
+    if (bilinear) break;
     BodyMapCollider other;
-    other.AllowAvx2(sse2);  // the width not timed above (SSE2 again on a CPU without AVX2)
+    CapLanes(&other, other_lanes);
     if (const Status s = other.Build(asset.body_maps.poses[0], DepthSampling::kNearest); !s.ok()) {
       Fail(paths[0] + ": " + s.message());
     }
@@ -168,7 +187,10 @@ int main(int argc, char** argv) {
         !s.ok()) {
       Fail(s.message());
     }
-    other_width = HashOutputs(positions, velocities, flags);
+    const uint64_t other_hash = HashOutputs(positions, velocities, flags);
+    std::printf("check: %s lanes %016llx\n", LanesName(other, false),
+                static_cast<unsigned long long>(other_hash));
+    agree = agree && other_hash == hash;
   }
   positions = motions.current;
   velocities = start_velocities;
@@ -183,10 +205,8 @@ int main(int argc, char** argv) {
     if (c.contact) ApplyResponse(c, params, &positions[k], &velocities[k]);
   }
   const uint64_t one_by_one = HashOutputs(positions, velocities, flags);
-  std::printf("check: other lane width %016llx, one by one %016llx\n",
-              static_cast<unsigned long long>(other_width),
-              static_cast<unsigned long long>(one_by_one));
-  if (other_width != hash || one_by_one != hash) {
+  std::printf("check: one by one %016llx\n", static_cast<unsigned long long>(one_by_one));
+  if (!agree || one_by_one != hash) {
     std::fprintf(stderr, "drape-replay-maps: %s: the answers differ between the ways\n",
                  paths[0].c_str());
     return 1;

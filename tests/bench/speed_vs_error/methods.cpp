@@ -19,8 +19,9 @@ void DieOnError(const Status& status, const std::string& what) {
 
 class BodyMapMethod final : public Method {
  public:
-  BodyMapMethod(const BodyMapPose& pose, DepthSampling sampling, bool allow_avx2) {
-    collider_.AllowAvx2(allow_avx2);
+  BodyMapMethod(const BodyMapPose& pose, DepthSampling sampling, MapLanes lanes) {
+    collider_.AllowAvx2(lanes != MapLanes::kSse2);
+    collider_.AllowAvx512(lanes == MapLanes::kWidest);
     DieOnError(collider_.Build(pose, sampling), "body maps");
   }
   void Collide(std::span<const Float3> previous, std::span<Float3> positions,
@@ -262,9 +263,8 @@ ResponseParams BenchResponse() {
 }
 
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
-                                          std::string setting, size_t baked_bytes,
-                                          bool allow_avx2) {
-  auto method = std::make_unique<BodyMapMethod>(pose, sampling, allow_avx2);
+                                          std::string setting, size_t baked_bytes, MapLanes lanes) {
+  auto method = std::make_unique<BodyMapMethod>(pose, sampling, lanes);
   method->family = "maps";
   method->setting = std::move(setting);
   method->baked_bytes = baked_bytes;

@@ -32,6 +32,7 @@
 #include "drape/bake/mesh_reference.h"
 #include "drape/bake/regions.h"
 #include "drape/formats/asset_file.h"
+#include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
 #include "evaluation.h"
@@ -194,16 +195,23 @@ struct MapSetting {
   float epsilon = 0.005f;
   DepthEncoding depth = DepthEncoding::kUnorm16;
   NormalEncoding normals = NormalEncoding::kOct16;
-  uint8_t layers = 1;       // the slab plus layers - 1 air gaps per texel
-  bool sse2_lanes = false;  // CollideBatch kept to four SSE2 lanes (else eight with AVX2)
+  uint8_t layers = 1;                  // the slab plus layers - 1 air gaps per texel
+  MapLanes lanes = MapLanes::kWidest;  // CollideBatch's lanes (kNearest)
 };
+
+// Whether this CPU runs the body maps' eight lanes with AVX-512 (so AVX2 alone is a setting).
+bool CpuHasAvx512Lanes() {
+  BodyMapCollider probe;
+  return probe.uses_avx512();
+}
 
 std::string Describe(const MapSetting& m) {
   std::ostringstream s;
   s << "N=" << m.resolution << (m.sampling == DepthSampling::kBilinear ? " bilinear" : " nearest");
   if (m.fitted) s << " fitted";
   if (m.layers != 1) s << " layers=" << int(m.layers);
-  if (m.sse2_lanes) s << " SSE2 lanes";
+  if (m.lanes == MapLanes::kSse2) s << " SSE2 lanes";
+  if (m.lanes == MapLanes::kAvx2) s << " AVX2 lanes";
   if (m.epsilon != 0.005f) s << " eps=" << m.epsilon * 1000.f << "mm";
   if (m.depth != DepthEncoding::kUnorm16 || m.normals != NormalEncoding::kOct16) {
     s << (m.depth == DepthEncoding::kFloat32 ? " depth=f32" : " depth=u16")
@@ -246,13 +254,20 @@ std::vector<MapSetting> MapSweep(bool quick) {
       m.sampling = s;
       sweep.push_back(m);
     }
-    // The same maps with the batch kept to four SSE2 lanes: what the eight AVX2 lanes buy
-    // (the answers are the same bits; --check holds both to the one-by-one query).
+    // The same maps with the batch kept to four SSE2 lanes: what the eight AVX2 lanes buy; and,
+    // where the CPU has AVX-512, kept to AVX2, with and without air gaps: what AVX-512VL's 32
+    // registers buy (the answers are the same bits; --check holds each to the one-by-one query).
     if (n <= 512) {
       MapSetting m;
       m.resolution = n;
-      m.sse2_lanes = true;
+      m.lanes = MapLanes::kSse2;
       sweep.push_back(m);
+      if (CpuHasAvx512Lanes()) {
+        m.lanes = MapLanes::kAvx2;
+        sweep.push_back(m);
+        m.layers = 2;
+        sweep.push_back(m);
+      }
     }
     // Air-gap layers (nearest): what paper A's slab bias costs in missed crossings.
     for (uint8_t layers : {uint8_t{2}, uint8_t{4}}) {
@@ -443,8 +458,7 @@ class Measurement {
       const Status baked = bake::BakeBodyMapPose(positions, triangles, o, &pose, &stats);
       if (!baked.ok()) Fail(spec.label + " maps " + Describe(m) + ": " + baked.message());
       if (options_.dump_maps) DumpMaps(spec, m, pose);
-      Measure(context,
-              *MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes, !m.sse2_lanes));
+      Measure(context, *MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes, m.lanes));
       const bool combo = m.sampling == DepthSampling::kBilinear && !m.fitted &&
                          m.epsilon == 0.005f && m.depth == DepthEncoding::kUnorm16 &&
                          m.normals == NormalEncoding::kOct16 &&
@@ -573,7 +587,8 @@ class Measurement {
     for (const MapSetting& m : posed_maps) {
       const MapSetting defaults;
       if (m.sampling != DepthSampling::kNearest || m.fitted || m.epsilon != defaults.epsilon ||
-          m.depth != defaults.depth || m.normals != defaults.normals || m.sse2_lanes) {
+          m.depth != defaults.depth || m.normals != defaults.normals ||
+          m.lanes != MapLanes::kWidest) {
         continue;
       }
       const bake::BodyMapOptions o = BodyMapOptionsFor(m);

@@ -191,6 +191,12 @@ class BodyMapCollider {
   // it to SSE2 (tests, measurement); the choice survives Build and sequence blending.
   void AllowAvx2(bool allow) { allow_avx2_ = allow; }
   bool uses_avx2() const;  // allowed, and the CPU (and OS) support it
+  // Where the CPU also has AVX-512 (F, VL, DQ and BW), the eight lanes are the same code compiled
+  // for it: still 256-bit vectors, no 512-bit ones, but 32 vector registers instead of 16, where
+  // the walking lanes' loop spilled (see docs/PERFORMANCE.md). The same bits again.
+  // AllowAvx512(false) keeps the eight lanes to AVX2; AllowAvx2(false) keeps all to SSE2.
+  void AllowAvx512(bool allow) { allow_avx512_ = allow; }
+  bool uses_avx512() const;  // uses_avx2(), allowed, and the CPU (and OS) support AVX-512
 
   // Discrete batch: inside[i] = IsInside(points[i]) ? 1 : 0. Sizes must match.
   Status InsideBatch(std::span<const Float3> points, std::span<uint8_t> inside) const;
@@ -347,11 +353,16 @@ class BodyMapCollider {
   uint32_t CollideFourShortMotions(const Float3* previous, Float3* positions, Float3* velocities,
                                    uint8_t* flags, const ResponseParams& params,
                                    uint32_t* long_motions) const;
-  // CollideFourShortMotions for eight particles in AVX2 (body_map_collider_avx2.cpp): the same
-  // answers, bit for bit. Call only when uses_avx2().
-  uint32_t CollideEightShortMotions(const Float3* previous, Float3* positions, Float3* velocities,
-                                    uint8_t* flags, const ResponseParams& params,
-                                    uint32_t* long_motions) const;
+  // CollideFourShortMotions for eight particles in AVX2 (body_map_collider_avx2.cpp), and in AVX2
+  // with AVX-512 (body_map_collider_avx512.cpp): the same answers, bit for bit. Call only when
+  // lane_kernel() is kAvx2, or kAvx512.
+  uint32_t CollideEightShortMotionsAvx2(const Float3* previous, Float3* positions,
+                                        Float3* velocities, uint8_t* flags,
+                                        const ResponseParams& params, uint32_t* long_motions) const;
+  uint32_t CollideEightShortMotionsAvx512(const Float3* previous, Float3* positions,
+                                          Float3* velocities, uint8_t* flags,
+                                          const ResponseParams& params,
+                                          uint32_t* long_motions) const;
   // Both, written once over a lane pack (runtime/src/body_map_lane_walk.inl).
   template <class Lanes>
   uint32_t CollideShortLanes(const Float3* previous, Float3* positions, Float3* velocities,
@@ -367,11 +378,17 @@ class BodyMapCollider {
   uint32_t CollideFourWalks(const uint32_t* index, uint32_t lanes, const Float3* previous,
                             Float3* positions, Float3* velocities, uint8_t* flags,
                             const ResponseParams& params) const;
-  // CollideFourWalks for eight lanes in AVX2 (body_map_collider_avx2.cpp; index holds eight
-  // entries): the same answers, bit for bit. Call only when uses_avx2().
-  uint32_t CollideEightWalks(const uint32_t* index, uint32_t lanes, const Float3* previous,
-                             Float3* positions, Float3* velocities, uint8_t* flags,
-                             const ResponseParams& params) const;
+  // CollideFourWalks for eight lanes (index holds eight entries), in AVX2 and in AVX2 with
+  // AVX-512, as the short motions: the same answers, bit for bit.
+  uint32_t CollideEightWalksAvx2(const uint32_t* index, uint32_t lanes, const Float3* previous,
+                                 Float3* positions, Float3* velocities, uint8_t* flags,
+                                 const ResponseParams& params) const;
+  uint32_t CollideEightWalksAvx512(const uint32_t* index, uint32_t lanes, const Float3* previous,
+                                   Float3* positions, Float3* velocities, uint8_t* flags,
+                                   const ResponseParams& params) const;
+  // The lanes CollideRange takes with kNearest: four SSE2, or eight (AVX2, AVX2 with AVX-512).
+  enum class LaneKernel : uint8_t { kSse2, kAvx2, kAvx512 };
+  LaneKernel lane_kernel() const;
   // Both, written once over a lane pack (runtime/src/body_map_lane_walk.inl).
   template <class Lanes>
   uint32_t CollideWalkLanes(const uint32_t* index, uint32_t lanes, const Float3* previous,
@@ -426,7 +443,8 @@ class BodyMapCollider {
   float origin_x_ = 0.f, origin_y_ = 0.f;
   float texel_size_ = 0.f, inv_texel_size_ = 0.f;  // metres, 1/metres
   DepthSampling sampling_ = DepthSampling::kNearest;
-  bool allow_avx2_ = true;  // AllowAvx2; Clear keeps it
+  bool allow_avx2_ = true;    // AllowAvx2; Clear keeps it
+  bool allow_avx512_ = true;  // AllowAvx512; Clear keeps it
   int32_t clip_ = -1;
   float time_ = 0.f;
   Float3 bounds_min_{1.f, 1.f, 1.f}, bounds_max_{-1.f, -1.f, -1.f};
@@ -486,6 +504,10 @@ class BodyMapSequence {
   // BodyMapCollider::AllowAvx2 on every pose (a caller's scratch keeps its own).
   void AllowAvx2(bool allow) {
     for (BodyMapCollider& pose : poses_) pose.AllowAvx2(allow);
+  }
+  // BodyMapCollider::AllowAvx512 on every pose, likewise.
+  void AllowAvx512(bool allow) {
+    for (BodyMapCollider& pose : poses_) pose.AllowAvx512(allow);
   }
 
  private:
