@@ -2,9 +2,10 @@
 // text as body_map_collider_avx2.cpp (eight_lanes.inl, body_map_lane_walk.inl), still on 256-bit
 // vectors, but with AVX-512VL's 32 vector registers instead of 16, where the walking lanes' loop
 // spilled (see docs/PERFORMANCE.md). CollideRange calls them only when lane_kernel() is kAvx512;
-// the answers are the bits of every other path. No 512-bit vector is used
-// (prefer-vector-width=256; tests/runtime/check_lane_objects.sh fails on a zmm register), so
-// the CPU keeps its clock.
+// the answers are the bits of every other path. No 512-bit register is used (prefer-vector-width
+// below; -mmove-max and -mstore-max from runtime/CMakeLists.txt keep GCC's struct copies to 256
+// bits; tests/runtime/check_lane_objects.sh fails on a zmm register), so that CPUs which lower
+// their clock for 512-bit instructions do not.
 //
 // As in the AVX2 file, only what is defined between the target pragmas is compiled for the
 // target; every header comes before them.
