@@ -573,7 +573,6 @@ void BodyMapCollider::Clear() {
   gap_layers_ = 0;
   gap_texel_bits_.clear();
   gap_word_first_.clear();
-  gap_block_sums_.clear();
   gaps_.clear();
   gap_normals_.clear();
 }
@@ -865,33 +864,6 @@ void BodyMapCollider::CountGapsBeforeWords() {
   }
 }
 
-void BodyMapCollider::FillGapLookups() {
-  if (gap_layers_ == 0) {
-    gap_block_sums_.clear();
-    return;
-  }
-  // Entry (bi + 1, bj + 1) first marks block (bi, bj) as having gaps, then becomes the sum over
-  // the blocks up to it (no allocation once a blend's scratch held this grid).
-  const size_t row = static_cast<size_t>(blocks_w_) + 1;
-  gap_block_sums_.assign(row * (static_cast<size_t>(blocks_h_) + 1), 0u);
-  for (size_t word = 0; word < gap_texel_bits_.size(); ++word) {
-    uint32_t bits = gap_texel_bits_[word];
-    while (bits != 0) {
-      const size_t k = word * 32 + static_cast<size_t>(std::countr_zero(bits));
-      bits &= bits - 1;
-      const size_t bi = (k % width_) >> kBlockShift, bj = (k / width_) >> kBlockShift;
-      gap_block_sums_[(bj + 1) * row + bi + 1] = 1u;
-    }
-  }
-  for (size_t bj = 1; bj <= blocks_h_; ++bj) {
-    for (size_t bi = 1; bi <= blocks_w_; ++bi) {
-      gap_block_sums_[bj * row + bi] += gap_block_sums_[(bj - 1) * row + bi] +
-                                        gap_block_sums_[bj * row + bi - 1] -
-                                        gap_block_sums_[(bj - 1) * row + bi - 1];
-    }
-  }
-}
-
 void BodyMapCollider::Finish() {
   const size_t w = width_, h = height_;
   uint32_t valid = 0;
@@ -916,7 +888,6 @@ void BodyMapCollider::Finish() {
   }
   stats_.valid_texels = valid;
   stats_.gap_texels = gap_layers_ == 0 ? 0u : static_cast<uint32_t>(gaps_.size() / gap_layers_);
-  FillGapLookups();
   const double s = texel_size_;
   if (valid == 0) {
     bounds_min_ = {1.f, 1.f, 1.f};
@@ -1023,8 +994,7 @@ BodyMapCollider::LaneKernel BodyMapCollider::lane_kernel() const {
 size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
-         (gap_texel_bits_.capacity() + gap_word_first_.capacity() + gap_block_sums_.capacity()) *
-             sizeof(uint32_t) +
+         (gap_texel_bits_.capacity() + gap_word_first_.capacity()) * sizeof(uint32_t) +
          bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds);
 }
 

@@ -747,32 +747,12 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
     texel_b[lane] = static_cast<int32_t>(
         keep & (static_cast<uint32_t>(jb[lane]) * row + static_cast<uint32_t>(ib[lane])));
   }
-  // Whether a lane can meet a texel with gaps: a walk stays in the box of its end texels, so
-  // when no 8x8 block under those boxes has one (most of a body, most of the time), the lanes
-  // run the walk without the gap tests. The blocks' summed-area table answers for a box in four
-  // reads, however long the walk.
-  // (Every lane's box is looked up, an unused lane's as block 0: which lanes are used is data,
-  // and a branch per lane would mispredict.)
-  bool gaps_near = false;
-  if (gap_layers_ != 0) {
-    const I keep = AsInt(MaskOfLanes<P>(lanes));
-    const auto block = [&](I texel) { return And(keep, ShiftRight<kBlockShift>(texel)); };
-    const auto min_i = [&](I a, I b) { return SelectLanesI(AsFloat(Greater(a, b)), b, a); };
-    const auto max_i = [&](I a, I b) { return SelectLanesI(AsFloat(Greater(a, b)), a, b); };
-    alignas(32) int32_t block_lo_i[kLanes], block_lo_j[kLanes], block_hi_i[kLanes],
-        block_hi_j[kLanes];
-    P::Store(block_lo_i, block(min_i(i0, i1)));
-    P::Store(block_lo_j, block(min_i(j0, j1)));
-    P::Store(block_hi_i, block(max_i(i0, i1)));
-    P::Store(block_hi_j, block(max_i(j0, j1)));
-    uint32_t blocks_with_gaps = 0;
-    for (int lane = 0; lane < kLanes; ++lane) {
-      blocks_with_gaps |= GapBlocksIn(
-          static_cast<uint32_t>(block_lo_i[lane]), static_cast<uint32_t>(block_lo_j[lane]),
-          static_cast<uint32_t>(block_hi_i[lane]), static_cast<uint32_t>(block_hi_j[lane]));
-    }
-    gaps_near = blocks_with_gaps != 0;
-  }
+  // With gap layers every walk runs the loop with the gap tests. Where a step meets no texel with
+  // gaps they cost a few mask operations (LanesWithGaps finds none, and nothing is gathered);
+  // asking first whether any 8x8 block under a lane's walk has gaps cost more than that on every
+  // layered replay, even CesiumMan's N = 256, where 27 % of walk groups had gaps near (3-5 % more
+  // instructions in all; docs/PERFORMANCE.md, sixteenth session).
+  const bool gaps_near = gap_layers_ != 0;
   static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabsAt loads a slab as 8 bytes");
   const Slab* const slabs = slabs_.data();
   const auto load_slabs = [&](const int32_t* at, F* top, F* bottom) {

@@ -58,11 +58,6 @@ static inline __m256i Equal(__m256i a, __m256i b) { return _mm256_cmpeq_epi32(a,
 static inline __m256i High16(__m256i a) {
   return _mm256_srli_epi32(a, 16);
 }  // logical shift: 0 .. 65535
-// Shifted right by kBits, zeros shifted in.
-template <int kBits>
-static inline __m256i ShiftRight(__m256i a) {
-  return _mm256_srli_epi32(a, kBits);
-}
 static inline __m256i Abs(__m256i x) { return _mm256_abs_epi32(x); }  // INT32_MIN stays, as in SSE2
 
 static inline __m256i TruncateToInt(__m256 a) { return _mm256_cvttps_epi32(a); }

@@ -60,11 +60,6 @@ inline __m128i Less(__m128i a, __m128i b) { return _mm_cmplt_epi32(a, b); }
 inline __m128i Greater(__m128i a, __m128i b) { return _mm_cmpgt_epi32(a, b); }
 inline __m128i Equal(__m128i a, __m128i b) { return _mm_cmpeq_epi32(a, b); }
 inline __m128i High16(__m128i a) { return _mm_srli_epi32(a, 16); }  // logical shift: 0 .. 65535
-// Shifted right by kBits, zeros shifted in.
-template <int kBits>
-inline __m128i ShiftRight(__m128i a) {
-  return _mm_srli_epi32(a, kBits);
-}
 inline __m128i Abs(__m128i x) {  // SSE2 has no pabsd; wraps for INT32_MIN as |x| would
   const __m128i sign = _mm_srai_epi32(x, 31);
   return _mm_sub_epi32(_mm_xor_si128(x, sign), sign);

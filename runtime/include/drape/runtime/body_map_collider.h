@@ -428,15 +428,7 @@ class BodyMapCollider {
   // anyway instead of a second lookup per step (GatherGapLanes). A top moves up by at most one
   // ulp to carry it: about 3e-8 m at z = 0.5 m, out of the body.
   void Finish();
-  void FillGapLookups();        // gap_block_sums_ from gap_texel_bits_ (Finish)
   void CountGapsBeforeWords();  // gap_word_first_ from gap_texel_bits_
-  // Blocks with gaps among blocks bi0..bi1 x bj0..bj1 (inclusive, on the grid), by the sums.
-  uint32_t GapBlocksIn(uint32_t bi0, uint32_t bj0, uint32_t bi1, uint32_t bj1) const {
-    const size_t row = blocks_w_ + 1;
-    const uint32_t* s = gap_block_sums_.data();
-    return s[(bj1 + 1) * row + bi1 + 1] - s[bj0 * row + bi1 + 1] - s[(bj1 + 1) * row + bi0] +
-           s[bj0 * row + bi0];
-  }
   void Clear();
 
   uint32_t width_ = 0, height_ = 0;
@@ -462,11 +454,6 @@ class BodyMapCollider {
   // gap texels before that word; empty without gaps.
   std::vector<uint32_t> gap_texel_bits_;
   std::vector<uint32_t> gap_word_first_;
-  // Summed-area table of the 8x8 blocks with gaps, (blocks_w_ + 1) x (blocks_h_ + 1): entry
-  // (bi, bj) counts those with block column < bi and row < bj, so that the lane walk asks whether
-  // any block under a walk has gaps in four reads (Finish derives it from the bits; empty without
-  // gaps).
-  std::vector<uint32_t> gap_block_sums_;
   std::vector<Slab> gaps_;                 // gap_layers_ per gap texel (see GapBaseAt)
   std::vector<TexelNormals> gap_normals_;  // same index: front = upper, back = lower boundary
 };
