@@ -49,6 +49,13 @@ struct BodyMapColliderTestAccess {
   // Sets c (and so CollideBatch) to take `lanes`; false, with c unchanged, where the CPU lacks
   // them (a test skips those).
   static bool UseLanes(BodyMapCollider* c, TestLanes lanes) {
+    static_assert(static_cast<int>(TestLanes::kSse2) ==
+                          static_cast<int>(BodyMapCollider::LaneKernel::kSse2) &&
+                      static_cast<int>(TestLanes::kAvx2) ==
+                          static_cast<int>(BodyMapCollider::LaneKernel::kAvx2) &&
+                      static_cast<int>(TestLanes::kAvx512) ==
+                          static_cast<int>(BodyMapCollider::LaneKernel::kAvx512),
+                  "TestLanes names LaneKernel's values");
     BodyMapCollider probe;
     probe.AllowAvx2(lanes != TestLanes::kSse2);
     probe.AllowAvx512(lanes == TestLanes::kAvx512);
