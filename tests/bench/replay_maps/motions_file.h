@@ -61,7 +61,8 @@ inline std::string DecodeMotions(const std::string& bytes, Motions* out) {
   std::memcpy(step, bytes.data() + 24, sizeof(step));
   if (version != kMotionsVersion) return "motions file version " + std::to_string(version);
   const uint64_t payload = bytes.size() - kMotionsHeaderBytes;
-  if (count == 0 || count > payload / (2 * sizeof(Float3)) || payload != 2 * count * 12) {
+  if (count == 0 || count > payload / (2 * sizeof(Float3)) ||
+      payload != 2 * count * sizeof(Float3)) {
     return "the count (" + std::to_string(count) + ") does not match the file's size";
   }
   const auto in_unit = [](float x) { return x >= 0.f && x <= 1.f; };  // false for NaN
