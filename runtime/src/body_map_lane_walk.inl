@@ -372,14 +372,11 @@ void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
                                      GapLanes<P>* out) const {
   constexpr int kLanes = P::kCount;
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
-  out->layers = gap_layers_;
-  if (with_gaps == 0) {
-    for (uint32_t g = 0; g < gap_layers_; ++g) {
-      out->top[g] = P::Splat(-kInfinity);
-      out->bottom[g] = P::Splat(kInfinity);
-    }
-    return;
-  }
+  // out->layers counts the layers gathered: up to the last one that some lane has. An absent gap
+  // (-inf, +inf) holds no z and bounds no interval, so the tests over `layers` give the same
+  // answers without the layers that no lane has.
+  out->layers = 0;
+  if (with_gaps == 0) return;
   alignas(32) int32_t t[kLanes];
   P::Store(t, texel);
   // Each lane's gaps, or for a lane without gaps ones that hold no z (-inf, +inf): the gaps are
@@ -395,9 +392,15 @@ void BodyMapCollider::GatherGapLanes(typename P::I texel, uint32_t with_gaps,
     const int lane = std::countr_zero(bits);
     first[lane] = gaps_.data() + GapBaseAt(static_cast<uint32_t>(t[lane]));
   }
+  // Gaps are filled from the front (Build refuses a gap after an absent one; a blend ends a
+  // texel's list at the first gap it lacks), and every texel with gaps has its first. So once no
+  // lane has gap g, no lane has a later one: on the bodies that need four layers most texels
+  // with gaps have one, and the loads and the callers' tests of the other two are skipped.
   for (uint32_t g = 0; g < gap_layers_; ++g) {
     P::LoadSlabsAt([&first, g](int lane) { return first[lane] + g; }, &out->top[g],
                    &out->bottom[g]);
+    if (g != 0 && LaneBits(Greater(out->top[g], out->bottom[g])) == 0) return;
+    out->layers = g + 1;
   }
 }
 

@@ -1777,9 +1777,13 @@ TEST(BodyMapBatch, LongWalksThroughBlockEdgeCornersAnswerAsQuery) {
 }
 
 TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
-  BodyMapCollider bodies[4] = {
+  // The stack and posts with 3 and 4 layers: with 4, no texel has a third gap, and groups whose
+  // lanes have one gap each gather fewer layers than the collider has (GatherGapLanes).
+  constexpr int kBodies = 5;
+  BodyMapCollider bodies[kBodies] = {
       BuildOrDie(MakePose(SphereGrid(), Sphere)), BuildOrDie(MakePose(BoxGrid(), Box)),
-      BuildOrDie(MakePose(SphereGrid(), ThinSlab)), BuildOrDie(LayeredPose(3, kStackAndPosts))};
+      BuildOrDie(MakePose(SphereGrid(), ThinSlab)), BuildOrDie(LayeredPose(3, kStackAndPosts)),
+      BuildOrDie(LayeredPose(4, kStackAndPosts))};
   ResponseParams params;
   params.friction = 0.3f;
   params.restitution = 0.25f;
@@ -1795,7 +1799,7 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
   size_t walked_gap_contacts = 0, walked_gap_starts = 0;
   size_t steep_short = 0, steep_walked = 0;  // from a gap through the start texel's whole slab
   size_t eight_lanes_answered[3] = {};       // by TestLanes: AVX2, AVX-512
-  for (int body = 0; body < 4; ++body) {
+  for (int body = 0; body < kBodies; ++body) {
     SCOPED_TRACE(::testing::Message() << "body " << body);
     BodyMapCollider& c = bodies[body];
     const Float3 lo = c.bounds_min(), hi = c.bounds_max();

@@ -401,7 +401,7 @@ class BodyMapCollider {
   struct GapLanes;
   // The gaps of the lanes' row-major texels into *out: of the lanes in `with_gaps`, whose
   // texels have gaps (LanesWithGaps in body_map_lane_walk.inl); absent ones (-inf, +inf) for
-  // the others.
+  // the others. out->layers stops after the last gap layer any of them has (0 for none).
   template <class Lanes>
   void GatherGapLanes(typename Lanes::I texel, uint32_t with_gaps, GapLanes<Lanes>* out) const;
   // The lanes' oct16 codes (two values per word, the first in the low half) of the front or,
