@@ -58,6 +58,22 @@ class HullMethod final : public Method {
       : hulls_(hulls.begin(), hulls.end()), spheres_(spheres.begin(), spheres.end()) {
     DieOnError(set_.Build(hulls, spheres, joint_count, options), "hull colliders");
     DieOnError(set_.SetPose(skinning, skinning), "hull pose");
+    HullColliderOptions four_wide = options;
+    four_wide.allow_avx2 = false;
+    DieOnError(four_wide_set_.Build(hulls, spheres, joint_count, four_wide), "hull colliders");
+    DieOnError(four_wide_set_.SetPose(skinning, skinning), "hull pose");
+  }
+  // The particles one at a time, with the plane loops four wide (SSE2): no eight-particle broad
+  // phase, which CollideBatch documents to give the same bits.
+  bool QueryEachAndRespond(std::span<const Float3> previous, std::span<Float3> positions,
+                           std::span<Float3> velocities, std::span<uint8_t> flags) const override {
+    for (size_t k = 0; k < positions.size(); ++k) {
+      DieOnError(four_wide_set_.CollideBatch(previous.subspan(k, 1), positions.subspan(k, 1),
+                                             velocities.subspan(k, 1), flags.subspan(k, 1),
+                                             BenchResponse()),
+                 setting);
+    }
+    return true;
   }
   long OwnSurfaceMisses(std::span<const Float3> previous, std::span<const Float3> current,
                         std::span<const uint8_t> flags) const override {
@@ -135,6 +151,7 @@ class HullMethod final : public Method {
   }
 
   HullColliderSet set_;
+  HullColliderSet four_wide_set_;  // QueryEachAndRespond's
   std::vector<HullColliderData> hulls_;
   std::vector<JointSphereData> spheres_;
 };

@@ -42,9 +42,10 @@ class Method {
     return -1;
   }
 
-  // Query + ApplyResponse one particle at a time, the answers Collide documents to equal bit for
-  // bit (with kCollisionInvalidInput for non-finite input); false when the method documents no
-  // such equality (then nothing is written).
+  // Query + ApplyResponse one particle at a time (the hulls: their batch one particle at a time,
+  // four planes per instruction), the answers Collide documents to equal bit for bit (with
+  // kCollisionInvalidInput for non-finite input); false when the method documents no such
+  // equality (then nothing is written).
   virtual bool QueryEachAndRespond(std::span<const Float3> previous, std::span<Float3> positions,
                                    std::span<Float3> velocities, std::span<uint8_t> flags) const {
     (void)previous, (void)positions, (void)velocities, (void)flags;

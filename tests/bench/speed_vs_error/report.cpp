@@ -119,9 +119,9 @@ std::string TargetChecks(const std::vector<Row>& rows, bool* ok) {
   std::ostringstream md;
   *ok = true;
   md << "| character | best body-map setting (p99 <= 2 mm, missed <= 0.1 %) | ns/particle | "
-        "<= 25 ns | continuous hull settings with no own-surface miss | x exact (maps / hulls) | x "
-        "FCL "
-        "(maps / hulls) |\n|---|---|---|---|---|---|---|\n";
+        "<= 25 ns | continuous hull settings with no own-surface miss | the cheapest of them | "
+        "ns/particle | x exact (maps / hulls) | x FCL (maps / hulls) |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
   for (const std::string& character : Characters(rows)) {
     const std::vector<const Row*> all = AllRows(rows, character);
     if (all.empty() || !all.front()->human) continue;
@@ -141,7 +141,8 @@ std::string TargetChecks(const std::vector<Row>& rows, bool* ok) {
         ++hull_settings;
         if (m.own_surface_misses == 0) {
           ++clean_hulls;
-          if (r->setting.find("default") != std::string::npos) best_hulls = r;
+          // The cheapest of them, as for the maps (the ratios' hull column).
+          if (!best_hulls || m.ns_one_thread < best_hulls->metrics.ns_one_thread) best_hulls = r;
         }
       }
     }
@@ -155,6 +156,8 @@ std::string TargetChecks(const std::vector<Row>& rows, bool* ok) {
     md << "| " << character << " | " << (best_maps ? best_maps->setting : "none") << " | "
        << (best_maps ? Fixed(best_maps->metrics.ns_one_thread, 1) : "-") << " | "
        << (fast ? "yes" : "**no**") << " | " << clean_hulls << " of " << hull_settings << " | "
+       << (best_hulls ? best_hulls->setting : "none") << " | "
+       << (best_hulls ? Fixed(best_hulls->metrics.ns_one_thread, 1) : "-") << " | "
        << ratio(exact, best_maps) << " / " << ratio(exact, best_hulls) << " | "
        << ratio(fcl, best_maps) << " / " << ratio(fcl, best_hulls) << " |\n";
     if (!best_maps || clean_hulls != hull_settings) *ok = false;
