@@ -1777,8 +1777,8 @@ TEST(BodyMapBatch, LongWalksThroughBlockEdgeCornersAnswerAsQuery) {
 }
 
 TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
-  // The stack and posts with 3 and 4 layers: with 4, no texel has a third gap, and groups whose
-  // lanes have one gap each gather fewer layers than the collider has (GatherGapLanes).
+  // The stack and posts with 3 and with 4 layers: groups whose lanes' texels have fewer gaps than
+  // the collider has layers for gather only the layers some lane has (GatherGapLanes).
   constexpr int kBodies = 5;
   BodyMapCollider bodies[kBodies] = {
       BuildOrDie(MakePose(SphereGrid(), Sphere)), BuildOrDie(MakePose(BoxGrid(), Box)),

@@ -257,9 +257,9 @@ std::vector<MapSetting> MapSweep(bool quick) {
     sweep.push_back(m);
   }
   // N = 224, between the grid where the coarse humans start to miss (192: RiggedFigure, posed
-  // RobotExpressive) and 256: on those it misses as few as 256 does for 5-15 % less time (run
-  // out-a1 in docs/PERFORMANCE.md). Three layers missed exactly what four did on every human at
-  // 192 and 224 (same run), so they are not swept.
+  // RobotExpressive) and 256: it passes on both (0.009 % and 0.040 % missed), on RiggedFigure
+  // for 14 % less time than 256 (runs out-a1 and out-b1 to b3 in docs/PERFORMANCE.md). Three
+  // layers missed exactly what four did on every human at 192 and 224 (out-a1): not swept.
   for (uint8_t layers : {uint8_t{1}, uint8_t{2}, uint8_t{4}}) {
     MapSetting m;
     m.resolution = 224;
