@@ -292,7 +292,7 @@ template <class P>
 struct BodyMapCollider::GapLanes {
   using F = typename P::F;
   using I = typename P::I;
-  uint32_t layers = 0;  // gap layers: BodyMapCollider::gap_layers_
+  uint32_t layers = 0;  // the gap layers gathered (GatherGapLanes), at most gap_layers_
   F top[kMaxBodyMapLayers - 1], bottom[kMaxBodyMapLayers - 1];
 
   // z strictly inside one of the gaps (BodyMapCollider::InGap).

@@ -117,9 +117,8 @@ class BodyMapSequence;
 // input encoding: float32 input loses < 0.004 degrees) + 1 byte of bilinear eligibility in
 // kBilinear mode, plus 8 bytes per 8x8 block for the min/max (Hi-Z) level. 1024 x 1024: 16.1 MiB
 // (17.1 MiB bilinear). A pose with gap layers adds two bits per texel (which texels have gaps,
-// and a 32-bit count per 32 of them), 4 bytes per 8x8 block (which blocks have gaps, summed)
-// and, per texel that has a gap, 16 bytes per gap layer (the gaps' upper and lower z, their
-// normals). memory_bytes() reports the exact figure.
+// and a 32-bit count per 32 of them) and, per texel that has a gap, 16 bytes per gap layer (the
+// gaps' upper and lower z, their normals). memory_bytes() reports the exact figure.
 //
 // Air gaps (BodyMapPose::layers > 1): a texel's inside set is its slab minus its gaps, i.e. up to
 // `layers` disjoint z intervals. Every query honours them: an entry into the body below a gap is
