@@ -40,7 +40,7 @@ check() {  # name, command...: one pass/fail step of this script
 }
 
 echo "== 1. full build"
-cmake --preset default >/dev/null && cmake --build build -j "$jobs" || { echo "tests: 0 passed, 1 failed"; exit 1; }
+cmake --preset test >/dev/null && cmake --build build -j "$jobs" || { echo "tests: 0 passed, 1 failed"; exit 1; }
 run_ctest build
 
 echo "== 2. runtime alone (-DDRAPE_BUILD_BAKE=OFF)"

@@ -15,7 +15,7 @@
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/collision_types.h"
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
 

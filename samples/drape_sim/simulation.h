@@ -16,7 +16,7 @@
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
 
 namespace drape::sim {

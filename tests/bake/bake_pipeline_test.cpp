@@ -20,7 +20,7 @@
 #include "drape/bake/regions.h"
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
 #include "test_support.h"
 

@@ -1,4 +1,4 @@
-// Tests of the body map bake's private CPU rasterizer (bake/src/cpu_rasterizer.h): the two-view
+// Tests of the body map bake's private CPU rasterizer (bake/src/body_map/cpu_rasterizer.h): the two-view
 // pass is bit-identical to two single-view passes, and images reused from an earlier call (the
 // same input again, or a bigger raster before a smaller one; the rasterizer keeps its working
 // depths in them) give exactly what fresh images give, with no stale texel. The fragment pass
@@ -6,7 +6,7 @@
 // closed mesh every texel's facing signs sum to zero (even with texel centres on edges and
 // vertices: the top-left rule is a consistent tie-break).
 
-#include "../../bake/src/cpu_rasterizer.h"
+#include "body_map/cpu_rasterizer.h"
 
 #include <gtest/gtest.h>
 

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
 #include "hull_fixtures.h"
 

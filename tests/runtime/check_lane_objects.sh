@@ -3,7 +3,7 @@
 # wider instruction set than the baseline (the body-map lanes in AVX2, and in AVX2 with AVX-512)
 # could hand its code to another path, or when the AVX-512 one uses 512-bit registers.
 #
-# body_map_collider_avx2.cpp and body_map_collider_avx512.cpp compile only their own region for
+# lanes_avx2.cpp and lanes_avx512.cpp compile only their own region for
 # their target (target pragmas after every #include). A function such an object defines weakly
 # (COMDAT: inline functions, template instantiations) that another object of the library also
 # defines is merged by the linker, which may keep either copy. So such a shared function must not
@@ -20,7 +20,7 @@ library=$(realpath "$1")
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 status=0
-for member in body_map_collider_avx2.cpp.o body_map_collider_avx512.cpp.o; do
+for member in lanes_avx2.cpp.o lanes_avx512.cpp.o; do
   if ! (cd "$scratch" && ar x "$library" "$member"); then
     echo "FAIL: no $member in $library"
     exit 1
@@ -51,7 +51,7 @@ for member in body_map_collider_avx2.cpp.o body_map_collider_avx512.cpp.o; do
   evex=$(objdump -d "$object" | grep -cP '^\s+[0-9a-f]+:\t62 ' || true)
   high=$(objdump -d --no-show-raw-insn "$object" | grep -cE '%[xy]mm(1[6-9]|2[0-9]|3[01])\b' || true)
   wide=$(objdump -d --no-show-raw-insn "$object" | grep -c '%zmm' || true)
-  if [ "$member" = body_map_collider_avx512.cpp.o ]; then
+  if [ "$member" = lanes_avx512.cpp.o ]; then
     if [ "$evex" -eq 0 ]; then
       echo "FAIL: $member holds no EVEX-encoded instruction: the AVX-512 target did not apply"
       status=1

@@ -19,7 +19,7 @@
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/garments.h"
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
 
 namespace drape {

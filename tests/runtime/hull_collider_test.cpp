@@ -4,7 +4,7 @@
 // arithmetic. Kirkpatrick-mode and map-table builder tests live in tests/bake (they need the
 // builders).
 
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 
 #include <gtest/gtest.h>
 #include <omp.h>

@@ -15,7 +15,7 @@
 
 #include "drape/formats/hull_collider_data.h"
 #include "drape/formats/types.h"
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
 
 namespace drape::test {

@@ -4,7 +4,7 @@
 //
 // Projection. The faces are projected along an OBB axis a onto (u, v) = ((p - obb.center) .
 // projection_u, (p - obb.center) . projection_v), computed in float by
-// drape/runtime/hull_collider.h ProjectHullUv, so the runtime reproduces a vertex's (u, v) bit for
+// drape/runtime/hull_collider_set.h ProjectHullUv, so the runtime reproduces a vertex's (u, v) bit for
 // bit. (projection_u, projection_v, a) is right-handed. A face is "upper" when its plane normal n
 // has n.a > tau and its projected triangle is strictly counter-clockwise (exact predicate on the
 // stored floats), "lower" when n.a < -tau and it is strictly clockwise (stored reversed, so

@@ -1,7 +1,7 @@
 #pragma once
 // Paper B §2.4: the map sphere / map cylinder of a convex hull collider, the table that lists per
 // direction cell every triangle a response ray in that cell can hit (drape/formats/
-// hull_collider_data.h MapTableData; the runtime side is drape/runtime/hull_collider.h).
+// hull_collider_data.h MapTableData; the runtime side is drape/runtime/hull_collider_set.h).
 //
 // Kind. A hull whose longest OBB half extent is at least cylinder_elongation times the middle one
 // gets a map cylinder along its longest OBB axis, the others a map sphere (MapTableChoice forces

@@ -83,7 +83,7 @@
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/collision_types.h"
-#include "drape/runtime/hull_collider.h"
+#include "drape/runtime/hull_collider_set.h"
 
 namespace drape {
 

@@ -1,0 +1,785 @@
+#include "drape/runtime/cloth_solver.h"
+
+#include "cloth/spring_colouring.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "drape/runtime/math.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace drape {
+namespace {
+
+using internal::Particle4;
+using internal::SpringBlock;
+using internal::SpringGroup;
+using internal::SpringRun;
+
+constexpr uint32_t kNoParticle = std::numeric_limits<uint32_t>::max();
+constexpr uint32_t kMaxSubsteps = 256;
+constexpr uint32_t kMaxIterations = 256;
+// Below these sizes a loop runs on one thread: forking costs more than it saves. The result is
+// the same either way (per-index writes).
+constexpr int64_t kParallelParticles = 2048;
+constexpr int64_t kParallelSprings = 4096;
+
+Status InvalidArgument(const std::string& message) {
+  return Status(StatusCode::kInvalidArgument, "ClothSolver: " + message);
+}
+
+bool Finite(const Mat34& m) {
+  for (const float v : m.m)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+// Which sign of the length error a spring acts on (paper A's buckling model restricts it).
+enum class SpringSide { kBoth, kStretched, kCompressed };
+
+SpringSide SideOf(SpringKind kind, bool buckling) {
+  if (!buckling) return SpringSide::kBoth;
+  return kind == SpringKind::kStretch ? SpringSide::kStretched : SpringSide::kCompressed;
+}
+
+template <SpringSide side>
+inline float ActiveError(float error) {
+  if constexpr (side == SpringSide::kStretched) return error > 0.f ? error : 0.f;
+  if constexpr (side == SpringSide::kCompressed) return error < 0.f ? error : 0.f;
+  return error;
+}
+
+// Paper B eq. 2-3 for lane k of a block: each end moves by its share of correction * (L - R)
+// along the spring. The scalar reference kernel. The SSE kernel below repeats these operations
+// lane by lane in the same order (no FMA; IEEE sqrt and division), so both give the same bits.
+template <SpringSide side>
+inline void CorrectSpring(const SpringBlock& block, int k, float correction, Particle4* p) {
+  Particle4& pa = p[block.a[k]];
+  Particle4& pb = p[block.b[k]];
+  const float dx = pb.x - pa.x, dy = pb.y - pa.y, dz = pb.z - pa.z;
+  const float length = std::sqrt((dx * dx + dy * dy) + dz * dz);
+  const float error = ActiveError<side>(length - block.rest_length[k]);
+  // A spring of length 0 has no direction: it waits for its neighbours to separate its ends.
+  const float scale = length > 1e-20f ? correction * error / length : 0.f;
+  const float sa = scale * block.weight_a[k], sb = scale * block.weight_b[k];
+  pa.x = pa.x + dx * sa;
+  pa.y = pa.y + dy * sa;
+  pa.z = pa.z + dz * sa;
+  pb.x = pb.x - dx * sb;
+  pb.y = pb.y - dy * sb;
+  pb.z = pb.z - dz * sb;
+}
+
+#if defined(__SSE2__)
+// The four springs of a block at once (they share no particle, so the scatter does not
+// overlap): aligned loads of (x, y, z, w) per end, transposed to x/y/z lanes and back.
+template <SpringSide side>
+inline void CorrectBlock(const SpringBlock& block, float correction, Particle4* p) {
+  float* a[4];
+  float* b[4];
+  for (int k = 0; k < 4; ++k) {
+    a[k] = &p[block.a[k]].x;
+    b[k] = &p[block.b[k]].x;
+  }
+  __m128 ax = _mm_load_ps(a[0]), ay = _mm_load_ps(a[1]), az = _mm_load_ps(a[2]),
+         aw = _mm_load_ps(a[3]);
+  __m128 bx = _mm_load_ps(b[0]), by = _mm_load_ps(b[1]), bz = _mm_load_ps(b[2]),
+         bw = _mm_load_ps(b[3]);
+  _MM_TRANSPOSE4_PS(ax, ay, az, aw);
+  _MM_TRANSPOSE4_PS(bx, by, bz, bw);
+  const __m128 dx = _mm_sub_ps(bx, ax), dy = _mm_sub_ps(by, ay), dz = _mm_sub_ps(bz, az);
+  const __m128 length = _mm_sqrt_ps(
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
+  __m128 error = _mm_sub_ps(length, _mm_load_ps(block.rest_length));
+  // maxps/minps return the second operand for NaN and for +-0 ties, like ActiveError.
+  if constexpr (side == SpringSide::kStretched) error = _mm_max_ps(error, _mm_setzero_ps());
+  if constexpr (side == SpringSide::kCompressed) error = _mm_min_ps(error, _mm_setzero_ps());
+  const __m128 valid = _mm_cmpgt_ps(length, _mm_set1_ps(1e-20f));
+  const __m128 scale =
+      _mm_and_ps(valid, _mm_div_ps(_mm_mul_ps(_mm_set1_ps(correction), error), length));
+  const __m128 sa = _mm_mul_ps(scale, _mm_load_ps(block.weight_a));
+  const __m128 sb = _mm_mul_ps(scale, _mm_load_ps(block.weight_b));
+  ax = _mm_add_ps(ax, _mm_mul_ps(dx, sa));
+  ay = _mm_add_ps(ay, _mm_mul_ps(dy, sa));
+  az = _mm_add_ps(az, _mm_mul_ps(dz, sa));
+  bx = _mm_sub_ps(bx, _mm_mul_ps(dx, sb));
+  by = _mm_sub_ps(by, _mm_mul_ps(dy, sb));
+  bz = _mm_sub_ps(bz, _mm_mul_ps(dz, sb));
+  _MM_TRANSPOSE4_PS(ax, ay, az, aw);
+  _MM_TRANSPOSE4_PS(bx, by, bz, bw);
+  _mm_store_ps(a[0], ax);
+  _mm_store_ps(a[1], ay);
+  _mm_store_ps(a[2], az);
+  _mm_store_ps(a[3], aw);
+  _mm_store_ps(b[0], bx);
+  _mm_store_ps(b[1], by);
+  _mm_store_ps(b[2], bz);
+  _mm_store_ps(b[3], bw);
+}
+#endif
+
+template <SpringSide side>
+inline void CorrectFour(const SpringBlock& block, float correction, bool simd, Particle4* p) {
+#if defined(__SSE2__)
+  if (simd) {
+    CorrectBlock<side>(block, correction, p);
+    return;
+  }
+#endif
+  (void)simd;
+  for (int lane = 0; lane < 4; ++lane) CorrectSpring<side>(block, lane, correction, p);
+}
+
+template <SpringSide side>
+void CorrectRunSequential(const SpringBlock* blocks, const SpringRun& run, float correction,
+                          bool simd, Particle4* p) {
+  for (uint32_t k = run.begin; k < run.end; ++k) CorrectFour<side>(blocks[k], correction, simd, p);
+}
+
+// The blocks of one run shared among the threads of the enclosing parallel region.
+template <SpringSide side>
+void CorrectRunShared(const SpringBlock* blocks, const SpringRun& run, float correction, bool simd,
+                      Particle4* p) {
+  const int64_t begin = run.begin, end = run.end;
+#pragma omp for schedule(static)
+  for (int64_t k = begin; k < end; ++k) CorrectFour<side>(blocks[k], correction, simd, p);
+}
+
+// Appends `springs` (pairwise disjoint: one colour) as blocks of four, in order. The lanes of the
+// last block left empty hold null springs (rest length 0, weights 0) on the group's own spare
+// slots spare..spare + 3, which only this group writes: their correction is 0 and they touch no
+// particle.
+void PackBlocks(const std::vector<ClothSpring>& springs, uint32_t spare,
+                std::vector<SpringBlock>* blocks) {
+  for (size_t k = 0; k < springs.size(); k += 4) {
+    SpringBlock& block = blocks->emplace_back();
+    for (uint32_t lane = 0; lane < 4; ++lane) {
+      if (k + lane < springs.size()) {
+        const ClothSpring& spring = springs[k + lane];
+        block.a[lane] = spring.a;
+        block.b[lane] = spring.b;
+        block.rest_length[lane] = spring.rest_length;
+        block.weight_a[lane] = spring.weight_a;
+        block.weight_b[lane] = spring.weight_b;
+      } else {
+        block.a[lane] = block.b[lane] = spare + lane;  // the rest stays 0
+      }
+    }
+  }
+}
+
+// Paper A's spring force on lane k of a block: F_a = (k (L - R) + c (v_b - v_a).u) u, F_b = -F_a,
+// or nothing while the buckling model keeps the spring inactive.
+template <SpringSide side>
+inline void AccumulateSpring(const SpringBlock& block, uint32_t k, float stiffness, float damping,
+                             const Float3* x, const Float3* v, Float3* forces) {
+  const uint32_t a = block.a[k], b = block.b[k];
+  if (a == b) return;  // a null lane: its spare slot is not a particle
+  const Float3 d = x[b] - x[a];
+  const float length = std::sqrt(Dot(d, d));
+  const float error = length - block.rest_length[k];
+  if (ActiveError<side>(error) == 0.f || !(length > 1e-20f)) return;
+  const Float3 u = d * (1.f / length);
+  const Float3 f = u * (stiffness * error + damping * Dot(v[b] - v[a], u));
+  forces[a] += f;
+  forces[b] -= f;
+}
+
+template <SpringSide side>
+void AccumulateRunLanes(const SpringBlock* blocks, const SpringRun& run, bool shared,
+                        float stiffness, float damping, const Float3* x, const Float3* v,
+                        Float3* forces) {
+  const int64_t begin = run.begin, end = run.end;
+  const auto block_forces = [&](int64_t k) {
+    for (uint32_t lane = 0; lane < 4; ++lane)
+      AccumulateSpring<side>(blocks[k], lane, stiffness, damping, x, v, forces);
+  };
+  if (shared) {
+#pragma omp for schedule(static)
+    for (int64_t k = begin; k < end; ++k) block_forces(k);
+  } else {
+    for (int64_t k = begin; k < end; ++k) block_forces(k);
+  }
+}
+
+}  // namespace
+
+ClothSolverSettings ClothSolverSettings::PaperA(uint32_t substeps) {
+  ClothSolverSettings s;
+  s.integrator = ClothIntegrator::kExplicitEuler;
+  s.substeps = substeps;
+  s.buckling = true;
+  return s;
+}
+
+ClothSolverSettings ClothSolverSettings::PaperB() {
+  ClothSolverSettings s;
+  s.integrator = ClothIntegrator::kVerlet;
+  s.iterations = 3;
+  s.buckling = false;
+  return s;
+}
+
+uint32_t RecommendedEulerSubsteps(const Cloth& cloth, float dt, float damping, float safety) {
+  const float h_max = cloth.MaxStableEulerStep(damping) * std::clamp(safety, 1e-3f, 1.f);
+  if (!(dt > 0.f) || !std::isfinite(h_max)) return 1;
+  const double count = std::ceil(static_cast<double>(dt) / h_max);
+  return static_cast<uint32_t>(std::clamp(count, 1.0, static_cast<double>(kMaxSubsteps)));
+}
+
+Status ClothSolver::SetSettings(const ClothSolverSettings& s) {
+  if (s.substeps < 1 || s.substeps > kMaxSubsteps)
+    return InvalidArgument("substeps = " + std::to_string(s.substeps) + ": must be in [1, 256]");
+  if (s.iterations < 1 || s.iterations > kMaxIterations)
+    return InvalidArgument("iterations = " + std::to_string(s.iterations) +
+                           ": must be in [1, 256]");
+  if (!IsFinite(s.gravity)) return InvalidArgument("gravity is not finite");
+  if (!IsFinite(s.wind)) return InvalidArgument("wind is not finite");
+  if (!std::isfinite(s.damping) || s.damping < 0.f)
+    return InvalidArgument("damping = " + std::to_string(s.damping) +
+                           " 1/s: must be finite and >= 0");
+  if (!std::isfinite(s.drag) || s.drag < 0.f)
+    return InvalidArgument("drag = " + std::to_string(s.drag) + ": must be finite and >= 0");
+  if (s.root_joint < -1)
+    return InvalidArgument("root_joint = " + std::to_string(s.root_joint) + ": must be >= -1");
+  if (!IsFinite(s.root_bind_position)) return InvalidArgument("root_bind_position is not finite");
+  if (s.integrator != ClothIntegrator::kVerlet && s.integrator != ClothIntegrator::kExplicitEuler)
+    return InvalidArgument("unknown integrator");
+  settings_ = s;
+  return Status::Ok();
+}
+
+// The spring layout. Particles are split into `chunks` index ranges of equal size (a number that
+// depends on the mesh only, never on the thread count). A spring between two particles of one
+// chunk belongs to that chunk; one between neighbouring chunks c and c + 1 to zone c; any other
+// is "far". Each group's springs are coloured (first fit, stretch then bend, in (a, b) order) and
+// each colour is one run of blocks of four: the blocks of a run are independent, so the CPU
+// overlaps their square roots and divisions. SolveSprings then runs per iteration: all chunks in
+// parallel (one thread per chunk, its runs in order), the even zones in parallel, the odd zones
+// in parallel (zone c touches chunks c and c + 1 only, so zones two apart share no particle),
+// then the far runs one by one, each shared among the threads. Meshes numbered row by row (every
+// generated garment, most scanned meshes) have no far springs: three barriers per iteration.
+void ClothSolver::BuildSpringGroups(const Cloth& cloth) {
+  const uint32_t n = cloth.particle_count();
+  // Chunks of at least 256 particles and longer than 99 % of the springs' index spans |a - b| (so
+  // that those cross at most one chunk boundary), a multiple of 8 of them (even shares for 2, 4
+  // and 8 threads), at most 64. A cloth of 2048 particles or more gets at least 8 chunks (its
+  // longer springs are then far springs); a smaller one is a single chunk.
+  std::vector<uint32_t> spans;
+  spans.reserve(cloth.springs().size());
+  for (const ClothSpring& spring : cloth.springs())
+    spans.push_back(std::max(spring.a, spring.b) - std::min(spring.a, spring.b));
+  uint32_t span = 0;
+  if (!spans.empty()) {
+    const size_t rank = spans.size() * 99 / 100;
+    std::nth_element(spans.begin(), spans.begin() + static_cast<std::ptrdiff_t>(rank), spans.end());
+    span = spans[rank];
+  }
+  uint32_t chunks = n / std::max(256u, span + 1);
+  if (chunks < 8) chunks = n >= 2048 ? 8 : 1;
+  chunks = chunks >= 8 ? std::min(64u, chunks / 8 * 8) : 1;
+  const auto chunk_of = [&](uint32_t i) { return static_cast<uint32_t>(uint64_t{i} * chunks / n); };
+  const uint32_t zones = chunks - 1;
+  const uint32_t far = chunks + zones;                // group index of the far springs
+  std::vector<std::vector<ClothSpring>> by_group[2];  // [kind][group]: chunks, zones, far
+  for (auto& g : by_group) g.resize(far + 1);
+  for (const SpringColour& colour : cloth.colours()) {
+    for (uint32_t k = colour.begin; k < colour.end; ++k) {
+      const ClothSpring& spring = cloth.springs()[k];
+      const uint32_t ca = chunk_of(std::min(spring.a, spring.b));
+      const uint32_t cb = chunk_of(std::max(spring.a, spring.b));
+      const uint32_t group = ca == cb ? ca : (cb == ca + 1 ? chunks + ca : far);
+      by_group[static_cast<int>(colour.kind)][group].push_back(spring);
+    }
+  }
+  // Spare slots after the particles: four per group, written only by that group's null lanes.
+  solver_positions_.assign(n + 4 * (far + 1), Particle4{});
+  blocks_.clear();
+  runs_.clear();
+  chunk_groups_.clear();
+  even_zones_.clear();
+  odd_zones_.clear();
+  const auto by_index = [](const ClothSpring& x, const ClothSpring& y) {
+    return x.a != y.a ? x.a < y.a : x.b < y.b;
+  };
+  std::vector<std::vector<uint64_t>> used(n);
+  std::vector<uint32_t> colour_of;
+  std::vector<std::vector<ClothSpring>> by_colour;
+  // One run per colour of the group's springs of one kind; runs of one group share its spares
+  // (they are solved one after the other, by one thread or with a barrier between them).
+  const auto add_runs = [&](std::vector<ClothSpring>& springs, SpringKind kind, uint32_t group) {
+    std::sort(springs.begin(), springs.end(), by_index);
+    by_colour.assign(detail::FirstFitColours(springs, &used, &colour_of), {});
+    for (size_t k = 0; k < springs.size(); ++k) by_colour[colour_of[k]].push_back(springs[k]);
+    for (const std::vector<ClothSpring>& colour : by_colour) {
+      SpringRun run;
+      run.begin = static_cast<uint32_t>(blocks_.size());
+      run.kind = kind;
+      PackBlocks(colour, n + 4 * group, &blocks_);
+      run.end = static_cast<uint32_t>(blocks_.size());
+      runs_.push_back(run);
+    }
+  };
+  for (uint32_t g = 0; g <= far; ++g) {
+    SpringGroup group;
+    group.run_begin = static_cast<uint32_t>(runs_.size());
+    add_runs(by_group[0][g], SpringKind::kStretch, g);
+    add_runs(by_group[1][g], SpringKind::kBend, g);
+    group.run_end = static_cast<uint32_t>(runs_.size());
+    if (g < chunks) {
+      chunk_groups_.push_back(group);
+    } else if (g < far) {
+      ((g - chunks) % 2 == 0 ? even_zones_ : odd_zones_).push_back(group);
+    } else {
+      far_runs_ = group;
+    }
+  }
+}
+
+Status ClothSolver::Init(const Cloth& cloth, const ClothSolverSettings& settings) {
+  if (cloth.empty()) return InvalidArgument("Init: the cloth is empty (not built)");
+  if (Status s = SetSettings(settings); !s.ok()) return s;
+  cloth_ = &cloth;
+  const size_t n = cloth.particle_count();
+  const size_t k = cloth.kinematic_particles().size();
+  backup_positions_.assign(n, Float3{});
+  backup_velocities_.assign(n, Float3{});
+  forces_.assign(n, Float3{});
+  kinematic_positions_.assign(k, Float3{});
+  kinematic_velocities_.assign(k, Float3{});
+  flags_.assign(n, 0);
+  body_map_flags_.assign(n, 0);
+  BuildSpringGroups(cloth);
+  return Status::Ok();
+}
+
+// ---- Step: the recipe --------------------------------------------------------------------------
+
+Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
+                         const ClothFrame& frame, ClothStepStats* stats) {
+  ClothStepStats local_stats;
+  ClothStepStats& st = stats != nullptr ? *stats : local_stats;
+  st = ClothStepStats{};
+  if (Status s = ValidateFrame(*state, colliders, frame); !s.ok()) return s;
+  if (const uint32_t bad = FirstNonFinite(*state); bad != kNoParticle)
+    return Status(StatusCode::kInvalidState,
+                  "ClothSolver::Step: input state of particle " + std::to_string(bad) +
+                      " is not finite (position or velocity); nothing was simulated");
+  if (colliders.hulls != nullptr) {
+    if (Status s = colliders.hulls->SetPose(frame.skinning_start, frame.skinning_end); !s.ok())
+      return s;
+  }
+  Float3 root_delta;  // metres over the whole frame
+  if (settings_.root_joint >= 0) {
+    const size_t r = static_cast<size_t>(settings_.root_joint);
+    root_delta = TransformPoint(frame.skinning_end[r], settings_.root_bind_position) -
+                 TransformPoint(frame.skinning_start[r], settings_.root_bind_position);
+  }
+
+  const uint32_t count = settings_.substeps;
+  const bool verlet = settings_.integrator == ClothIntegrator::kVerlet;
+  const bool relative = settings_.root_joint >= 0;
+  const bool parallel = static_cast<int64_t>(state->positions.size()) >= kParallelParticles;
+  for (uint32_t k = 0; k < count; ++k) {
+    Substep sub;
+    sub.s0 = static_cast<float>(k) / static_cast<float>(count);
+    sub.s1 = static_cast<float>(k + 1) / static_cast<float>(count);  // exactly 1 at the end
+    sub.h = frame.dt / static_cast<float>(count);
+    const Float3 shift = root_delta * (sub.s1 - sub.s0);
+
+    // The solver's own stages share one parallel region: each holds `omp for` loops bound to it.
+#pragma omp parallel if (parallel)
+    {
+      BeginSubstep(state);
+      if (relative) ApplyRootMotion(state, shift);
+      if (!verlet) AccumulateSpringForces(*state);
+      Integrate(state, sub);
+      ApplyAttachments(state, frame, sub);
+      if (verlet) SolveSprings(state);
+      UpdateVelocities(state, sub);
+    }
+    // The colliders parallelise their batches themselves.
+    if (Status s = Collide(state, colliders, sub, &st); !s.ok()) {
+      RestoreBackup(state);
+      return s;
+    }
+    RestoreKinematic(state);
+    if (const uint32_t bad = FirstNonFinite(*state); bad != kNoParticle) {
+      RestoreBackup(state);
+      st.contacts = 0;
+      st.max_stretch = MaxStretch(*state);
+      return Status(StatusCode::kInvalidState,
+                    "ClothSolver::Step: particle " + std::to_string(bad) +
+                        " became non-finite in substep " + std::to_string(k) +
+                        " (a blow-up: for explicit Euler use more substeps); the state is left "
+                        "at the end of the last valid substep");
+    }
+    st.contacts = CountContacts();
+    ++st.substeps;
+  }
+  st.max_stretch = MaxStretch(*state);
+  return Status::Ok();
+}
+
+Status ClothSolver::ValidateFrame(const ClothState& state, const ClothColliders& colliders,
+                                  const ClothFrame& frame) const {
+  if (cloth_ == nullptr) return InvalidArgument("Step: Init was not called");
+  if (!state.Matches(*cloth_))
+    return InvalidArgument("Step: the state's arrays do not have the cloth's " +
+                           std::to_string(cloth_->particle_count()) +
+                           " particles (call ClothState::Reset)");
+  if (!std::isfinite(frame.dt) || !(frame.dt > 0.f))
+    return InvalidArgument("Step: dt = " + std::to_string(frame.dt) + " s: must be finite and > 0");
+  size_t joints = cloth_->required_joint_count();
+  if (settings_.root_joint >= 0) joints = std::max(joints, size_t(settings_.root_joint) + 1);
+  if (frame.skinning_start.size() < joints || frame.skinning_end.size() < joints)
+    return InvalidArgument("Step: " + std::to_string(joints) +
+                           " skinning matrices are needed (attachments, root joint) at the start "
+                           "and end of the frame; got " +
+                           std::to_string(frame.skinning_start.size()) + " and " +
+                           std::to_string(frame.skinning_end.size()));
+  for (size_t j = 0; j < joints; ++j) {
+    if (!Finite(frame.skinning_start[j]) || !Finite(frame.skinning_end[j]))
+      return InvalidArgument("Step: skinning matrix of joint " + std::to_string(j) +
+                             " is not finite");
+  }
+  const ResponseParams& r = colliders.response;
+  if (!(std::isfinite(r.friction) && r.friction >= 0.f && r.friction <= 1.f &&
+        std::isfinite(r.restitution) && r.restitution >= 0.f && r.restitution <= 1.f &&
+        std::isfinite(r.separation) && r.separation >= 0.f))
+    return InvalidArgument(
+        "Step: response friction and restitution must be in [0, 1], separation finite and >= 0");
+  if (colliders.body_map != nullptr && colliders.body_map->empty())
+    return InvalidArgument("Step: the body map collider is empty (not built)");
+  return Status::Ok();
+}
+
+// ---- Stages ------------------------------------------------------------------------------------
+// BeginSubstep .. UpdateVelocities run inside Step's parallel region (their `omp for` loops bind
+// to it; called outside one they run on the calling thread). Loops over all particles use the
+// same static schedule, so a thread sees its own writes of the previous such loop without a
+// barrier; loops that read other particles come after a barrier.
+
+void ClothSolver::BeginSubstep(ClothState* state) {
+  const Float3* x = state->positions.data();
+  const Float3* v = state->velocities.data();
+  Float3* backup_x = backup_positions_.data();
+  Float3* backup_v = backup_velocities_.data();
+  const int64_t n = static_cast<int64_t>(state->positions.size());
+#pragma omp for schedule(static) nowait
+  for (int64_t i = 0; i < n; ++i) {
+    backup_x[i] = x[i];
+    backup_v[i] = v[i];
+  }
+}
+
+void ClothSolver::ApplyRootMotion(ClothState* state, Float3 shift) {
+  Float3* x = state->positions.data();
+  const int64_t n = static_cast<int64_t>(state->positions.size());
+#pragma omp for schedule(static) nowait
+  for (int64_t i = 0; i < n; ++i) x[i] += shift;
+}
+
+// The same traversal as SolveSprings (chunks, even zones, odd zones, far runs): every spring
+// adds to its two particles' forces from one thread, in a fixed order.
+void ClothSolver::AccumulateSpringForces(const ClothState& state) {
+  const Float3* x = state.positions.data();
+  const Float3* v = state.velocities.data();
+  Float3* forces = forces_.data();
+  const int64_t n = static_cast<int64_t>(forces_.size());
+  // The barrier after this loop also orders the springs after every thread's root motion.
+#pragma omp for schedule(static)
+  for (int64_t i = 0; i < n; ++i) forces[i] = Float3{};
+  const auto group_forces = [&](const SpringGroup& group) {
+    for (uint32_t r = group.run_begin; r < group.run_end; ++r)
+      AccumulateRun(runs_[r], false, x, v, forces);
+  };
+  const int64_t chunk_count = static_cast<int64_t>(chunk_groups_.size());
+  const int64_t even_count = static_cast<int64_t>(even_zones_.size());
+  const int64_t odd_count = static_cast<int64_t>(odd_zones_.size());
+#pragma omp for schedule(static)
+  for (int64_t g = 0; g < chunk_count; ++g) group_forces(chunk_groups_[g]);
+#pragma omp for schedule(static)
+  for (int64_t g = 0; g < even_count; ++g) group_forces(even_zones_[g]);
+#pragma omp for schedule(static)
+  for (int64_t g = 0; g < odd_count; ++g) group_forces(odd_zones_[g]);
+  for (uint32_t r = far_runs_.run_begin; r < far_runs_.run_end; ++r)
+    AccumulateRun(runs_[r], true, x, v, forces);
+}
+
+void ClothSolver::AccumulateRun(const SpringRun& run, bool shared, const Float3* x, const Float3* v,
+                                Float3* forces) const {
+  const SpringBlock* blocks = blocks_.data();
+  const SpringMaterial& m = cloth_->material(run.kind);
+  switch (SideOf(run.kind, settings_.buckling)) {
+    case SpringSide::kBoth:
+      AccumulateRunLanes<SpringSide::kBoth>(blocks, run, shared, m.stiffness, m.damping, x, v,
+                                            forces);
+      break;
+    case SpringSide::kStretched:
+      AccumulateRunLanes<SpringSide::kStretched>(blocks, run, shared, m.stiffness, m.damping, x, v,
+                                                 forces);
+      break;
+    case SpringSide::kCompressed:
+      AccumulateRunLanes<SpringSide::kCompressed>(blocks, run, shared, m.stiffness, m.damping, x, v,
+                                                  forces);
+      break;
+  }
+}
+
+// External forces: gravity, plus damping and fluid drag treated implicitly (a per-particle rate
+// r = damping + drag * area / m, v' = (v + h (g + a_spring + r_drag * wind)) / (1 + h r)), which
+// is unconditionally stable for any rate; the spring forces of explicit Euler stay explicit
+// (paper A eq. 1).
+void ClothSolver::Integrate(ClothState* state, const Substep& sub) {
+  const Cloth& cloth = *cloth_;
+  const float* inverse_mass = cloth.inverse_masses().data();
+  const float* area = cloth.areas().data();
+  Float3* x = state->positions.data();
+  Float3* x_start = state->previous_positions.data();
+  Float3* v = state->velocities.data();
+  const Float3* forces = forces_.data();
+  const bool verlet = settings_.integrator == ClothIntegrator::kVerlet;
+  const Float3 g = settings_.gravity;
+  const Float3 wind = settings_.wind;
+  const float h = sub.h;
+  const float damping = settings_.damping;
+  const float drag = settings_.drag;
+  const int64_t n = static_cast<int64_t>(state->positions.size());
+  // Barrier at the end: ApplyAttachments writes particles other threads read here.
+#pragma omp for schedule(static)
+  for (int64_t i = 0; i < n; ++i) {
+    const Float3 xi = x[i];
+    x_start[i] = xi;
+    const float w = inverse_mass[i];
+    if (w == 0.f) continue;  // pinned or attached: moved by the caller or ApplyAttachments
+    const float drag_rate = drag * area[i] * w;  // 1/s
+    const float rate = damping + drag_rate;
+    Float3 a = g + wind * drag_rate;
+    if (!verlet) a += forces[i] * w;
+    const Float3 v_new = (v[i] + a * h) * (1.f / (1.f + h * rate));
+    // Verlet (paper B eq. 4): x + (x - x_prev) + h^2 a, with x - x_prev = h v; the velocity is
+    // re-estimated from positions after the spring correction. Euler: v' and x + h v'.
+    if (!verlet) v[i] = v_new;
+    x[i] = xi + v_new * h;
+  }
+}
+
+void ClothSolver::ApplyAttachments(ClothState* state, const ClothFrame& frame, const Substep& sub) {
+  const float s = sub.s1;
+  Float3* x = state->positions.data();
+  const ClothAttachment* attachments = cloth_->attachments().data();
+  const int64_t count = static_cast<int64_t>(cloth_->attachments().size());
+#pragma omp for schedule(static)
+  for (int64_t k = 0; k < count; ++k) {
+    const ClothAttachment& a = attachments[k];
+    const size_t j = static_cast<size_t>(a.joint);
+    const Float3 start = TransformPoint(frame.skinning_start[j], a.bind_position);
+    const Float3 end = TransformPoint(frame.skinning_end[j], a.bind_position);
+    x[a.particle] = start * (1.f - s) + end * s;  // exactly `end` at s = 1
+  }
+}
+
+// Works on the solver's copy of the positions (16-byte aligned particles for the SSE loads),
+// copied in and out once per substep. Spring order: see BuildSpringGroups.
+void ClothSolver::SolveSprings(ClothState* state) {
+  Float3* x = state->positions.data();
+  Particle4* p = solver_positions_.data();
+  const int64_t n = static_cast<int64_t>(state->positions.size());
+  const SpringGroup* chunks = chunk_groups_.data();
+  const SpringGroup* even = even_zones_.data();
+  const SpringGroup* odd = odd_zones_.data();
+  const int64_t chunk_count = static_cast<int64_t>(chunk_groups_.size());
+  const int64_t even_count = static_cast<int64_t>(even_zones_.size());
+  const int64_t odd_count = static_cast<int64_t>(odd_zones_.size());
+#pragma omp for schedule(static)
+  for (int64_t i = 0; i < n; ++i) p[i] = Particle4{x[i].x, x[i].y, x[i].z, 0.f};
+  for (uint32_t it = 0; it < settings_.iterations; ++it) {
+#pragma omp for schedule(static)
+    for (int64_t g = 0; g < chunk_count; ++g) CorrectGroup(chunks[g], p);
+#pragma omp for schedule(static)
+    for (int64_t g = 0; g < even_count; ++g) CorrectGroup(even[g], p);
+#pragma omp for schedule(static)
+    for (int64_t g = 0; g < odd_count; ++g) CorrectGroup(odd[g], p);
+    for (uint32_t r = far_runs_.run_begin; r < far_runs_.run_end; ++r)
+      CorrectRun(runs_[r], true, p);
+  }
+#pragma omp for schedule(static) nowait
+  for (int64_t i = 0; i < n; ++i) x[i] = Float3{p[i].x, p[i].y, p[i].z};
+}
+
+void ClothSolver::CorrectGroup(const SpringGroup& group, Particle4* p) const {
+  for (uint32_t r = group.run_begin; r < group.run_end; ++r) CorrectRun(runs_[r], false, p);
+}
+
+// One run of springs of one kind: sequentially on the calling thread, or shared among the
+// threads of the enclosing region.
+void ClothSolver::CorrectRun(const SpringRun& run, bool shared, Particle4* p) const {
+  const SpringBlock* blocks = blocks_.data();
+  const float correction = cloth_->material(run.kind).correction;
+  const bool simd = settings_.simd;
+  switch (SideOf(run.kind, settings_.buckling)) {
+    case SpringSide::kBoth:
+      shared ? CorrectRunShared<SpringSide::kBoth>(blocks, run, correction, simd, p)
+             : CorrectRunSequential<SpringSide::kBoth>(blocks, run, correction, simd, p);
+      break;
+    case SpringSide::kStretched:
+      shared ? CorrectRunShared<SpringSide::kStretched>(blocks, run, correction, simd, p)
+             : CorrectRunSequential<SpringSide::kStretched>(blocks, run, correction, simd, p);
+      break;
+    case SpringSide::kCompressed:
+      shared ? CorrectRunShared<SpringSide::kCompressed>(blocks, run, correction, simd, p)
+             : CorrectRunSequential<SpringSide::kCompressed>(blocks, run, correction, simd, p);
+      break;
+  }
+}
+
+void ClothSolver::UpdateVelocities(ClothState* state, const Substep& sub) {
+  const Float3* x = state->positions.data();
+  const Float3* x_start = state->previous_positions.data();
+  Float3* v = state->velocities.data();
+  const float inv_h = 1.f / sub.h;
+  if (settings_.integrator == ClothIntegrator::kVerlet) {
+    const int64_t n = static_cast<int64_t>(state->positions.size());
+#pragma omp for schedule(static)
+    for (int64_t i = 0; i < n; ++i) v[i] = (x[i] - x_start[i]) * inv_h;
+  } else {
+    const uint32_t* kinematic = cloth_->kinematic_particles().data();
+    const int64_t count = static_cast<int64_t>(cloth_->kinematic_particles().size());
+#pragma omp for schedule(static)
+    for (int64_t k = 0; k < count; ++k) {
+      const uint32_t i = kinematic[k];
+      v[i] = (x[i] - x_start[i]) * inv_h;
+    }
+  }
+}
+
+Status ClothSolver::Collide(ClothState* state, const ClothColliders& colliders, const Substep& sub,
+                            ClothStepStats* stats) {
+  merge_flags_ = false;
+  if (colliders.hulls == nullptr && colliders.body_map == nullptr) {
+    std::memset(flags_.data(), 0, flags_.size());
+    return Status::Ok();
+  }
+  // Colliders see every particle; RestoreKinematic undoes what they do to kinematic ones.
+  const std::span<const uint32_t> kinematic = cloth_->kinematic_particles();
+  for (size_t k = 0; k < kinematic.size(); ++k) {
+    kinematic_positions_[k] = state->positions[kinematic[k]];
+    kinematic_velocities_[k] = state->velocities[kinematic[k]];
+  }
+  restore_kinematic_ = true;
+  const std::span<const Float3> x_start = state->previous_positions;
+  if (colliders.hulls != nullptr) {
+    if (Status s = colliders.hulls->SelectSubstep(sub.s0, sub.s1); !s.ok()) return s;
+    uint32_t contacts = 0;
+    if (Status s =
+            colliders.hulls->CollideBatch(x_start, state->positions, state->velocities, flags_,
+                                          colliders.response, sub.s0, sub.s1, &contacts);
+        !s.ok())
+      return s;
+    stats->hull_contacts += contacts;
+  }
+  if (colliders.body_map != nullptr) {
+    merge_flags_ = colliders.hulls != nullptr;
+    uint32_t contacts = 0;
+    if (Status s = colliders.body_map->CollideBatch(x_start, state->positions, state->velocities,
+                                                    merge_flags_ ? body_map_flags_ : flags_,
+                                                    colliders.response, &contacts);
+        !s.ok())
+      return s;
+    stats->body_map_contacts += contacts;
+  }
+  return Status::Ok();
+}
+
+void ClothSolver::RestoreKinematic(ClothState* state) {
+  if (!restore_kinematic_) return;
+  restore_kinematic_ = false;
+  const std::span<const uint32_t> kinematic = cloth_->kinematic_particles();
+  for (size_t k = 0; k < kinematic.size(); ++k) {
+    const uint32_t i = kinematic[k];
+    state->positions[i] = kinematic_positions_[k];
+    state->velocities[i] = kinematic_velocities_[k];
+    flags_[i] = 0;
+    body_map_flags_[i] = 0;
+  }
+}
+
+uint32_t ClothSolver::FirstNonFinite(const ClothState& state) const {
+  const Float3* x = state.positions.data();
+  const Float3* v = state.velocities.data();
+  const int64_t n = static_cast<int64_t>(state.positions.size());
+  // a - a is +0 for every finite a and NaN for infinities and NaN, so the sum below is 0 exactly
+  // when all six components are finite (an integer OR: the same in any order).
+  uint32_t any_bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : any_bad) if (n >= kParallelParticles)
+  for (int64_t i = 0; i < n; ++i) {
+    const Float3 p = x[i], u = v[i];
+    const float zero =
+        (((p.x - p.x) + (p.y - p.y)) + ((p.z - p.z) + (u.x - u.x))) + ((u.y - u.y) + (u.z - u.z));
+    any_bad |= static_cast<uint32_t>(!(zero == 0.f));
+  }
+  if (any_bad == 0) return kNoParticle;
+  for (int64_t i = 0; i < n; ++i)  // rare: the first one in order
+    if (!IsFinite(x[i]) || !IsFinite(v[i])) return static_cast<uint32_t>(i);
+  return kNoParticle;
+}
+
+uint32_t ClothSolver::CountContacts() {
+  uint8_t* flags = flags_.data();
+  const uint8_t* extra = body_map_flags_.data();
+  const bool merge = merge_flags_;
+  const int64_t n = static_cast<int64_t>(flags_.size());
+  uint32_t contacts = 0;
+#pragma omp parallel for schedule(static) reduction(+ : contacts) if (n >= kParallelParticles)
+  for (int64_t i = 0; i < n; ++i) {
+    if (merge) flags[i] = static_cast<uint8_t>(flags[i] | extra[i]);
+    contacts += flags[i] & kCollisionContact;
+  }
+  return contacts;
+}
+
+void ClothSolver::RestoreBackup(ClothState* state) {
+  const size_t bytes = state->positions.size() * sizeof(Float3);
+  std::memcpy(state->positions.data(), backup_positions_.data(), bytes);
+  std::memcpy(state->previous_positions.data(), backup_positions_.data(), bytes);
+  std::memcpy(state->velocities.data(), backup_velocities_.data(), bytes);
+  restore_kinematic_ = false;
+}
+
+float ClothSolver::MaxStretch(const ClothState& state) const {
+  const Cloth& cloth = *cloth_;
+  if (cloth.spring_count(SpringKind::kStretch) == 0) return 0.f;
+  const ClothSpring* springs = cloth.springs().data();
+  const Float3* x = state.positions.data();
+  float max_stretch = -1.f;  // a spring of length 0 has stretch -1
+  const bool parallel = static_cast<int64_t>(cloth.springs().size()) >= kParallelSprings;
+#pragma omp parallel if (parallel)
+  for (const SpringColour& colour : cloth.colours()) {
+    if (colour.kind != SpringKind::kStretch) continue;
+    const int64_t begin = colour.begin, end = colour.end;
+    // Float max is exact and order-independent. Each thread skips the square root and division
+    // for springs clearly below its running max (L^2 < (R (1 + max))^2 (1 - 1e-5): a margin far
+    // above the rounding of the test), so the result is the exact max at any thread count. The
+    // private copies start at -FLT_MAX (OpenMP's identity for max), hence the clamp to -1.
+#pragma omp for schedule(static) reduction(max : max_stretch)
+    for (int64_t k = begin; k < end; ++k) {
+      const ClothSpring& s = springs[k];
+      const Float3 d = x[s.b] - x[s.a];
+      const float length_squared = Dot(d, d);
+      const float bound = s.rest_length * (1.f + std::max(max_stretch, -1.f));
+      if (length_squared < bound * bound * (1.f - 1e-5f)) continue;
+      max_stretch = std::max(max_stretch, std::sqrt(length_squared) / s.rest_length - 1.f);
+    }
+  }
+  return max_stretch;
+}
+
+}  // namespace drape
