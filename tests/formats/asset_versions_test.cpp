@@ -1,0 +1,154 @@
+// Format and class versions: a newer or older format version and an unknown class version are
+// refused by name; each format version holds exactly its own BodyMapPose version; files of the
+// older formats load as one-layer poses (dense ones for format 1).
+
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "asset_fixtures.h"
+#include "drape/formats/asset_file.h"
+#include "test_support.h"
+
+namespace drape {
+namespace {
+
+using test::Encode;
+using test::FixChecksums;
+using test::LayeredAsset;
+using test::ReadBytes;
+using test::SmallAsset;
+
+TEST(AssetFile, NewerAndOlderFormatVersionsAreRefusedByName) {
+  for (uint32_t version : {0u, kAssetFormatVersion + 1}) {
+    std::vector<uint8_t> bytes = Encode(SmallAsset());
+    for (int i = 0; i < 4; ++i) bytes[8 + i] = static_cast<uint8_t>(version >> (8 * i));
+    FixChecksums(bytes);
+    CharacterAsset out;
+    const Status s = DecodeAsset(bytes, "v.drape", &out);
+    EXPECT_EQ(s.code(), StatusCode::kUnsupportedVersion);
+    EXPECT_NE(s.message().find(version > kAssetFormatVersion ? "is newer" : "is older"),
+              std::string::npos)
+        << s.message();
+  }
+}
+
+TEST(AssetFile, UnknownTypeVersionIsRefusedByTypeName) {
+  std::vector<uint8_t> bytes = Encode(SmallAsset());
+  // Payload: 1 byte of cereal endianness, then CharacterAsset's uint32 class version.
+  ASSERT_EQ(bytes[kAssetHeaderSize + 1], 1);
+  bytes[kAssetHeaderSize + 1] = 2;
+  FixChecksums(bytes);
+  CharacterAsset out;
+  const Status s = DecodeAsset(bytes, "t.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("unsupported version 2 of CharacterAsset"), std::string::npos)
+      << s.message();
+}
+
+// A format version 1 file holds only class version 1: a version 2 or 3 pose under a version 1
+// header is refused, and an older class version of BodyMapPose is read as dense with one layer
+// (the golden files).
+TEST(BodyMapLayout, FormatVersion1HoldsOnlyDensePoses) {
+  std::vector<uint8_t> bytes = Encode(SmallAsset());  // BodyMapPose version 3
+  bytes[8] = 1;
+  FixChecksums(bytes);
+  CharacterAsset out;
+  Status s = DecodeAsset(bytes, "v1.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("BodyMapPose version 3 in a format version 1 file"), std::string::npos)
+      << s.message();
+  // mannequin_v2.drape holds a BodyMapPose version 2: under a version 1 header it is refused too.
+  bytes = ReadBytes(test::GoldenDir() + "/mannequin_v2.drape");
+  ASSERT_GT(bytes.size(), kAssetHeaderSize);
+  bytes[8] = 1;
+  FixChecksums(bytes);
+  s = DecodeAsset(bytes, "v1.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_NE(s.message().find("BodyMapPose version 2 in a format version 1 file"), std::string::npos)
+      << s.message();
+  EXPECT_TRUE(out.body_maps.poses.empty());
+  // mannequin_colliders_v1.drape was written by the format version 1 writer with a body-map pose.
+  CharacterAsset golden;
+  const Status g = ReadAssetFile(test::GoldenDir() + "/mannequin_colliders_v1.drape", &golden);
+  ASSERT_TRUE(g.ok()) << g.message();
+  ASSERT_EQ(golden.body_maps.poses.size(), 1u);
+  const BodyMapPose& pose = golden.body_maps.poses[0];
+  EXPECT_EQ(pose.layout, BodyMapLayout::kDense);
+  EXPECT_EQ(pose.layers, 1);
+  EXPECT_TRUE(pose.row_span_offsets.empty() && pose.span_begin.empty());
+  EXPECT_EQ(BodyMapStoredTexels(pose), static_cast<size_t>(pose.width) * pose.height);
+  EXPECT_EQ(pose.depth_u16[0].size(), static_cast<size_t>(pose.width) * pose.height);
+}
+
+// `bytes` (a file holding a BodyMapPose of class version `pose_version`) under a format
+// `format_version` header, checksums fixed: refused as corrupt, naming both versions, no pose.
+void ExpectPoseVersionRefused(std::vector<uint8_t> bytes, uint32_t format_version,
+                              uint32_t pose_version) {
+  bytes[8] = static_cast<uint8_t>(format_version);
+  FixChecksums(bytes);
+  CharacterAsset out;
+  const std::string name = "v" + std::to_string(format_version) + ".drape";
+  const Status s = DecodeAsset(bytes, name, &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(), name + ": BodyMapPose version " + std::to_string(pose_version) +
+                             " in a format version " + std::to_string(format_version) + " file");
+  EXPECT_TRUE(out.body_maps.poses.empty());
+}
+
+// Files of format versions 1 and 2 load with one layer; a BodyMapPose version 3 cannot be in
+// them.
+TEST(BodyMapLayers, OlderFormatsLoadWithOneLayerAndCannotHoldLayers) {
+  CharacterAsset v2;
+  ASSERT_TRUE(ReadAssetFile(test::GoldenDir() + "/mannequin_v2.drape", &v2).ok());
+  ASSERT_EQ(v2.body_maps.poses.size(), 1u);
+  EXPECT_EQ(v2.body_maps.poses[0].layers, 1);
+  // Written again as format version 3, it reads the same.
+  CharacterAsset again;
+  ASSERT_TRUE(DecodeAsset(Encode(v2), "v3.drape", &again).ok());
+  EXPECT_EQ(AssetToJson(again), AssetToJson(v2));
+  // A version 3 pose under a format version 2 header.
+  ExpectPoseVersionRefused(Encode(LayeredAsset()), 2, 3);
+}
+
+// A format version holds exactly its own BodyMapPose version. SmallAsset's pose rewritten as
+// class version 2 (the layers byte removed) is a valid format version 2 file, and refused under
+// a format version 3 header: no writer wrote it, and it would not re-encode to the same bytes.
+TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
+  const CharacterAsset small = SmallAsset();
+  std::vector<uint8_t> bytes = Encode(small);
+  // Class version 3, clip -1, time 0, width 2, height 2 (the pose's first fields).
+  // clang-format off
+  const std::vector<uint8_t> start = {3, 0, 0, 0,  0xFF, 0xFF, 0xFF, 0xFF,  0, 0, 0, 0,
+                                      2, 0, 0, 0,  2, 0, 0, 0};
+  // clang-format on
+  const auto found = std::search(bytes.begin(), bytes.end(), start.begin(), start.end());
+  ASSERT_NE(found, bytes.end());
+  const size_t pose = static_cast<size_t>(found - bytes.begin());
+  // 4 class version, 36 of clip .. depth_range, 2 encodings, 1 layout: then layers.
+  const size_t layers_at = pose + 4 + 36 + 2 + 1;
+  ASSERT_EQ(bytes[layers_at], 1);
+  bytes[pose] = 2;
+  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(layers_at));
+  // The dense pose's empty span table (three uint64 counts), then gap_texels' count: remove it.
+  const size_t gap_count_at = layers_at + 3 * 8;
+  for (size_t i = 0; i < 8; ++i) ASSERT_EQ(bytes[gap_count_at + i], 0) << i;
+  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at),
+              bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at + 8));
+  const uint64_t payload = bytes.size() - kAssetHeaderSize;
+  for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
+  bytes[8] = 2;
+  FixChecksums(bytes);
+  CharacterAsset v2;
+  const Status read = DecodeAsset(bytes, "v2.drape", &v2);
+  ASSERT_TRUE(read.ok()) << read.message();
+  EXPECT_EQ(v2.body_maps.poses[0].layers, 1);
+  EXPECT_EQ(AssetToJson(v2), AssetToJson(small));
+  ExpectPoseVersionRefused(bytes, 3, 2);
+}
+
+}  // namespace
+}  // namespace drape
