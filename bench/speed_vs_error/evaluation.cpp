@@ -63,8 +63,7 @@ double AngleDegrees(Float3 a, const double b[3]) {
 
 }  // namespace
 
-std::vector<ReferenceAnswer> AnswerQueries(const MeshReference& reference,
-                                           const QuerySet& set) {
+std::vector<ReferenceAnswer> AnswerQueries(const MeshReference& reference, const QuerySet& set) {
   std::vector<ReferenceAnswer> answers(set.size());
   const long count = static_cast<long>(set.size());
 #pragma omp parallel for schedule(dynamic, 64)

@@ -30,8 +30,7 @@ struct ReferenceAnswer {
   bool contact_expected = false;
 };
 
-std::vector<ReferenceAnswer> AnswerQueries(const MeshReference& reference,
-                                           const QuerySet& set);
+std::vector<ReferenceAnswer> AnswerQueries(const MeshReference& reference, const QuerySet& set);
 
 struct Metrics {
   size_t queries = 0;

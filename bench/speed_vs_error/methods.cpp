@@ -19,9 +19,10 @@ void DieOnError(const Status& status, const std::string& what) {
 
 class BodyMapMethod final : public Method {
  public:
-  BodyMapMethod(const BodyMapPose& pose, DepthSampling sampling, MapLanes lanes) {
-    collider_.AllowAvx2(lanes != MapLanes::kSse2);
-    collider_.AllowAvx512(lanes == MapLanes::kWidest);
+  // lanes: the widest instruction set CollideBatch may use (kNearest); every set gives the
+  // same bits.
+  BodyMapMethod(const BodyMapPose& pose, DepthSampling sampling, InstructionSet lanes) {
+    collider_.LimitInstructionSet(lanes);
     DieOnError(collider_.Build(pose, sampling), "body maps");
   }
   void Collide(std::span<const Float3> previous, std::span<Float3> positions,
@@ -59,7 +60,7 @@ class HullMethod final : public Method {
     DieOnError(set_.Build(hulls, spheres, joint_count, options), "hull colliders");
     DieOnError(set_.SetPose(skinning, skinning), "hull pose");
     HullColliderOptions four_wide = options;
-    four_wide.allow_avx2 = false;
+    four_wide.instruction_set = InstructionSet::kSse2;
     DieOnError(four_wide_set_.Build(hulls, spheres, joint_count, four_wide), "hull colliders");
     DieOnError(four_wide_set_.SetPose(skinning, skinning), "hull pose");
   }
@@ -280,7 +281,7 @@ ResponseParams BenchResponse() {
 }
 
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
-                                          std::string setting, size_t baked_bytes, MapLanes lanes) {
+                                          std::string setting, size_t baked_bytes, InstructionSet lanes) {
   auto method = std::make_unique<BodyMapMethod>(pose, sampling, lanes);
   method->family = "maps";
   method->setting = std::move(setting);

@@ -60,14 +60,11 @@ class Method {
   bool speed_only = false;   // no accuracy metrics (its answers do not classify inside)
 };
 
-// The lanes CollideBatch may take (kNearest): the widest the CPU has, eight AVX2 ones without
-// AVX-512, or four SSE2 ones. The answers are the same bits.
-enum class MapLanes { kWidest, kAvx2, kSse2 };
 
 // Paper A's body maps of one pose.
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
                                           std::string setting, size_t baked_bytes,
-                                          MapLanes lanes = MapLanes::kWidest);
+                                          InstructionSet lanes = InstructionSet::kAvx2);
 
 // Paper B's colliders at one pose (skinning applied at the start and the end of the step).
 // Either list may be empty (hulls alone, joint spheres alone).
