@@ -1,0 +1,19 @@
+#pragma once
+// The OBJ reader of OBJ garments: `v` and `f` lines, polygons fanned.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drape/formats/status.h"
+#include "drape/formats/types.h"
+
+namespace drape::bake::detail {
+
+// Reads the vertices and the triangles (0-based; negative OBJ indices count back from the
+// vertices read so far) of `file`. Messages start with `where` (the scene and its JSON path) and
+// name the file and line.
+Status ReadObj(const std::string& file, const std::string& where, std::vector<Float3>* positions,
+               std::vector<uint32_t>* triangles);
+
+}  // namespace drape::bake::detail
