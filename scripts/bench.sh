@@ -5,11 +5,14 @@
 #   scripts/bench.sh --quick      the reduced sweep, fewer motions (about a minute)
 #   scripts/bench.sh --gbench     also every Google Benchmark program (bench_*), output in
 #                                 out/bench/gbench/*.json
+# Then it writes out/bench/PERFORMANCE.md (scripts/performance_doc.py: docs/PERFORMANCE.md's
+# shape, this run's figures, machine, command and commit) with its charts in out/bench/images/.
 # Installs what is missing, builds the bench preset (Release + benchmarks), runs on two cores.
 # Figures depend on the machine and its load: run it on an idle machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${DRAPE_JOBS:-2}
+load_start=$(cut -d ' ' -f 1-3 /proc/loadavg)  # before this command's own build and runs
 quick=()
 gbench=0
 for arg in "$@"; do
@@ -21,21 +24,55 @@ for arg in "$@"; do
 done
 scripts/setup.sh
 cmake --preset bench >/dev/null
-cmake --build build-bench -j "$jobs" --target drape-speed-vs-error
+targets=(drape-speed-vs-error)
+if [ "$gbench" = 1 ]; then
+  for source in bench/gbench/*_bench.cpp; do
+    name=$(basename "$source" .cpp)
+    targets+=("bench_${name%_bench}")
+  done
+fi
+cmake --build build-bench -j "$jobs" --target "${targets[@]}"
+
 out=out/bench
 mkdir -p "$out"
+# What the generated document states about this run (read by scripts/performance_doc.py).
+compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' build-bench/CMakeCache.txt)
+{
+  echo "command=scripts/bench.sh${*:+ $*}"
+  echo "commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  if [ -n "$(git status --porcelain --untracked-files=no 2>/dev/null)" ]; then
+    echo "worktree=modified"
+  else
+    echo "worktree=clean"
+  fi
+  echo "date=$(date -u +%Y-%m-%d)"
+  echo "cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)"
+  echo "cores=$(nproc)"
+  echo "compiler=$("${compiler:-c++}" --version | head -n 1)"
+  echo "preset=bench (Release, -DDRAPE_BUILD_BENCH=ON)"
+  echo "quick=$([ ${#quick[@]} -gt 0 ] && echo 1 || echo 0)"
+  echo "gbench=$gbench"
+  echo "omp=OMP_PROC_BIND=${OMP_PROC_BIND:-close} OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-(default)}"
+  echo "load_start=$load_start"
+} >"$out/run_info.txt"
+
 OMP_PROC_BIND=${OMP_PROC_BIND:-close} build-bench/bin/drape-speed-vs-error --out "$out" \
   --character all "${quick[@]}"
 if [ "$gbench" = 1 ]; then
-  cmake --build build-bench -j "$jobs"
   mkdir -p "$out/gbench"
-  for b in build-bench/bin/bench_*; do
-    name=$(basename "$b")
-    echo "== $name"
-    "$b" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
-      --benchmark_out="$out/gbench/$name.json" --benchmark_out_format=json
+  rm -f "$out"/gbench/*.json
+  for b in "${targets[@]:1}"; do
+    echo "== $b"
+    "build-bench/bin/$b" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+      --benchmark_out="$out/gbench/$b.json" --benchmark_out_format=json
   done
 fi
+echo "load_end=$(cut -d ' ' -f 1-3 /proc/loadavg)" >>"$out/run_info.txt"
+
+python3 scripts/performance_doc.py --out "$out"
 echo
 echo "bench: $out/speed_vs_error.csv (every row), $out/speed_vs_error.md (tables, targets),"
-echo "       $out/speed_vs_error.png (chart of the first character; one per character beside it)."
+echo "       $out/speed_vs_error.png (chart of the first character; one per character beside it),"
+echo "       $out/PERFORMANCE.md (the current state, with its charts in $out/images/)."
+echo "To adopt this run's figures (an idle machine, the full sweep with --gbench):"
+echo "  cp $out/PERFORMANCE.md docs/ && cp $out/images/*.png docs/images/"
