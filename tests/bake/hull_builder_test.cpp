@@ -250,16 +250,6 @@ void ExpectValidCollider(const std::vector<Float3>& points, const HullOptions& o
   EXPECT_NEAR(s.obb_volume, 8.f * half[0] * half[1] * half[2], 1e-6f * s.obb_volume);
 }
 
-std::string Describe(const HullStats& s) {
-  return "points " + std::to_string(s.input_points) + ", H0 " +
-         std::to_string(s.hull_triangles_before) + " tris / " + std::to_string(s.planes_before) +
-         " planes -> " + std::to_string(s.triangles_after) + " tris / " +
-         std::to_string(s.planes_after) + " planes, growth " + std::to_string(s.growth_mm) +
-         " mm, " + std::to_string(s.ms) + " ms (simplify " + std::to_string(s.simplify_ms) +
-         " ms, " + std::to_string(s.evaluations) + " evaluations, " + std::to_string(s.collapses) +
-         " collapses, " + std::to_string(s.rejected) + " rejected)";
-}
-
 TEST(HullBuilder, RandomCloudDefaults) {
   const std::vector<Float3> points = RandomCloud(1, 300, F3(0.1, -0.2, 0.3), F3(0.05, 0.08, 0.04));
   const HullOptions options;
@@ -267,7 +257,6 @@ TEST(HullBuilder, RandomCloudDefaults) {
   ExpectValidCollider(points, options, built);
   EXPECT_TRUE(built.stats.budget_reached);
   EXPECT_GT(built.stats.hull_triangles_before, options.max_triangles);
-  std::cout << "random 300: " << Describe(built.stats) << "\n";
 }
 
 TEST(HullBuilder, ForearmAndCube) {
@@ -277,14 +266,12 @@ TEST(HullBuilder, ForearmAndCube) {
     options.max_triangles = budget;
     const Built built = Build(forearm, options);
     ExpectValidCollider(forearm, options, built);
-    std::cout << "forearm budget " << budget << ": " << Describe(built.stats) << "\n";
   }
   const std::vector<Float3> cube = Cube(0.05);
   HullOptions options;
   options.max_triangles = 16;
   const Built built = Build(cube, options);
   ExpectValidCollider(cube, options, built);
-  std::cout << "cube: " << Describe(built.stats) << "\n";
 }
 
 TEST(HullBuilder, FlatDiscIsInflatedToASolid) {
@@ -329,7 +316,6 @@ TEST(HullBuilder, TriangleBudgetsAndGrowthBound) {
     const Built built = Build(points, options);
     ExpectValidCollider(points, options, built);
     EXPECT_TRUE(built.stats.budget_reached) << budget;
-    std::cout << "budget " << budget << ": " << Describe(built.stats) << "\n";
     previous_growth = built.stats.growth_mm;
   }
   EXPECT_LT(previous_growth, 5.f);  // 400 triangles: barely simplified
@@ -341,7 +327,6 @@ TEST(HullBuilder, TriangleBudgetsAndGrowthBound) {
   ExpectValidCollider(points, tight, built);
   EXPECT_FALSE(built.stats.budget_reached);
   EXPECT_LE(built.stats.growth_mm, 1.f + 1e-4f);
-  std::cout << "growth bound 1 mm: " << Describe(built.stats) << "\n";
 }
 
 TEST(HullBuilder, SimplifyModes) {
@@ -358,7 +343,6 @@ TEST(HullBuilder, SimplifyModes) {
     } else {
       EXPECT_LT(built.stats.triangles_after, built.stats.hull_triangles_before);
     }
-    std::cout << "mode " << static_cast<int>(mode) << ": " << Describe(built.stats) << "\n";
   }
 }
 
@@ -411,11 +395,9 @@ TEST(HullBuilder, ObbModes) {
   // Same collider, different box.
   EXPECT_EQ(covariance.collider.vertices.size(), optimal.collider.vertices.size());
   const float ratio = optimal.stats.obb_volume / covariance.stats.obb_volume;
-  std::cout << "OBB volume: covariance " << covariance.stats.obb_volume << " m^3, CGAL "
-            << optimal.stats.obb_volume << " m^3 (ratio " << ratio << "), CGAL took "
-            << optimal.stats.obb_ms << " ms\n";
   // The optimiser is a heuristic; on an elongated cloud it should not be much worse than PCA.
-  EXPECT_LT(ratio, 1.1f);
+  EXPECT_LT(ratio, 1.1f) << "OBB volume: covariance " << covariance.stats.obb_volume
+                         << " m^3, CGAL " << optimal.stats.obb_volume << " m^3";
   // Seeded: two runs agree.
   const Built again = Build(points, options);
   EXPECT_EQ(std::memcmp(&again.collider.obb, &optimal.collider.obb, sizeof(Obb)), 0);
@@ -459,7 +441,6 @@ TEST(HullBuilder, DegenerateInputs) {
   std::vector<Float3> far = RandomCloud(30, 100, F3(1e4, -1e4, 1e4), F3(0.1, 0.1, 0.1));
   const Built far_built = Build(far, options);
   ExpectValidCollider(far, options, far_built);
-  std::cout << "far: " << Describe(far_built.stats) << "\n";
   // delta = 0 needs a full-dimensional input.
   HullOptions zero = options;
   zero.delta = 0.f;
