@@ -1,0 +1,247 @@
+"""The Google Benchmark tables of PERFORMANCE.md (scripts/performance_doc.py): reads the JSON that
+scripts/bench.sh --gbench writes (median aggregates) and writes one table per program."""
+
+import json
+import math
+import os
+import re
+import sys
+
+from performance_doc_format import mm, ns, pair, span
+
+
+def read_gbench(out):
+    """{program: {(benchmark, (args...)): entry}}: the median aggregates (or single runs)."""
+    programs = {}
+    directory = os.path.join(out, "gbench")
+    if not os.path.isdir(directory):
+        return programs
+    for name in sorted(os.listdir(directory)):
+        if not name.endswith(".json"):
+            continue
+        with open(os.path.join(directory, name), encoding="utf-8") as f:
+            text = f.read()
+        try:
+            data = json.loads(re.sub(r"-nan\b", "NaN", text))
+        except ValueError as error:
+            print(f"performance_doc: {name}: {error}; skipped", file=sys.stderr)
+            continue
+        entries = {}
+        for b in data.get("benchmarks", []):
+            aggregate = b.get("aggregate_name")
+            if b.get("run_type") == "aggregate" and aggregate != "median":
+                continue
+            parts = b.get("run_name", b["name"]).split("/")
+            decorations = ("real_time", "iterations:", "min_time:", "repeats:", "threads:")
+            args = tuple(p.split(":")[-1] for p in parts[1:] if not p.startswith(decorations))
+            key = (parts[0], args)
+            if aggregate == "median" or key not in entries:
+                entries[key] = b
+        programs[name[:-len(".json")]] = entries
+    return programs
+
+
+def value(gb, program, name, args, field="ns_per_particle"):
+    entry = gb.get(program, {}).get((name, tuple(str(a) for a in args)))
+    if entry is None:
+        return None
+    v = entry.get(field)
+    if field in ("real_time", "cpu_time") and v is not None:  # to ms
+        scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[entry.get("time_unit", "ns")]
+        v *= scale
+    return None if v is None or (isinstance(v, float) and math.isnan(v)) else v
+
+
+def body_map_queries(doc, gb):
+    p = "bench_body_map_query"
+    if p not in gb:
+        return
+    doc.add("## Body maps at run time", "",
+            "`bench_body_map_query`: analytic maps of a 0.3 m sphere and of a 1.7 m figure of 10 "
+            "capsules in a 1.8 m window; particles 2 mm in front of the surface, half of them "
+            "moving through it: resting (steps up to 0.02 texel, cloth lying on the body), "
+            "sliding (0.1–0.5 texel) or stepping (1–2 texels). ns per particle, median of 3; "
+            "each cell spans the two shapes, one thread / two where the call is parallel.", "",
+            "| query | N = 512 | N = 1024 |", "|---|---|---|")
+
+    def shapes(name, args, threads=None):
+        def one(n, t):
+            rest = args if t is None else (t,) + args
+            return span([value(gb, p, name, (s, n) + rest) for s in (0, 1)], ns)
+
+        cells = []
+        for n in (512, 1024):
+            cells.append(one(n, None) if threads is None else f"{one(n, 1)} / {one(n, 2)}")
+        return " | ".join(cells)
+
+    doc.add(f"| IsInside, cloth-sheet order | {shapes('BM_Inside', (0,))} |",
+            f"| IsInside, shuffled | {shapes('BM_Inside', (1,))} |",
+            f"| InsideBatch | {shapes('BM_InsideBatch', (), threads=True)} |")
+    motions = (("resting", 2), ("sliding", 0), ("stepping", 1))
+    for label, m in motions:
+        doc.add(f"| Query, nearest, {label} | {shapes('BM_Continuous', (0, m))} |")
+    for label, m in motions:
+        doc.add(f"| Query, bilinear, {label} | {shapes('BM_Continuous', (1, m))} |")
+    for lanes_count, lanes_name in ((8, "eight lanes"), (4, "four SSE2 lanes")):
+        for label, m in motions:
+            doc.add(f"| CollideBatch, {lanes_name}, {label} | "
+                    f"{shapes('BM_CollideBatch', (m, lanes_count), threads=True)} |")
+    lengths = (1, 4, 16, 64, 256)
+    doc.add("", "One `Query` per horizontal segment of a fixed length at a random depth in the "
+            "figure, N = 1024 (the walk's cost against its length), ns:", "",
+            "| sampling | " + " | ".join(f"{n} texel{'s' if n > 1 else ''}" for n in lengths)
+            + " |", "|---|" + "---|" * len(lengths))
+    for label, s in (("nearest", 0), ("bilinear", 1)):
+        doc.add(f"| {label} | " + " | ".join(ns(value(gb, p, "BM_SegmentLength", (n, s)))
+                                             for n in lengths) + " |")
+    doc.source(p)
+
+
+def hull_queries(doc, gb):
+    p = "bench_hull_query"
+    if p not in gb:
+        return
+    doc.add("## Hull colliders at run time", "",
+            "`bench_hull_query`: a tilted ellipsoid hull of 20, 80 or 320 faces (each its own "
+            "plane) with its hierarchies and map table; points half uniform in the OBB, half "
+            "within 5 mm of the surface. ns per query, one thread, median of 3.", "",
+            "| step | 20 faces | 80 faces | 320 faces |", "|---|---|---|---|")
+    levels = (0, 1, 2)
+
+    def per_level(name, rest=(), field="ns_per_particle"):
+        return " | ".join(ns(value(gb, p, name, (lv,) + rest, field)) for lv in levels)
+
+    obb = value(gb, p, "BM_ObbRejection", ())
+    doc.add(f"| OBB rejection (points in 3x the box) | - | {ns(obb)} | - |",
+            f"| plane inside test | {per_level('BM_PlaneInside')} |",
+            f"| Kirkpatrick inside test (both sides) | {per_level('BM_KirkpatrickInside')} |",
+            f"| Kirkpatrick location, one side | {per_level('BM_KirkpatrickLocate')} |")
+    tests = " | ".join(mm(value(gb, p, "BM_KirkpatrickLocate", (lv,), "node_tests"))
+                       for lv in levels)
+    doc.add(f"| node tests per location | {tests} |",
+            f"| push-out response, whole narrow phase | {per_level('BM_Response', (0,))} |",
+            f"| map-table ray response, whole narrow phase | {per_level('BM_Response', (1,))} |",
+            f"| map-table ray alone | {per_level('BM_MapTableRay')} |",
+            f"| 2 cm segment near the surface (continuous) | {per_level('BM_Segment')} |")
+    doc.add("", "`BM_Scene`: `CollideBatch` of 100 000 particles around a 1.7 m figure of 14 "
+            "hulls (80 faces) and 6 joint spheres moving over the step; ns per particle, one "
+            "thread / two:", "",
+            "| mode | within 3 cm of a surface | uniform around the figure | 5 m away |",
+            "|---|---|---|---|")
+    for label, mode in (("plane test, push-out (default)", 0), ("map-table ray", 1),
+                        ("Kirkpatrick", 2)):
+        doc.add(f"| {label} | " + " | ".join(
+            pair(value(gb, p, "BM_Scene", (1, mode, d)), value(gb, p, "BM_Scene", (2, mode, d)))
+            for d in (0, 1, 2)) + " |")
+    doc.source(p)
+
+
+def cloth(doc, gb, sections):
+    p = "bench_cloth_step"
+    title = "Simulation level: drape's cloth against Bullet's soft body"
+    if p not in gb and title not in sections:
+        return
+    doc.add("## Cloth step", "")
+    if p in gb:
+        doc.add("`bench_cloth_step`: one 1/60 s frame of a 10 100-particle skirt on a walking "
+                "pair of legs (4 box hulls, 16 joint spheres), 5 Verlet iterations per substep, "
+                "continuous collision, friction 0.3; ms per frame, median of 3. Bullet's soft "
+                "body (the peer) steps the same skirt against the same shapes, one thread; depth: "
+                "the mean over frames of the deepest particle inside a collider.", "",
+                "| setup | 1 thread | 2 threads | speed-up | depth mm |", "|---|---|---|---|---|")
+        for label, substeps, colliders in (("1 substep, with colliders", 1, 1),
+                                           ("2 substeps, with colliders", 2, 1),
+                                           ("1 substep, solver alone", 1, 0)):
+            one = value(gb, p, "BM_ClothStep", (1, substeps, colliders), "real_time")
+            two = value(gb, p, "BM_ClothStep", (2, substeps, colliders), "real_time")
+            depth = value(gb, p, "BM_ClothStep", (1, substeps, colliders), "frame_max_depth_mm")
+            up = f"{one / two:.2f}x" if one and two else "-"
+            doc.add(f"| drape, {label} | {mm(one, 2)} | {mm(two, 2)} | {up} | "
+                    f"{mm(depth, 2) if colliders else '-'} |")
+        for substeps in (1, 2):
+            t = value(gb, p, "BM_BulletSkirt", (substeps,), "real_time")
+            depth = value(gb, p, "BM_BulletSkirt", (substeps,), "frame_max_depth_mm")
+            doc.add(f"| Bullet btSoftBody, {substeps} substep{'s' if substeps > 1 else ''} | "
+                    f"{mm(t, 2)} | - | - | {mm(depth, 2)} |")
+        doc.source(p)
+    if title in sections:
+        doc.add("The same comparison on the walking mannequin, penetration measured against the "
+                "exact posed body (from `drape-speed-vs-error`):", "", sections[title])
+        doc.source("speed against error")
+
+
+def body_map_bake(doc, gb):
+    p = "bench_body_map_bake"
+    if p not in gb:
+        return
+    doc.add("## Bake: body maps", "",
+            "`bench_body_map_bake`: one pose of a UV sphere and of a capsule mannequin, about 5k "
+            "and 80k triangles. ms per view (the fastest iteration's render time, median of 3 "
+            "repetitions); the CPU rasterizer renders both views in one pass and charges each "
+            "half.", "",
+            "| mesh | renderer | N = 512 | N = 1024 | N = 2048 |", "|---|---|---|---|---|")
+    for mesh_label, mannequin in (("sphere", 0), ("mannequin", 1)):
+        for fine in (0, 1):
+            for renderer, osmesa in (("CPU", 0), ("OSMesa (llvmpipe)", 1)):
+                cells = []
+                triangles = None
+                for n in (512, 1024, 2048):
+                    args = (mannequin, fine, n, osmesa, 1)
+                    cells.append(mm(value(gb, p, "BM_BodyMapBake", args, "front_min_ms")))
+                    triangles = triangles or value(gb, p, "BM_BodyMapBake", args, "triangles")
+                if any(c != "-" for c in cells):
+                    count = (f"{triangles:,.0f}".replace(",", " ") if triangles
+                             else ("80k" if fine else "5k"))
+                    doc.add(f"| {mesh_label} {count} | {renderer} | " + " | ".join(cells) + " |")
+    gaps = [(m, value(gb, p, "BM_BodyMapBake", (m, 1, 1024, 0, 3), "gap_min_ms")) for m in (0, 1)]
+    if any(g for _, g in gaps):
+        doc.add("", "The air-gap fragment pass (`maps.layers` 3) on the 80k-triangle meshes at "
+                "N = 1024: " + ", ".join(f"{'mannequin' if m else 'sphere'} {mm(g)} ms"
+                                         for m, g in gaps) + ".")
+    doc.source(p)
+
+
+def hull_bake(doc, gb):
+    p = "bench_hull_bake"
+    if p not in gb:
+        return
+    doc.add("## Bake: hulls", "",
+            "`bench_hull_bake`: one limb-like bone (points on a tapered 25 cm capsule), δ 5 mm. "
+            "ms per bone (median of 3) and, in brackets, the growth beyond the inflated hull in "
+            "mm.", "", "| simplification, budget 100 triangles | 50 points | 200 points | "
+            "400 points |", "|---|---|---|---|")
+    modes = (("edge collapse (default)", 0), ("plane removal", 1), ("none", 2))
+    for label, mode in modes:
+        cells = []
+        for points in (50, 200, 400):
+            args = (points, mode, 100, 0)
+            t = value(gb, p, "BM_HullBake", args, "real_time")
+            g = value(gb, p, "BM_HullBake", args, "growth_mm")
+            cells.append(f"{mm(t)} ({mm(g, 2)})" if t is not None else "-")
+        doc.add(f"| {label} | " + " | ".join(cells) + " |")
+    budgets = (16, 25, 50, 100, 200, 400)
+    doc.add("", "Growth (mm) and planes against the triangle budget, 400 points:", "",
+            "| simplification | " + " | ".join(str(b) for b in budgets) + " |",
+            "|---|" + "---|" * len(budgets))
+    for label, mode in modes[:2]:
+        cells = []
+        for b in budgets:
+            args = (400, mode, b, 1)
+            g = value(gb, p, "BM_HullBake", args, "growth_mm")
+            planes = value(gb, p, "BM_HullBake", args, "planes")
+            cells.append(f"{mm(g, 2)} ({planes:.0f})" if g is not None and planes else "-")
+        doc.add(f"| {label} | " + " | ".join(cells) + " |")
+    obb = [(label, value(gb, p, "BM_HullBakeObb", (m,), "obb_ms"),
+            value(gb, p, "BM_HullBakeObb", (m,), "obb_cm3"))
+           for label, m in (("covariance", 0), ("CGAL optimal", 1))]
+    if any(t for _, t, _ in obb):
+        doc.add("", "OBB of the 400-point bone: " + "; ".join(
+            f"{label} {mm(t, 2)} ms, {mm(v, 1)} cm³" for label, t, v in obb) + ".")
+    bones = value(gb, p, "BM_CesiumManHulls", (), "bones")
+    if bones:
+        doc.add("", f"Every bone of CesiumMan, one thread: "
+                f"{mm(value(gb, p, 'BM_CesiumManHulls', (), 'real_time'))} ms for {bones:.0f} "
+                f"hulls (slowest bone {mm(value(gb, p, 'BM_CesiumManHulls', (), 'max_bone_ms'))} "
+                f"ms, mean {mm(value(gb, p, 'BM_CesiumManHulls', (), 'mean_tris'), 0)} "
+                "triangles).")
+    doc.source(p)
