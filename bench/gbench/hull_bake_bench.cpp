@@ -6,6 +6,11 @@
 //    Modes: 0 = edge collapse (default), 1 = plane removal, 2 = none.
 //  BM_HullBakeObb/<obb mode>: the same 400-point bone with the covariance or the CGAL OBB.
 //  BM_CesiumManHulls: every bone of CesiumMan (rigid threshold 0.99), one thread, default options.
+//  BM_KirkpatrickBuild/<levels>: both point-location hierarchies of a tilted ellipsoid hull
+//    (icosphere subdivided `levels` times: 80, 320, 1280 faces; default options, so the auto axis
+//    builds all three). Counters: levels and nodes per side, mean_tests (node tests per location).
+//  BM_MapTableBuild/<levels>/<rows>: the map cylinder of the same hull with rows x rows cells.
+//    Counters: mean_list, max_list, empty_cells (a conservative table has none).
 
 #include <benchmark/benchmark.h>
 
@@ -19,8 +24,11 @@
 #include "drape/bake/bake_config.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
+#include "drape/bake/kirkpatrick_builder.h"
+#include "drape/bake/map_table_builder.h"
 #include "drape/bake/regions.h"
 #include "drape/runtime/math.h"
+#include "hull_fixtures.h"
 #include "test_support.h"
 
 namespace drape::bake {
@@ -159,6 +167,60 @@ void BM_CesiumManHulls(benchmark::State& state) {
   state.counters["mean_tris"] = built > 0 ? triangles / built : 0.0;
 }
 BENCHMARK(BM_CesiumManHulls)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The elongated hull of the Kirkpatrick and map-table tests: a tilted ellipsoid 12 x 50 x 16 cm.
+HullColliderData TiltedEllipsoid(int levels) {
+  Float3 axes[3];
+  test::RotatedAxes(21.0, {0.2f, 1.f, -0.7f}, axes);
+  return test::MakeEllipsoid({0.06f, 0.25f, 0.08f}, levels, {0.f, 0.4f, 0.f}, axes);
+}
+
+void BM_KirkpatrickBuild(benchmark::State& state) {
+  const HullColliderData hull = TiltedEllipsoid(static_cast<int>(state.range(0)));
+  KirkpatrickStats stats;
+  for (auto _ : state) {
+    HullColliderData h = hull;
+    const Status status = BuildKirkpatrick(&h, KirkpatrickOptions{}, &stats);
+    if (!status.ok()) {
+      state.SkipWithError(status.message().c_str());
+      break;
+    }
+    benchmark::DoNotOptimize(h.upper.children.data());
+  }
+  state.counters["faces"] = static_cast<double>(hull.triangles.size() / 3);
+  state.counters["upper_levels"] = stats.upper.levels;
+  state.counters["lower_levels"] = stats.lower.levels;
+  state.counters["upper_nodes"] = stats.upper.nodes;
+  state.counters["lower_nodes"] = stats.lower.nodes;
+  state.counters["mean_tests"] = stats.mean_tests;
+}
+BENCHMARK(BM_KirkpatrickBuild)->ArgName("levels")->DenseRange(1, 3)->Unit(benchmark::kMillisecond);
+
+void BM_MapTableBuild(benchmark::State& state) {
+  const HullColliderData hull = TiltedEllipsoid(static_cast<int>(state.range(0)));
+  MapTableOptions options;
+  options.cylinder_rows = static_cast<uint32_t>(state.range(1));
+  options.cylinder_cols = static_cast<uint32_t>(state.range(1));
+  MapTableStats stats;
+  for (auto _ : state) {
+    HullColliderData h = hull;
+    const Status status = BuildMapTable(&h, options, &stats);
+    if (!status.ok()) {
+      state.SkipWithError(status.message().c_str());
+      break;
+    }
+    benchmark::DoNotOptimize(h.map.cell_triangles.data());
+  }
+  state.counters["faces"] = static_cast<double>(hull.triangles.size() / 3);
+  state.counters["cylinder"] = stats.kind == MapTableKind::kCylinder ? 1 : 0;
+  state.counters["mean_list"] = stats.mean_list;
+  state.counters["max_list"] = stats.max_list;
+  state.counters["empty_cells"] = stats.empty_cells;
+}
+BENCHMARK(BM_MapTableBuild)
+    ->ArgNames({"levels", "rows"})
+    ->ArgsProduct({{1, 3}, {16, 64}})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace drape::bake
