@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/normal_encoding.h"
 
 namespace drape {
 namespace {
@@ -246,10 +247,9 @@ void BM_CollideBatch(benchmark::State& state) {
   const int shape = static_cast<int>(state.range(0));
   BodyMapCollider& c =
       Collider(shape, static_cast<uint32_t>(state.range(1)), DepthSampling::kNearest);
-  // Eight lanes are the widest the CPU has (AVX2 with AVX-512 where it has that; drape-replay-maps
-  // --lanes and drape-speed-vs-error's "AVX2 lanes" settings compare the two); four are SSE2.
-  c.AllowAvx2(state.range(4) == 8);
-  if (state.range(4) == 8 && !c.uses_avx2()) {
+  // Eight lanes are AVX2's, four SSE2's (drape-replay-maps --lanes also runs the scalar pack).
+  c.LimitInstructionSet(state.range(4) == 8 ? InstructionSet::kAvx2 : InstructionSet::kSse2);
+  if (state.range(4) == 8 && c.instruction_set() != InstructionSet::kAvx2) {
     state.SkipWithError("this CPU has no AVX2");
     return;
   }

@@ -39,6 +39,7 @@
 #include "drape/bake/map_table_builder.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "hull/hull_collider_set_access.h"
 #include "hull_fixtures.h"
 
 namespace drape {
@@ -96,7 +97,7 @@ const Single& GetSingle(int levels) {
   std::shuffle(s.mixed.begin(), s.mixed.end(), rng);
   while (s.inside.size() < 65536) {
     const Float3 p = in_obb(1.f);
-    if (s.set.InsideLocal(0, p, InsideTest::kPlanes)) s.inside.push_back(p);
+    if (HullColliderSetAccess::InsideLocal(s.set, 0, p, InsideTest::kPlanes)) s.inside.push_back(p);
   }
   std::uniform_real_distribution<float> step(-0.02f, 0.02f);
   while (s.seg_a.size() < 65536) {
@@ -125,7 +126,8 @@ void BM_ObbRejection(benchmark::State& state) {
                      h.obb.axes[2] * (u(rng) * h.obb.half_extents.z));
   uint32_t kept = 0;
   for (auto _ : state) {
-    for (const Float3& p : points) kept += s.set.ObbMayContainLocal(0, p) ? 1u : 0u;
+    for (const Float3& p : points)
+      kept += HullColliderSetAccess::ObbMayContainLocal(s.set, 0, p) ? 1u : 0u;
     benchmark::DoNotOptimize(kept);
   }
   SetPerParticle(state, points.size());
@@ -137,7 +139,7 @@ void BM_PlaneInside(benchmark::State& state) {
   uint32_t inside = 0;
   for (auto _ : state) {
     for (const Float3& p : s.mixed)
-      inside += s.set.InsideLocal(0, p, InsideTest::kPlanes) ? 1u : 0u;
+      inside += HullColliderSetAccess::InsideLocal(s.set, 0, p, InsideTest::kPlanes) ? 1u : 0u;
     benchmark::DoNotOptimize(inside);
   }
   SetPerParticle(state, s.mixed.size());
@@ -150,7 +152,7 @@ void BM_KirkpatrickInside(benchmark::State& state) {
   uint32_t inside = 0;
   for (auto _ : state) {
     for (const Float3& p : s.mixed)
-      inside += s.set.InsideLocal(0, p, InsideTest::kKirkpatrick) ? 1u : 0u;
+      inside += HullColliderSetAccess::InsideLocal(s.set, 0, p, InsideTest::kKirkpatrick) ? 1u : 0u;
     benchmark::DoNotOptimize(inside);
   }
   SetPerParticle(state, s.mixed.size());
@@ -164,7 +166,7 @@ void BM_KirkpatrickLocate(benchmark::State& state) {
   for (auto _ : state) {
     for (const Float3& p : s.mixed) {
       uint32_t steps;
-      sum += s.set.LocateLocal(0, p, true, &steps);
+      sum += HullColliderSetAccess::LocateLocal(s.set, 0, p, true, &steps);
       steps_total += steps;
     }
     benchmark::DoNotOptimize(sum);
@@ -186,7 +188,7 @@ void BM_Response(benchmark::State& state) {
   uint32_t fallbacks = 0;
   for (auto _ : state) {
     for (const Float3& p : s.inside) {
-      const ContactQuery c = set.QueryHullLocal(0, p, p);
+      const ContactQuery c = HullColliderSetAccess::QueryHullLocal(set, 0, p, p);
       sum += c.point.x;
       fallbacks += (c.flags & kCollisionFallback) ? 1u : 0u;
     }
@@ -204,7 +206,7 @@ void BM_MapTableRay(benchmark::State& state) {
   for (auto _ : state) {
     for (const Float3& p : s.inside) {
       Float3 point, normal;
-      s.set.MapTableRayLocal(0, p, &point, &normal);
+      HullColliderSetAccess::MapTableRayLocal(s.set, 0, p, &point, &normal);
       sum += point.x;
     }
     benchmark::DoNotOptimize(sum);
@@ -218,7 +220,7 @@ void BM_Segment(benchmark::State& state) {
   uint32_t contacts = 0;
   for (auto _ : state) {
     for (size_t i = 0; i < s.seg_a.size(); ++i)
-      contacts += s.set.QueryHullLocal(0, s.seg_a[i], s.seg_b[i]).contact;
+      contacts += HullColliderSetAccess::QueryHullLocal(s.set, 0, s.seg_a[i], s.seg_b[i]).contact;
     benchmark::DoNotOptimize(contacts);
   }
   SetPerParticle(state, s.seg_a.size());

@@ -4,13 +4,12 @@
 // both inputs. Prints the best time per particle over the repetitions and a hash of every
 // output bit (positions, velocities, flags), so that two builds can be checked to agree.
 //
-//   drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--lanes sse2|avx2|avx512]
+//   drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--lanes scalar|sse2|avx2]
 //                     [--bilinear] [--threads N] [--check]
 //
-// --lanes caps the batch's lanes (BodyMapCollider::AllowAvx2, AllowAvx512); by default they are
-// the widest the CPU has. --check also answers the motions with every other lane path the CPU
-// has and one by one (Query, then ApplyResponse), and exits 1 unless every way gives the same
-// bits.
+// --lanes caps the batch's lanes (BodyMapCollider::LimitInstructionSet); by default they are the
+// widest the CPU has. --check also answers the motions with every other lane pack the CPU runs
+// and one by one (Query, then ApplyResponse), and exits 1 unless every way gives the same bits.
 //
 // Sampling and lanes are the runtime's choices, not the asset's: a dumped setting named
 // "bilinear" or "SSE2 lanes" replays as such with --bilinear or --lanes sse2.
@@ -41,18 +40,25 @@ using namespace drape;
   std::exit(2);
 }
 
-// The lanes a collider may take, capped at `lanes` ("sse2", "avx2", "avx512").
+// The lanes a collider may take, capped at `lanes` ("scalar", "sse2", "avx2").
 void CapLanes(BodyMapCollider* collider, const std::string& lanes) {
-  collider->AllowAvx2(lanes != "sse2");
-  collider->AllowAvx512(lanes == "avx512");
+  collider->LimitInstructionSet(lanes == "scalar" ? InstructionSet::kScalar
+                                : lanes == "sse2" ? InstructionSet::kSse2
+                                                  : InstructionSet::kAvx2);
 }
 
 // What the batch of `collider` takes.
 const char* LanesName(const BodyMapCollider& collider, bool bilinear) {
-  return bilinear                 ? "no"
-         : collider.uses_avx512() ? "eight AVX-512"
-         : collider.uses_avx2()   ? "eight AVX2"
-                                  : "four SSE2";
+  if (bilinear) return "no";
+  switch (collider.instruction_set()) {
+    case InstructionSet::kAvx2:
+      return "eight AVX2";
+    case InstructionSet::kSse2:
+      return "four SSE2";
+    case InstructionSet::kScalar:
+      return "four scalar";
+  }
+  return "unknown";
 }
 
 uint32_t ParseCount(const std::string& option, const std::string& text, uint32_t limit) {
@@ -85,7 +91,7 @@ uint64_t HashOutputs(const std::vector<Float3>& positions, const std::vector<Flo
 int main(int argc, char** argv) {
   std::vector<std::string> paths;
   uint32_t repetitions = 5, threads = 1;
-  std::string lanes = "avx512";
+  std::string lanes = "avx2";
   bool bilinear = false, check = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -99,8 +105,8 @@ int main(int argc, char** argv) {
       threads = ParseCount(arg, value(), 256);
     } else if (arg == "--lanes") {
       lanes = value();
-      if (lanes != "sse2" && lanes != "avx2" && lanes != "avx512") {
-        Fail("--lanes " + lanes + ": not sse2, avx2 or avx512");
+      if (lanes != "scalar" && lanes != "sse2" && lanes != "avx2") {
+        Fail("--lanes " + lanes + ": not scalar, sse2 or avx2");
       }
     } else if (arg == "--bilinear") {
       bilinear = true;
@@ -108,7 +114,7 @@ int main(int argc, char** argv) {
       check = true;
     } else if (arg == "--help" || arg == "-h") {
       std::printf(
-          "drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--lanes sse2|avx2|avx512] "
+          "drape-replay-maps ASSET.drape MOTIONS [--repetitions N] [--lanes scalar|sse2|avx2] "
           "[--bilinear] [--threads N] [--check]\n");
       return 0;
     } else if (!arg.empty() && arg[0] == '-') {
@@ -172,9 +178,9 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(hash));
   if (!check) return 0;
 
-  // The same motions the other ways: every lane path the CPU has, and one by one.
+  // The same motions the other ways: every lane pack the CPU runs, and one by one.
   bool agree = true;
-  for (const char* other_lanes : {"sse2", "avx2", "avx512"}) {
+  for (const char* other_lanes : {"scalar", "sse2", "avx2"}) {
     if (bilinear) break;
     BodyMapCollider other;
     CapLanes(&other, other_lanes);

@@ -14,6 +14,7 @@
 #include "drape/formats/character_asset.h"
 #include "drape/formats/status.h"
 #include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/body_map_sequence.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/hull_collider_set.h"

@@ -22,6 +22,7 @@
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "hull/hull_collider_set_access.h"
 #include "test_support.h"
 
 namespace drape {
@@ -91,7 +92,7 @@ TEST_P(BakeEveryCharacter, HullsContainTheirRigidVerticesAndAreConvex) {
     for (uint32_t v : regions.rigid_vertices[joint]) {
       const Float3 p = TransformPoint(to_local, regions.rest_positions[v]);
       // The world round trip costs a few float ulps of the coordinates: allow 1e-5 m.
-      ASSERT_LE(set.MaxPlaneDistanceLocal(h, p), 1e-5f)
+      ASSERT_LE(HullColliderSetAccess::MaxPlaneDistanceLocal(set, h, p), 1e-5f)
           << result.asset.skeleton.joint_names[joint] << " vertex " << v;
     }
   }

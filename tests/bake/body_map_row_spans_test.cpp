@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "body_map/body_map_collider_access.h"
 #include "body_map_fixtures.h"
 #include "body_map_gap_fixtures.h"
 #include "drape/bake/bake_config.h"
@@ -76,10 +77,13 @@ void ExpectLayoutsEquivalent(const BodyMapPose& dense, const BodyMapPose& spans,
     for (uint32_t j = 0; j < a.height(); ++j) {
       for (uint32_t i = 0; i < a.width(); ++i) {
         float at = 0.f, ab = 0.f, bt = 0.f, bb = 0.f;
-        const bool av = a.TexelSlab(i, j, &at, &ab), bv = b.TexelSlab(i, j, &bt, &bb);
+        const bool av = BodyMapColliderAccess::TexelSlab(a, i, j, &at, &ab),
+                   bv = BodyMapColliderAccess::TexelSlab(b, i, j, &bt, &bb);
         slab_mismatches += av != bv || Bits(at) != Bits(bt) || Bits(ab) != Bits(bb) ||
-                           !SameBits(a.TexelNormal(i, j, false), b.TexelNormal(i, j, false)) ||
-                           !SameBits(a.TexelNormal(i, j, true), b.TexelNormal(i, j, true));
+                           !SameBits(BodyMapColliderAccess::TexelNormal(a, i, j, false),
+                                     BodyMapColliderAccess::TexelNormal(b, i, j, false)) ||
+                           !SameBits(BodyMapColliderAccess::TexelNormal(a, i, j, true),
+                                     BodyMapColliderAccess::TexelNormal(b, i, j, true));
       }
     }
     EXPECT_EQ(slab_mismatches, 0u);

@@ -10,6 +10,7 @@
 #include <map>
 #include <string>
 
+#include "body_map/body_map_collider_access.h"
 #include "drape/bake/bake_config.h"
 #include "drape/bake/bake_pipeline.h"
 #include "drape/formats/asset_file.h"
@@ -134,7 +135,8 @@ TEST_P(GoldenColliders, BodyMapsKeepCoverageAndDepth) {
     const long j = std::lround(std::floor((y - c.origin_y()) / s));
     if (i < 0 || j < 0 || i >= static_cast<long>(c.width()) || j >= static_cast<long>(c.height()))
       return false;
-    return c.TexelSlab(static_cast<uint32_t>(i), static_cast<uint32_t>(j), top, bottom);
+    return BodyMapColliderAccess::TexelSlab(c, static_cast<uint32_t>(i), static_cast<uint32_t>(j),
+                                            top, bottom);
   };
   for (float y = y0 + 0.5f * s; y < y1; y += s) {
     for (float x = x0 + 0.5f * s; x < x1; x += s) {

@@ -20,6 +20,7 @@
 
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "hull/hull_collider_set_access.h"
 #include "hull_fixtures.h"
 
 namespace drape::bake {
@@ -354,18 +355,19 @@ TEST(KirkpatrickBuilderTest, KirkpatrickAndPlaneTestsAgreeOnAMillionPointsPerHul
              total[5] = {0, 0, 0, 0, 0};
     uint32_t outside_band = 0;
     for (const Sample& s : samples) {
-      const bool planes = set.InsideLocal(0, s.p, InsideTest::kPlanes);
-      const bool kirk = set.InsideLocal(0, s.p, InsideTest::kKirkpatrick);
+      const bool planes = HullColliderSetAccess::InsideLocal(set, 0, s.p, InsideTest::kPlanes);
+      const bool kirk = HullColliderSetAccess::InsideLocal(set, 0, s.p, InsideTest::kKirkpatrick);
       ++total[s.kind];
       if (planes) ++inside_count[s.kind];
       if (planes != kirk) {
         ++disagree[s.kind];
-        if (std::fabs(set.MaxPlaneDistanceLocal(0, s.p)) > band) {
+        if (std::fabs(HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, s.p)) > band) {
           ++outside_band;
           if (outside_band < 5)
             ADD_FAILURE() << named.name << ": disagreement away from the surface at (" << s.p.x
                           << ", " << s.p.y << ", " << s.p.z << ") kind " << s.kind << " planes "
-                          << planes << " max plane " << set.MaxPlaneDistanceLocal(0, s.p);
+                          << planes << " max plane "
+                          << HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, s.p);
         }
       }
     }
@@ -410,14 +412,14 @@ TEST(KirkpatrickBuilderTest, AxisAlignedBoxSurfacePointsAreInsideForBothTests) {
             c[(fixed + 1) % 3] = he[(fixed + 1) % 3] * (float(i) / 4.f - 1.f);
             c[(fixed + 2) % 3] = he[(fixed + 2) % 3] * (float(j) / 4.f - 1.f);
             const Float3 p{c[0], c[1], c[2]};
-            EXPECT_TRUE(set.InsideLocal(0, p, InsideTest::kPlanes));
-            EXPECT_TRUE(set.InsideLocal(0, p, InsideTest::kKirkpatrick))
+            EXPECT_TRUE(HullColliderSetAccess::InsideLocal(set, 0, p, InsideTest::kPlanes));
+            EXPECT_TRUE(HullColliderSetAccess::InsideLocal(set, 0, p, InsideTest::kKirkpatrick))
                 << p.x << " " << p.y << " " << p.z;
             // Just outside (by 1/1024 of the box): outside for both.
             Float3 q = p;
             (&q.x)[fixed] += sign * 1.f / 1024.f;
-            EXPECT_FALSE(set.InsideLocal(0, q, InsideTest::kPlanes));
-            EXPECT_FALSE(set.InsideLocal(0, q, InsideTest::kKirkpatrick));
+            EXPECT_FALSE(HullColliderSetAccess::InsideLocal(set, 0, q, InsideTest::kPlanes));
+            EXPECT_FALSE(HullColliderSetAccess::InsideLocal(set, 0, q, InsideTest::kKirkpatrick));
             ++checked;
           }
     EXPECT_EQ(checked, 6 * 81);
@@ -488,8 +490,8 @@ TEST(KirkpatrickBuilderTest, LargeHullBuildsWithLogarithmicDepth) {
   const std::vector<Sample> samples = AgreementSamples(h, 100000, 5);
   uint32_t disagree = 0;
   for (const Sample& p : samples)
-    disagree += set.InsideLocal(0, p.p, InsideTest::kPlanes) !=
-                set.InsideLocal(0, p.p, InsideTest::kKirkpatrick);
+    disagree += HullColliderSetAccess::InsideLocal(set, 0, p.p, InsideTest::kPlanes) !=
+                HullColliderSetAccess::InsideLocal(set, 0, p.p, InsideTest::kKirkpatrick);
   EXPECT_EQ(disagree, 0u);
 }
 

@@ -19,6 +19,7 @@
 
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "hull/hull_collider_set_access.h"
 #include "hull_fixtures.h"
 
 namespace drape::bake {
@@ -245,7 +246,7 @@ TEST(MapTableBuilderTest, RuntimeRayResponseNeverFallsBackFromInside) {
                  h.obb.axes[2] * (u(rng) * h.obb.half_extents.z);
       if (MaxPlane(h, p) > 0.f) continue;
       ++inside;
-      const ContactQuery c = set.QueryHullLocal(0, p, p);
+      const ContactQuery c = HullColliderSetAccess::QueryHullLocal(set, 0, p, p);
       ASSERT_TRUE(c.contact);
       if (c.flags & kCollisionFallback) {
         ++fallbacks;

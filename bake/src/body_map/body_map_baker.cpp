@@ -11,6 +11,7 @@
 
 #include "body_map/cpu_rasterizer.h"
 #include "body_map/osmesa_renderer.h"
+#include "drape/runtime/normal_encoding.h"
 
 namespace drape::bake {
 namespace {

@@ -11,9 +11,8 @@
 
 #include "drape/runtime/math.h"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include "common/lanes/scalar_lanes.h"
+#include "common/lanes/sse2_lanes.h"
 
 namespace drape {
 namespace {
@@ -49,6 +48,8 @@ SpringSide SideOf(SpringKind kind, bool buckling) {
   return kind == SpringKind::kStretch ? SpringSide::kStretched : SpringSide::kCompressed;
 }
 
+// The length error a spring acts on: all of it, or under paper A's buckling model only a stretch
+// (stretch springs) or only a compression (bend springs).
 template <SpringSide side>
 inline float ActiveError(float error) {
   if constexpr (side == SpringSide::kStretched) return error > 0.f ? error : 0.f;
@@ -56,100 +57,71 @@ inline float ActiveError(float error) {
   return error;
 }
 
-// Paper B eq. 2-3 for lane k of a block: each end moves by its share of correction * (L - R)
-// along the spring. The scalar reference kernel. The SSE kernel below repeats these operations
-// lane by lane in the same order (no FMA; IEEE sqrt and division), so both give the same bits.
-template <SpringSide side>
-inline void CorrectSpring(const SpringBlock& block, int k, float correction, Particle4* p) {
-  Particle4& pa = p[block.a[k]];
-  Particle4& pb = p[block.b[k]];
-  const float dx = pb.x - pa.x, dy = pb.y - pa.y, dz = pb.z - pa.z;
-  const float length = std::sqrt((dx * dx + dy * dy) + dz * dz);
-  const float error = ActiveError<side>(length - block.rest_length[k]);
-  // A spring of length 0 has no direction: it waits for its neighbours to separate its ends.
-  const float scale = length > 1e-20f ? correction * error / length : 0.f;
-  const float sa = scale * block.weight_a[k], sb = scale * block.weight_b[k];
-  pa.x = pa.x + dx * sa;
-  pa.y = pa.y + dy * sa;
-  pa.z = pa.z + dz * sa;
-  pb.x = pb.x - dx * sb;
-  pb.y = pb.y - dy * sb;
-  pb.z = pb.z - dz * sb;
-}
-
-#if defined(__SSE2__)
-// The four springs of a block at once (they share no particle, so the scatter does not
-// overlap): aligned loads of (x, y, z, w) per end, transposed to x/y/z lanes and back.
-template <SpringSide side>
+// Paper B eq. 2-3 for the four springs of a block at once (they share no particle, so the scatter
+// does not overlap): each end moves by its share of correction * (L - R) along the spring. One
+// kernel over a four-lane pack (common/lanes/): the scalar reference and SSE2 give the same bits.
+// The particles' (x, y, z, w) rows are transposed to x/y/z lanes and back.
+template <class P, SpringSide side>
 inline void CorrectBlock(const SpringBlock& block, float correction, Particle4* p) {
+  using F = typename P::F;
+  using namespace detail::lanes;
   float* a[4];
   float* b[4];
   for (int k = 0; k < 4; ++k) {
     a[k] = &p[block.a[k]].x;
     b[k] = &p[block.b[k]].x;
   }
-  __m128 ax = _mm_load_ps(a[0]), ay = _mm_load_ps(a[1]), az = _mm_load_ps(a[2]),
-         aw = _mm_load_ps(a[3]);
-  __m128 bx = _mm_load_ps(b[0]), by = _mm_load_ps(b[1]), bz = _mm_load_ps(b[2]),
-         bw = _mm_load_ps(b[3]);
-  _MM_TRANSPOSE4_PS(ax, ay, az, aw);
-  _MM_TRANSPOSE4_PS(bx, by, bz, bw);
-  const __m128 dx = _mm_sub_ps(bx, ax), dy = _mm_sub_ps(by, ay), dz = _mm_sub_ps(bz, az);
-  const __m128 length = _mm_sqrt_ps(
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
-  __m128 error = _mm_sub_ps(length, _mm_load_ps(block.rest_length));
-  // maxps/minps return the second operand for NaN and for +-0 ties, like ActiveError.
-  if constexpr (side == SpringSide::kStretched) error = _mm_max_ps(error, _mm_setzero_ps());
-  if constexpr (side == SpringSide::kCompressed) error = _mm_min_ps(error, _mm_setzero_ps());
-  const __m128 valid = _mm_cmpgt_ps(length, _mm_set1_ps(1e-20f));
-  const __m128 scale =
-      _mm_and_ps(valid, _mm_div_ps(_mm_mul_ps(_mm_set1_ps(correction), error), length));
-  const __m128 sa = _mm_mul_ps(scale, _mm_load_ps(block.weight_a));
-  const __m128 sb = _mm_mul_ps(scale, _mm_load_ps(block.weight_b));
-  ax = _mm_add_ps(ax, _mm_mul_ps(dx, sa));
-  ay = _mm_add_ps(ay, _mm_mul_ps(dy, sa));
-  az = _mm_add_ps(az, _mm_mul_ps(dz, sa));
-  bx = _mm_sub_ps(bx, _mm_mul_ps(dx, sb));
-  by = _mm_sub_ps(by, _mm_mul_ps(dy, sb));
-  bz = _mm_sub_ps(bz, _mm_mul_ps(dz, sb));
-  _MM_TRANSPOSE4_PS(ax, ay, az, aw);
-  _MM_TRANSPOSE4_PS(bx, by, bz, bw);
-  _mm_store_ps(a[0], ax);
-  _mm_store_ps(a[1], ay);
-  _mm_store_ps(a[2], az);
-  _mm_store_ps(a[3], aw);
-  _mm_store_ps(b[0], bx);
-  _mm_store_ps(b[1], by);
-  _mm_store_ps(b[2], bz);
-  _mm_store_ps(b[3], bw);
+  F ax, ay, az, aw, bx, by, bz, bw;
+  P::LoadRows4(a, &ax, &ay, &az, &aw);
+  P::LoadRows4(b, &bx, &by, &bz, &bw);
+  const F dx = Sub(bx, ax), dy = Sub(by, ay), dz = Sub(bz, az);
+  const F length = Sqrt(Add(Add(Mul(dx, dx), Mul(dy, dy)), Mul(dz, dz)));
+  F error = Sub(length, P::Load(block.rest_length));
+  // Paper A's buckling model: stretch springs act only when stretched, bend springs only when
+  // compressed (NaN and +-0 ties give 0, maxps / minps's second operand).
+  if constexpr (side == SpringSide::kStretched) error = detail::StdMax(P::Zero(), error);
+  if constexpr (side == SpringSide::kCompressed) error = detail::StdMin(P::Zero(), error);
+  // A spring of length 0 has no direction: it waits for its neighbours to separate its ends.
+  const F valid = Greater(length, P::Splat(1e-20f));
+  const F scale = And(valid, Div(Mul(P::Splat(correction), error), length));
+  const F sa = Mul(scale, P::Load(block.weight_a));
+  const F sb = Mul(scale, P::Load(block.weight_b));
+  ax = Add(ax, Mul(dx, sa));
+  ay = Add(ay, Mul(dy, sa));
+  az = Add(az, Mul(dz, sa));
+  bx = Sub(bx, Mul(dx, sb));
+  by = Sub(by, Mul(dy, sb));
+  bz = Sub(bz, Mul(dz, sb));
+  P::StoreRows4(a, ax, ay, az, aw);
+  P::StoreRows4(b, bx, by, bz, bw);
 }
-#endif
 
 template <SpringSide side>
-inline void CorrectFour(const SpringBlock& block, float correction, bool simd, Particle4* p) {
+inline void CorrectFour(const SpringBlock& block, float correction, InstructionSet set,
+                        Particle4* p) {
 #if defined(__SSE2__)
-  if (simd) {
-    CorrectBlock<side>(block, correction, p);
+  if (set != InstructionSet::kScalar) {
+    CorrectBlock<detail::Sse2Lanes, side>(block, correction, p);
     return;
   }
 #endif
-  (void)simd;
-  for (int lane = 0; lane < 4; ++lane) CorrectSpring<side>(block, lane, correction, p);
+  (void)set;
+  CorrectBlock<detail::ScalarLanes, side>(block, correction, p);
 }
 
 template <SpringSide side>
 void CorrectRunSequential(const SpringBlock* blocks, const SpringRun& run, float correction,
-                          bool simd, Particle4* p) {
-  for (uint32_t k = run.begin; k < run.end; ++k) CorrectFour<side>(blocks[k], correction, simd, p);
+                          InstructionSet set, Particle4* p) {
+  for (uint32_t k = run.begin; k < run.end; ++k) CorrectFour<side>(blocks[k], correction, set, p);
 }
 
 // The blocks of one run shared among the threads of the enclosing parallel region.
 template <SpringSide side>
-void CorrectRunShared(const SpringBlock* blocks, const SpringRun& run, float correction, bool simd,
-                      Particle4* p) {
+void CorrectRunShared(const SpringBlock* blocks, const SpringRun& run, float correction,
+                      InstructionSet set, Particle4* p) {
   const int64_t begin = run.begin, end = run.end;
 #pragma omp for schedule(static)
-  for (int64_t k = begin; k < end; ++k) CorrectFour<side>(blocks[k], correction, simd, p);
+  for (int64_t k = begin; k < end; ++k) CorrectFour<side>(blocks[k], correction, set, p);
 }
 
 // Appends `springs` (pairwise disjoint: one colour) as blocks of four, in order. The lanes of the
@@ -624,19 +596,19 @@ void ClothSolver::CorrectGroup(const SpringGroup& group, Particle4* p) const {
 void ClothSolver::CorrectRun(const SpringRun& run, bool shared, Particle4* p) const {
   const SpringBlock* blocks = blocks_.data();
   const float correction = cloth_->material(run.kind).correction;
-  const bool simd = settings_.simd;
+  const InstructionSet set = UsableInstructionSet(settings_.instruction_set);
   switch (SideOf(run.kind, settings_.buckling)) {
     case SpringSide::kBoth:
-      shared ? CorrectRunShared<SpringSide::kBoth>(blocks, run, correction, simd, p)
-             : CorrectRunSequential<SpringSide::kBoth>(blocks, run, correction, simd, p);
+      shared ? CorrectRunShared<SpringSide::kBoth>(blocks, run, correction, set, p)
+             : CorrectRunSequential<SpringSide::kBoth>(blocks, run, correction, set, p);
       break;
     case SpringSide::kStretched:
-      shared ? CorrectRunShared<SpringSide::kStretched>(blocks, run, correction, simd, p)
-             : CorrectRunSequential<SpringSide::kStretched>(blocks, run, correction, simd, p);
+      shared ? CorrectRunShared<SpringSide::kStretched>(blocks, run, correction, set, p)
+             : CorrectRunSequential<SpringSide::kStretched>(blocks, run, correction, set, p);
       break;
     case SpringSide::kCompressed:
-      shared ? CorrectRunShared<SpringSide::kCompressed>(blocks, run, correction, simd, p)
-             : CorrectRunSequential<SpringSide::kCompressed>(blocks, run, correction, simd, p);
+      shared ? CorrectRunShared<SpringSide::kCompressed>(blocks, run, correction, set, p)
+             : CorrectRunSequential<SpringSide::kCompressed>(blocks, run, correction, set, p);
       break;
   }
 }

@@ -6,7 +6,7 @@
 // against a skeleton (garment meshes, joint indices, the clip), and "model only what a scene
 // needs": the region the garments can reach over every frame the scene plays, the colliders that
 // region touches and the poses it plays (AnalyzeSceneReach). The format is documented field by
-// field in samples/scenes/README.md.
+// field in docs/SCENES.md, generated from the parser's schema (SceneReferenceMarkdown).
 //
 // Frames of a scene. The simulation advances in frames of solver.dt seconds. Frame k (k >= 0)
 // covers scene time [start + k dt, start + (k + 1) dt]; clip time is scene time wrapped by the
@@ -27,6 +27,7 @@
 #include "drape/formats/status.h"
 #include "drape/formats/types.h"
 #include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/body_map_sequence.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/garments.h"
@@ -152,6 +153,10 @@ Status LoadScene(const std::string& path, Scene* scene);
 // Parses a scene already read; `source` names it in messages, `directory` resolves paths.
 Status ParseScene(const nlohmann::json& json, const std::string& source,
                   const std::string& directory, Scene* scene);
+
+// The scenes reference (docs/SCENES.md) as markdown: the conventions, the sample scenes and one
+// table per JSON object of a scene, generated from the schema ParseScene reads with.
+std::string SceneReferenceMarkdown();
 
 // The bake configuration a scene needs: the scene's /bake overrides, then the collider kinds from
 // its collision methods (maps, hulls, spheres each on or off) and, when maps are used with a

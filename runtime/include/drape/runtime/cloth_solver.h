@@ -84,6 +84,7 @@
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
+#include "drape/runtime/instruction_set.h"
 
 namespace drape {
 
@@ -106,10 +107,9 @@ struct ClothSolverSettings {
   // (the translation of inverse(inverse_bind[root])).
   int32_t root_joint = -1;
   Float3 root_bind_position;
-  // The SSE spring kernel (4 springs per instruction) where the CPU has SSE2; false selects the
-  // scalar reference kernel. Both perform the same IEEE operations in the same order: the
-  // results are bitwise identical (tested).
-  bool simd = true;
+  // The widest instruction set the spring kernel may use (narrowed to the CPU's): four springs
+  // per instruction in SSE2 (AVX2 too), or the scalar reference pack. The same bits (tested).
+  InstructionSet instruction_set = InstructionSet::kAvx2;
 
   // Paper A: explicit Euler with the buckling model. substeps must still satisfy the stability
   // bound of the cloth (see RecommendedEulerSubsteps).

@@ -30,6 +30,11 @@ inline Float3 NormalizeOr(Float3 a, Float3 fallback) {
 inline bool IsFinite(Float3 a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
+inline bool IsFinite(const Mat34& m) {
+  for (float v : m.m)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
 
 // Quaternions (x, y, z, w).
 inline Quat Multiply(Quat a, Quat b) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "drape/runtime/math.h"
+#include "hull/hull_collider_set_access.h"
 #include "hull_fixtures.h"
 
 namespace drape {
@@ -181,8 +182,8 @@ TEST(HullColliderTest, ObbRejectionIsConservative) {
   uint32_t inside = 0, rejected = 0;
   for (int i = 0; i < 200000; ++i) {
     const Float3 p = RandomIn(rng, {-0.2f, -0.35f, 0.1f}, {0.25f, 0.15f, 0.5f});
-    const bool in = set.InsideLocal(0, p, InsideTest::kPlanes);
-    const bool may = set.ObbMayContainLocal(0, p);
+    const bool in = HullColliderSetAccess::InsideLocal(set, 0, p, InsideTest::kPlanes);
+    const bool may = HullColliderSetAccess::ObbMayContainLocal(set, 0, p);
     if (in) {
       ++inside;
       EXPECT_TRUE(may);
@@ -191,7 +192,8 @@ TEST(HullColliderTest, ObbRejectionIsConservative) {
   }
   EXPECT_GT(inside, 1000u);
   EXPECT_GT(rejected, 100000u);
-  for (const Float3& v : h.vertices) EXPECT_TRUE(set.ObbMayContainLocal(0, v));
+  for (const Float3& v : h.vertices)
+    EXPECT_TRUE(HullColliderSetAccess::ObbMayContainLocal(set, 0, v));
 }
 
 TEST(HullColliderTest, PushOutIsOnTheSurfaceAndMinimalForABox) {
@@ -201,12 +203,12 @@ TEST(HullColliderTest, PushOutIsOnTheSurfaceAndMinimalForABox) {
   std::mt19937 rng(1);
   for (int i = 0; i < 20000; ++i) {
     const Float3 p = RandomIn(rng, -he * 0.999f, he * 0.999f);
-    const ContactQuery c = set.QueryHullLocal(0, p, p);
+    const ContactQuery c = HullColliderSetAccess::QueryHullLocal(set, 0, p, p);
     ASSERT_TRUE(c.contact);
     EXPECT_TRUE(c.inside_end);
     EXPECT_TRUE(c.flags & kCollisionStartedInside);
     // On or outside the hull in the runtime's arithmetic.
-    EXPECT_GE(set.MaxPlaneDistanceLocal(0, c.point), 0.f);
+    EXPECT_GE(HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, c.point), 0.f);
     // Minimal: the distance to the box boundary.
     const double exact = std::min({he.x - std::fabs(double(p.x)), he.y - std::fabs(double(p.y)),
                                    he.z - std::fabs(double(p.z))});
@@ -243,7 +245,7 @@ TEST(HullColliderTest, GrazingSegmentsAlongFacesEdgesAndVertices) {
   };
   for (size_t k = 0; k < std::size(cases); ++k) {
     const Case& c = cases[k];
-    const ContactQuery q = set.QueryHullLocal(0, c.a, c.b);
+    const ContactQuery q = HullColliderSetAccess::QueryHullLocal(set, 0, c.a, c.b);
     EXPECT_EQ(q.contact, c.contact) << "case " << k;
     EXPECT_TRUE(IsFinite(q.point) && IsFinite(q.normal)) << "case " << k;
     std::vector<Float3> previous = {c.a}, positions = {c.b}, velocities = {c.b - c.a};
@@ -251,7 +253,8 @@ TEST(HullColliderTest, GrazingSegmentsAlongFacesEdgesAndVertices) {
     ASSERT_TRUE(set.CollideBatch(previous, positions, velocities, flags, ResponseParams{}).ok());
     EXPECT_EQ((flags[0] & kCollisionContact) != 0, c.contact) << "case " << k;
     EXPECT_TRUE(IsFinite(positions[0]) && IsFinite(velocities[0])) << "case " << k;
-    EXPECT_GT(set.MaxPlaneDistanceLocal(0, positions[0]), 0.f) << "case " << k;
+    EXPECT_GT(HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, positions[0]), 0.f)
+        << "case " << k;
   }
 }
 
@@ -265,15 +268,15 @@ TEST(HullColliderTest, PushOutOfARotatedEllipsoidIsOnTheFaceOfTheMaxPlane) {
   for (int i = 0; i < 1000000 && tested < 10000; ++i) {
     const Float3 p = RandomIn(rng, {0.1f, 0.9f, -0.45f}, {0.5f, 1.3f, 0.05f});
     uint32_t plane;
-    const float m = set.MaxPlaneDistanceLocal(0, p, &plane);
+    const float m = HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, p, &plane);
     if (m > 0.f) continue;
     ++tested;
-    const ContactQuery c = set.QueryHullLocal(0, p, p);
+    const ContactQuery c = HullColliderSetAccess::QueryHullLocal(set, 0, p, p);
     ASSERT_TRUE(c.contact);
-    EXPECT_GE(set.MaxPlaneDistanceLocal(0, c.point), 0.f);
+    EXPECT_GE(HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, c.point), 0.f);
     // The projection lands on the face: every other plane still holds (up to rounding) and the
     // displacement equals the max-plane depth (the exact distance to the polytope's boundary).
-    EXPECT_LE(set.MaxPlaneDistanceLocal(0, c.point), 2e-6f);
+    EXPECT_LE(HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, c.point), 2e-6f);
     EXPECT_NEAR(Length(c.point - p), -m, 2e-6f);
     EXPECT_NEAR(c.depth, -m, 1e-7f);
     EXPECT_EQ(c.normal.x, h.planes[plane].normal.x);
@@ -548,16 +551,22 @@ TEST(HullColliderTest, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
     EXPECT_EQ(std::memcmp(p1.data(), p3.data(), p1.size() * sizeof(Float3)), 0);
     EXPECT_EQ(f1, f3);
     ASSERT_TRUE(set.SelectSubstep(0.f, 1.f).ok());
-    // 4-wide (SSE2) plane loops give the same bits as 8-wide (AVX2, when the CPU has it).
-    HullColliderOptions narrow;
-    narrow.allow_avx2 = false;
-    ASSERT_TRUE(set.SetOptions(narrow).ok());
-    std::vector<Float3> p4 = positions, v4 = velocities;
-    std::vector<uint8_t> f4(positions.size());
-    ASSERT_TRUE(set.CollideBatch(previous, p4, v4, f4, params, s0, s1).ok());
-    EXPECT_EQ(std::memcmp(p1.data(), p4.data(), p1.size() * sizeof(Float3)), 0);
-    EXPECT_EQ(std::memcmp(v1.data(), v4.data(), v1.size() * sizeof(Float3)), 0);
-    EXPECT_EQ(f1, f4);
+    // Every instruction set's kernels (the scalar reference, 4-wide SSE2, 8-wide AVX2 where the
+    // CPU has it) give the same bits, the group broad phase included.
+    for (InstructionSet instruction_set :
+         {InstructionSet::kScalar, InstructionSet::kSse2, InstructionSet::kAvx2}) {
+      HullColliderOptions narrow;
+      narrow.instruction_set = instruction_set;
+      ASSERT_TRUE(set.SetOptions(narrow).ok());
+      if (set.instruction_set() != instruction_set) continue;  // the CPU lacks it
+      SCOPED_TRACE(ToString(instruction_set));
+      std::vector<Float3> p4 = positions, v4 = velocities;
+      std::vector<uint8_t> f4(positions.size());
+      ASSERT_TRUE(set.CollideBatch(previous, p4, v4, f4, params, s0, s1).ok());
+      EXPECT_EQ(std::memcmp(p1.data(), p4.data(), p1.size() * sizeof(Float3)), 0);
+      EXPECT_EQ(std::memcmp(v1.data(), v4.data(), v1.size() * sizeof(Float3)), 0);
+      EXPECT_EQ(f1, f4);
+    }
     ASSERT_TRUE(set.SetOptions(HullColliderOptions{}).ok());
   }
 }
@@ -630,11 +639,11 @@ TEST(HullColliderTest, MapTableRayResponseAndFallback) {
   std::mt19937 rng(2);
   for (int i = 0; i < 5000; ++i) {
     const Float3 p = RandomIn(rng, {-0.099f, -0.199f, -0.049f}, {0.099f, 0.199f, 0.049f});
-    const ContactQuery c = set.QueryHullLocal(0, p, p);
+    const ContactQuery c = HullColliderSetAccess::QueryHullLocal(set, 0, p, p);
     ASSERT_TRUE(c.contact);
     EXPECT_FALSE(c.flags & kCollisionFallback) << i;
-    EXPECT_GE(set.MaxPlaneDistanceLocal(0, c.point), 0.f);
-    EXPECT_LE(set.MaxPlaneDistanceLocal(0, c.point), 1e-6f);
+    EXPECT_GE(HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, c.point), 0.f);
+    EXPECT_LE(HullColliderSetAccess::MaxPlaneDistanceLocal(set, 0, c.point), 1e-6f);
     // On the ray from the source through p, beyond p.
     const Float3 d = p - box.map.origin, e = c.point - box.map.origin;
     EXPECT_LE(Length(Cross(d, e)), 1e-6f * Length(e));
@@ -644,7 +653,8 @@ TEST(HullColliderTest, MapTableRayResponseAndFallback) {
   box.map.cell_offsets = {0, 0};
   box.map.cell_triangles.clear();
   HullColliderSet empty = BuildSet({box}, {}, 1, options);
-  const ContactQuery c = empty.QueryHullLocal(0, {0.f, 0.f, 0.04f}, {0.f, 0.f, 0.04f});
+  const ContactQuery c =
+      HullColliderSetAccess::QueryHullLocal(empty, 0, {0.f, 0.f, 0.04f}, {0.f, 0.f, 0.04f});
   EXPECT_TRUE(c.contact);
   EXPECT_TRUE(c.flags & kCollisionFallback);
   EXPECT_NEAR(c.point.z, 0.05f, 1e-6f);

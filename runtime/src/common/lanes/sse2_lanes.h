@@ -1,12 +1,13 @@
 #pragma once
-// Private to the runtime: SSE2 lane helpers shared by the colliders' four-lane paths. Each gives
-// lane by lane what the scalar expression gives (IEEE single precision per lane), so a lane path
-// can be bit for bit its scalar twin.
+// Private to the runtime: the lane operations on four SSE2 lanes. Each gives lane by lane what the
+// scalar expression gives (IEEE single precision per lane), so a lane path can be bit for bit its
+// scalar twin.
 //
 // The lane operations are named once for any width: the overloads here take __m128 / __m128i,
-// those in body_map_collider_avx2.cpp take __m256 / __m256i, and a pack type (Sse2Lanes here,
-// Avx2Lanes there) holds what only the width decides. A template written in these names
-// (body_map_lane_walk.inl) is one text for four lanes and for eight, with the same bits per lane.
+// those of scalar_lanes.h take ScalarF / ScalarI, those of avx2_lanes.inl __m256 / __m256i, and a
+// pack type (ScalarLanes, Sse2Lanes, EightLanes) holds what only the width decides. A template
+// written in these names (body_map/lanes/, hull/plane_kernels.inl) is one text for every pack,
+// with the same bits per lane.
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -93,10 +94,26 @@ struct Sse2Lanes {
   static I FromLanesI(const Value& value) {
     return _mm_setr_epi32(value(0), value(1), value(2), value(3));
   }
+  static F Load(const float* unaligned) { return _mm_loadu_ps(unaligned); }
   static void Store(int32_t* aligned, I a) {
     _mm_store_si128(reinterpret_cast<__m128i*>(aligned), a);
   }
   static void Store(float* aligned, F a) { _mm_store_ps(aligned, a); }
+  // The 16-byte aligned (x, y, z, w) rows at rows[0..3] as lanes (a 4x4 transpose), and back.
+  static void LoadRows4(float* const rows[4], F* x, F* y, F* z, F* w) {
+    *x = _mm_load_ps(rows[0]);
+    *y = _mm_load_ps(rows[1]);
+    *z = _mm_load_ps(rows[2]);
+    *w = _mm_load_ps(rows[3]);
+    _MM_TRANSPOSE4_PS(*x, *y, *z, *w);
+  }
+  static void StoreRows4(float* const rows[4], F x, F y, F z, F w) {
+    _MM_TRANSPOSE4_PS(x, y, z, w);
+    _mm_store_ps(rows[0], x);
+    _mm_store_ps(rows[1], y);
+    _mm_store_ps(rows[2], z);
+    _mm_store_ps(rows[3], w);
+  }
   // Four consecutive (x, y, z) float triples (48 packed bytes) as lanes: three loads and a
   // transpose.
   static void LoadFloat3s(const void* triples, F* x, F* y, F* z) {

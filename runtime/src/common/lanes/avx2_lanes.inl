@@ -1,17 +1,16 @@
-// Private to the runtime: the lane operations of sse_lanes.h on eight lanes (__m256), and the
-// lane pack EightLanes, for body_map_lane_walk.inl. Included, after every header, inside the
-// target region of body_map_collider_avx2.cpp (AVX2) and of body_map_collider_avx512.cpp
-// (AVX2 with AVX-512VL's 32 registers): the same text, compiled twice.
+// Private to the runtime: the lane operations of sse2_lanes.h on eight lanes (__m256), and the
+// lane pack EightLanes. Included, after every header, inside the AVX2 target region of
+// body_map/lanes/lanes_avx2.cpp and hull/plane_kernels_avx2.cpp.
 //
-// Each definition here has internal linkage (static, or the unnamed namespace): the two objects'
-// copies differ in instruction set, and a linker merging weak copies could hand the AVX-512 one
-// to a CPU with AVX2 alone. tests/runtime/check_lane_objects.sh fails if one is ever shared.
+// Each definition here has internal linkage (static, or the unnamed namespace): a linker merging
+// weak copies compiled for AVX2 with baseline ones could hand AVX2 code to a CPU without it.
+// tests/runtime/check_lane_objects.sh fails if one is ever shared.
 //
-// No #include here, for the reason body_map_lane_walk.inl gives.
+// No #include here, for the reason body_map/lanes/lanes.inl gives.
 
 namespace drape::detail {
 
-// The operations of sse_lanes.h on eight lanes, beside their SSE2 overloads (where the lane walk's
+// The operations of sse2_lanes.h on eight lanes, beside their SSE2 overloads (where the lane walk's
 // using-declarations find both); this file alone defines them. Comparisons use the predicates of
 // the SSE2 instructions (cmpltps is LT_OS, cmpeqps EQ_OQ, ...): the same mask bits, NaN included.
 // Every mask the lanes select by is all ones or all zeros per lane (a comparison, or And / Or /
@@ -89,6 +88,7 @@ struct EightLanes {
     return _mm256_setr_epi32(value(0), value(1), value(2), value(3), value(4), value(5), value(6),
                              value(7));
   }
+  static F Load(const float* unaligned) { return _mm256_loadu_ps(unaligned); }
   static void Store(int32_t* aligned, I a) {
     _mm256_store_si256(reinterpret_cast<__m256i*>(aligned), a);
   }

@@ -1,0 +1,243 @@
+// Private to the runtime: the PlaneKernels of plane_kernels.h written once over a lane pack P
+// (common/lanes/). Included by plane_kernels.cpp (ScalarLanes, Sse2Lanes) and, inside its AVX2
+// target region, by plane_kernels_avx2.cpp (EightLanes).
+//
+// No #include here: everything this text uses must be declared before it is included, so that in
+// the AVX2 file no function the baseline code also uses is compiled for AVX2.
+//
+// Same bits in every pack: plane i is in lane i % P::kCount of the i / P::kCount-th vector, in
+// every pack; the max kernels keep 8 / P::kCount vectors per 8 planes and combine them in a fixed
+// order, and the horizontal reductions are pairwise trees, so a width's grouping never changes
+// which of two equal values (0 and -0) survives.
+
+namespace drape::detail {
+namespace {
+
+using namespace lanes;
+
+template <class P>
+struct PlaneLanes {
+  using F = typename P::F;
+  static constexpr uint32_t kVectors = kPlanePad / P::kCount;  // vectors per 8 planes
+
+  // ((nx px + ny py) + nz pz) - d for planes i .. i + P::kCount - 1.
+  static F Value(const PlaneSoa& s, uint32_t i, F px, F py, F pz) {
+    F v = Mul(P::Load(s.nx + i), px);
+    v = Add(v, Mul(P::Load(s.ny + i), py));
+    v = Add(v, Mul(P::Load(s.nz + i), pz));
+    return Sub(v, P::Load(s.d + i));
+  }
+  // Pairwise trees over the lanes: (l0 l1)(l2 l3) for four, ((l0 l1)(l2 l3))((l4 l5)(l6 l7)) for
+  // eight, with std::max / std::min's operand order (written out: std::max is an inline function
+  // the baseline code shares, which must not be compiled in an AVX2 region).
+  static float HorizontalMax(F v) {
+    alignas(32) float l[P::kCount];
+    P::Store(l, v);
+    for (int width = P::kCount; width > 1; width /= 2)
+      for (int k = 0; k < width / 2; ++k) l[k] = l[2 * k] < l[2 * k + 1] ? l[2 * k + 1] : l[2 * k];
+    return l[0];
+  }
+  static float HorizontalMin(F v) {
+    alignas(32) float l[P::kCount];
+    P::Store(l, v);
+    for (int width = P::kCount; width > 1; width /= 2)
+      for (int k = 0; k < width / 2; ++k) l[k] = l[2 * k + 1] < l[2 * k] ? l[2 * k + 1] : l[2 * k];
+    return l[0];
+  }
+  // The max of one 8-plane block's vectors: v0 alone, or max(v0, v1) as maxps(v0, v1) gives it.
+  static F BlockMax(const F* v) {
+    if constexpr (kVectors == 1) {
+      return v[0];
+    } else {
+      return StdMax(v[1], v[0]);
+    }
+  }
+  static uint32_t FirstLane(uint32_t bits) { return static_cast<uint32_t>(__builtin_ctz(bits)); }
+
+  static float Max(const PlaneSoa& s, Float3 p) {
+    const F px = P::Splat(p.x), py = P::Splat(p.y), pz = P::Splat(p.z);
+    F m[kVectors];
+    for (uint32_t k = 0; k < kVectors; ++k) m[k] = P::Splat(-kPadOffset);
+    for (uint32_t i = 0; i < s.padded; i += kPlanePad)
+      for (uint32_t k = 0; k < kVectors; ++k)
+        m[k] = StdMax(m[k], Value(s, i + k * P::kCount, px, py, pz));
+    return HorizontalMax(BlockMax(m));
+  }
+
+  static uint32_t FirstEqual(const PlaneSoa& s, Float3 p, float value) {
+    const F px = P::Splat(p.x), py = P::Splat(p.y), pz = P::Splat(p.z);
+    const F target = P::Splat(value);
+    for (uint32_t i = 0; i < s.padded; i += P::kCount) {
+      const uint32_t bits = LaneBits(Equal(Value(s, i, px, py, pz), target));
+      if (bits != 0) return i + FirstLane(bits);
+    }
+    return 0;
+  }
+
+  static DualResult Dual(const PlaneSoa& s, Float3 a, Float3 b) {
+    const F ax = P::Splat(a.x), ay = P::Splat(a.y), az = P::Splat(a.z);
+    const F bx = P::Splat(b.x), by = P::Splat(b.y), bz = P::Splat(b.z);
+    const F zero = P::Zero();
+    F ma = P::Splat(-kPadOffset), mb = ma;
+    for (uint32_t i = 0; i < s.padded; i += kPlanePad) {
+      F fa[kVectors], fb[kVectors];
+      F separated = zero;
+      for (uint32_t k = 0; k < kVectors; ++k) {
+        fa[k] = Value(s, i + k * P::kCount, ax, ay, az);
+        fb[k] = Value(s, i + k * P::kCount, bx, by, bz);
+        separated = Or(separated, And(Greater(fa[k], zero), Greater(fb[k], zero)));
+      }
+      if (LaneBits(separated) != 0) return {0.f, 0.f, true};
+      ma = StdMax(ma, BlockMax(fa));
+      mb = StdMax(mb, BlockMax(fb));
+    }
+    return {HorizontalMax(ma), HorizontalMax(mb), false};
+  }
+
+  static DualResult DualSame(const PlaneSoa& s, Float3 a) {
+    const F ax = P::Splat(a.x), ay = P::Splat(a.y), az = P::Splat(a.z);
+    const F zero = P::Zero();
+    F ma = P::Splat(-kPadOffset);
+    for (uint32_t i = 0; i < s.padded; i += kPlanePad) {
+      F fa[kVectors];
+      F outside = zero;
+      for (uint32_t k = 0; k < kVectors; ++k) {
+        fa[k] = Value(s, i + k * P::kCount, ax, ay, az);
+        outside = Or(outside, Greater(fa[k], zero));
+      }
+      if (LaneBits(outside) != 0) return {0.f, 0.f, true};
+      ma = StdMax(ma, BlockMax(fa));
+    }
+    const float m = HorizontalMax(ma);
+    return {m, m, false};
+  }
+
+  static ClipResult Clip(const PlaneSoa& s, Float3 a, Float3 b) {
+    const F ax = P::Splat(a.x), ay = P::Splat(a.y), az = P::Splat(a.z);
+    const F bx = P::Splat(b.x), by = P::Splat(b.y), bz = P::Splat(b.z);
+    const F zero = P::Zero();
+    F t_in = P::Splat(-1.f), t_out = P::Splat(1.f);
+    for (uint32_t i = 0; i < s.padded; i += P::kCount) {
+      const F fa = Value(s, i, ax, ay, az), fb = Value(s, i, bx, by, bz);
+      const F t = Div(fa, Sub(fa, fb));
+      const F entering = Greater(fa, zero);
+      const F leaving = AndNot(entering, Greater(fb, zero));
+      t_in = StdMax(t_in, SelectLanes(entering, t, t_in));
+      t_out = StdMin(t_out, SelectLanes(leaving, t, t_out));
+    }
+    return {HorizontalMax(t_in), HorizontalMin(t_out)};
+  }
+
+  static uint32_t Entry(const PlaneSoa& s, Float3 a, Float3 b, float t_in) {
+    const F ax = P::Splat(a.x), ay = P::Splat(a.y), az = P::Splat(a.z);
+    const F bx = P::Splat(b.x), by = P::Splat(b.y), bz = P::Splat(b.z);
+    const F zero = P::Zero(), target = P::Splat(t_in);
+    for (uint32_t i = 0; i < s.padded; i += P::kCount) {
+      const F fa = Value(s, i, ax, ay, az), fb = Value(s, i, bx, by, bz);
+      const F t = Div(fa, Sub(fa, fb));
+      const uint32_t bits = LaneBits(And(Greater(fa, zero), Equal(t, target)));
+      if (bits != 0) return i + FirstLane(bits);
+    }
+    return 0;
+  }
+
+  static uint32_t SphereFilter(const float* xs, const float* ys, const float* zs, const float* rs,
+                               uint32_t total, Float3 mid, float half, uint32_t* out,
+                               uint32_t capacity) {
+    const F mx = P::Splat(mid.x), my = P::Splat(mid.y), mz = P::Splat(mid.z);
+    const F hv = P::Splat(half);
+    uint32_t count = 0;
+    for (uint32_t k = 0; k < total; k += P::kCount) {
+      const F dx = Sub(mx, P::Load(xs + k));
+      const F dy = Sub(my, P::Load(ys + k));
+      const F dz = Sub(mz, P::Load(zs + k));
+      const F d2 = Add(Add(Mul(dx, dx), Mul(dy, dy)), Mul(dz, dz));
+      const F rr = Add(P::Load(rs + k), hv);
+      uint32_t bits = LaneBits(LessEq(d2, Mul(rr, rr)));
+      while (bits != 0 && count < capacity) {
+        const uint32_t index = k + FirstLane(bits);
+        bits &= bits - 1;
+        if (index < total) out[count++] = index;  // padding fails unless the segment is ~1e38 long
+      }
+    }
+    return count;
+  }
+
+  static uint32_t SphereMasks(const Float3* p0, const Float3* p1, const Float3* velocity,
+                              uint32_t lanes, const float* xs, const float* ys, const float* zs,
+                              const float* rs, uint32_t total, Float3 union_center,
+                              float union_radius, uint32_t* masks) {
+    using I = typename P::I;
+    F ax, ay, az, bx, by, bz, vx, vy, vz;
+    if (lanes == static_cast<uint32_t>(P::kCount)) {
+      P::LoadFloat3s(p0, &ax, &ay, &az);
+      P::LoadFloat3s(p1, &bx, &by, &bz);
+      P::LoadFloat3s(velocity, &vx, &vy, &vz);
+    } else {
+      const auto from = [lanes](int l) { return static_cast<uint32_t>(l) < lanes ? l : 0; };
+      ax = P::FromLanes([&](int l) { return p0[from(l)].x; });
+      ay = P::FromLanes([&](int l) { return p0[from(l)].y; });
+      az = P::FromLanes([&](int l) { return p0[from(l)].z; });
+      bx = P::FromLanes([&](int l) { return p1[from(l)].x; });
+      by = P::FromLanes([&](int l) { return p1[from(l)].y; });
+      bz = P::FromLanes([&](int l) { return p1[from(l)].z; });
+      vx = P::FromLanes([&](int l) { return velocity[from(l)].x; });
+      vy = P::FromLanes([&](int l) { return velocity[from(l)].y; });
+      vz = P::FromLanes([&](int l) { return velocity[from(l)].z; });
+    }
+    // IsFinite's answer: x - x == 0 for every coordinate.
+    const F zero = P::Zero();
+    F finite = Equal(zero, zero);
+    const F coordinates[9] = {ax, ay, az, bx, by, bz, vx, vy, vz};
+    for (const F& x : coordinates) finite = And(finite, Equal(Sub(x, x), zero));
+    const F one_half = P::Splat(0.5f);
+    const F mx = Mul(Add(ax, bx), one_half);
+    const F my = Mul(Add(ay, by), one_half);
+    const F mz = Mul(Add(az, bz), one_half);
+    const F sx = Sub(bx, ax), sy = Sub(by, ay), sz = Sub(bz, az);
+    const F length2 = Add(Add(Mul(sx, sx), Mul(sy, sy)), Mul(sz, sz));
+    const F half = Mul(Sqrt(length2), P::Splat(0.50001f));
+    const uint32_t finite_lanes = LaneBits(finite);
+    // Invalid lanes fail every test; the skip needs the valid ones outside the union sphere. The
+    // union test's sum is grown by 1e-5 relative (the float tests round by ~1e-7 relative), so a
+    // lane that passes any collider's test passes it whatever its half length.
+    const F ux = Sub(mx, P::Splat(union_center.x));
+    const F uy = Sub(my, P::Splat(union_center.y));
+    const F uz = Sub(mz, P::Splat(union_center.z));
+    const F ud2 = Add(Add(Mul(ux, ux), Mul(uy, uy)), Mul(uz, uz));
+    const F urr = Mul(Add(P::Splat(union_radius), half), P::Splat(1.00001f));
+    const F near = LessEq(ud2, Mul(urr, urr));
+    I acc = P::ZeroI();
+    if (LaneBits(And(near, finite)) != 0) {
+      for (uint32_t k = 0; k < total; ++k) {
+        const F dx = Sub(mx, P::Splat(xs[k]));
+        const F dy = Sub(my, P::Splat(ys[k]));
+        const F dz = Sub(mz, P::Splat(zs[k]));
+        const F d2 = Add(Add(Mul(dx, dx), Mul(dy, dy)), Mul(dz, dz));
+        const F rr = Add(P::Splat(rs[k]), half);
+        const F inside = LessEq(d2, Mul(rr, rr));
+        acc = Or(acc, And(AsInt(inside), P::SplatI(static_cast<int32_t>(1u << k))));
+      }
+    }
+    alignas(32) int32_t stored[P::kCount];
+    P::Store(stored, acc);
+    for (int l = 0; l < P::kCount; ++l) masks[l] = static_cast<uint32_t>(stored[l]);
+    return finite_lanes;
+  }
+
+  static const PlaneKernels& Table() {
+    static const PlaneKernels kernels{static_cast<uint32_t>(P::kCount),
+                                      Max,
+                                      FirstEqual,
+                                      Dual,
+                                      DualSame,
+                                      Clip,
+                                      Entry,
+                                      SphereFilter,
+                                      SphereMasks};
+    return kernels;
+  }
+};
+
+}  // namespace
+}  // namespace drape::detail

@@ -1,0 +1,48 @@
+// The hull plane kernels eight lanes at a time in AVX2: plane_kernels.inl compiled for 256-bit
+// lanes (common/lanes/avx2_lanes.inl). PlaneKernelsFor hands them out only for
+// InstructionSet::kAvx2, which BestInstructionSet() reports only where the CPU and OS have AVX2.
+//
+// Only what is defined between the target pragmas below is compiled for AVX2. Every header comes
+// before them, so the inline functions they define (which the baseline code also uses, and which
+// the linker merges with its copies) keep the baseline instruction set;
+// tests/runtime/check_lane_objects.sh checks it.
+#include <cstdint>
+
+#include "common/lanes/sse2_lanes.h"
+#include "hull/plane_kernels.h"
+
+#if defined(__SSE2__) && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#include <immintrin.h>
+
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+
+#include "common/lanes/avx2_lanes.inl"
+
+#include "hull/plane_kernels.inl"
+
+namespace drape::detail {
+
+const PlaneKernels& Avx2PlaneKernels() { return PlaneLanes<EightLanes>::Table(); }
+
+}  // namespace drape::detail
+
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
+#endif
+
+#else  // no AVX2 on this target: BestInstructionSet() never reports it
+
+namespace drape::detail {
+
+const PlaneKernels& Avx2PlaneKernels() { return PlaneKernelsFor(InstructionSet::kSse2); }
+
+}  // namespace drape::detail
+
+#endif
