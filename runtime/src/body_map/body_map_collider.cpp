@@ -29,7 +29,7 @@ float WithGapFlag(float top, uint32_t has_gaps) {
   return std::bit_cast<float>(keep ? std::bit_cast<uint32_t>(top) : moved);
 }
 // Bilinear depth only where the four corner depths spread less than this many texel sizes
-// (notes/algorithms.md §5.1 step 4): larger spreads are silhouettes or steps, where bilinear
+// (docs/ALGORITHMS.md §7.3): larger spreads are silhouettes or steps, where bilinear
 // would invent a slope through air.
 constexpr float kBilinearSpreadTexels = 3.f;
 

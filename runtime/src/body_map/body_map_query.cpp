@@ -1,6 +1,6 @@
 // BodyMapCollider::Query: the quick paths (a motion within one texel, a motion through air),
-// the clip of the motion to the maps' box, the walk and the answer (docs/ALGORITHMS.md, the
-// body-map walk); and the bilinear depth the walk samples.
+// the clip of the motion to the maps' box, the walk and the answer (docs/ALGORITHMS.md §7.2,
+// §7.5); and the bilinear depth the walk samples (§7.3).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -337,7 +337,7 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
     if (walk.hit_side == kEntrySideWall) {
       result.flags = kCollisionSideWall;
       // The wall's own normal would be horizontal; the texel's surface normal from the map
-      // whose surface is nearer in z describes the body better (notes/algorithms.md §5.1 step 3).
+      // whose surface is nearer in z describes the body better (docs/ALGORITHMS.md §7.2).
       const Interval wall = interval_at(walk.hit_ci, walk.hit_cj, u, v, walk.hit_z);
       slot = walk.hit_z - wall.bottom < wall.top - walk.hit_z ? wall.bottom_slot : wall.top_slot;
       // The wall point belongs to the entered texel, whose slab contains it: a particle put there

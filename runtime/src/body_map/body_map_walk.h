@@ -1,7 +1,7 @@
 #pragma once
 // Private to the runtime: the continuous test's walk over the texels (or, with bilinear depth,
-// the half-texels) a clipped segment crosses, with the per-cell slab solve (docs/ALGORITHMS.md,
-// the body-map walk). Included by body_map_query.cpp alone: the walk is inlined there.
+// the half-texels) a clipped segment crosses, with the per-cell slab solve (docs/ALGORITHMS.md
+// §7.2). Included by body_map_query.cpp alone: the walk is inlined there.
 
 #include <algorithm>
 #include <bit>

@@ -1,5 +1,5 @@
 // One particle against every collider its segment may reach: Gauss-Seidel passes, deepest
-// contact first, with the contact planes of earlier responses re-imposed (docs/ALGORITHMS.md).
+// contact first, with the contact planes of earlier responses re-imposed (docs/ALGORITHMS.md §8.6).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

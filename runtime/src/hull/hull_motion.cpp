@@ -1,5 +1,5 @@
 // HullColliderSet's motion within a step: the colliders' poses at the start and end of a step,
-// their screw interpolation between them (docs/ALGORITHMS.md), and the transforms and swept
+// their screw interpolation between them (docs/ALGORITHMS.md §8.1), and the transforms and swept
 // spheres of the selected substep.
 #include <algorithm>
 #include <cmath>

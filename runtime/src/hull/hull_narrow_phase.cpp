@@ -1,6 +1,6 @@
 // One collider against one particle segment: the hull's plane test or Kirkpatrick test, its
-// push-out or map-table response, the continuous clip of the segment (docs/ALGORITHMS.md), and
-// the world-space wrapper with the OBB rejection.
+// push-out or map-table response, the continuous clip of the segment (docs/ALGORITHMS.md §8.3-8.5),
+// and the world-space wrapper with the OBB rejection.
 #include <algorithm>
 #include <cmath>
 #include <cstring>

@@ -1,5 +1,5 @@
 // Paper B's response ray: from the map table's source through the particle, against the hull
-// triangles listed in its cell (docs/ALGORITHMS.md).
+// triangles listed in its cell (docs/ALGORITHMS.md §5.3).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

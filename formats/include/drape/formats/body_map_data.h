@@ -19,7 +19,7 @@ enum class DepthEncoding : uint8_t {
 enum class NormalEncoding : uint8_t {
   kFloat32 = 0,  // 3 floats per texel, unit length (0,0,0 on background)
   kOct16 = 1,    // octahedral, 2 x uint16 per texel (about 0.004 degrees); the exact
-                 // encode/decode is documented in bake/include/drape/bake/body_map_baker.h
+                 // encode/decode: drape/runtime/normal_encoding.h
   kRgb8 = 2,     // paper A's colour encoding, 3 x uint8 per texel (about 0.4 degrees)
 };
 

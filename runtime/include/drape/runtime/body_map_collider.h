@@ -2,7 +2,7 @@
 // Paper A's image-space collider at run time: the front/back depth and normal maps of one posed
 // body (drape/formats/body_map_data.h) as a per-texel slab of asset-frame z, tested discretely,
 // continuously along each particle's motion, and in batches with the response. How it works:
-// docs/ALGORITHMS.md (the body maps at run time); figures: docs/PERFORMANCE.md.
+// docs/ALGORITHMS.md §7; figures: docs/PERFORMANCE.md.
 //
 //   BodyMapCollider maps;
 //   maps.Build(asset.body_maps[0]);                                   // once: allocates

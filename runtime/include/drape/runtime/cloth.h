@@ -1,26 +1,11 @@
 #pragma once
 // A mass-spring cloth built from any triangle mesh (paper A §1, paper B §1.1): the editable
-// ClothDescription, the validating BuildCloth, the immutable Cloth topology it fills, and the
-// ClothState (positions, previous positions, velocities) the caller owns and the solver advances.
-//
-// Springs. Every distinct triangle edge is a stretch spring. Every edge shared by exactly two
-// triangles also gives a bend spring between the two vertices opposite it (paper A fig. 1, paper
-// B fig. 1), unless those two vertices are already joined by a stretch spring or another bend
-// spring. Rest lengths are the distances in ClothDescription::positions.
-//
-// Masses. Either explicit per particle, or from area: each triangle gives a third of its area to
-// each of its vertices, times `density` (kg/m^2); a positive `total_mass` then rescales all
-// masses to that sum. Pinned and attached particles have inverse mass 0: springs and forces do
-// not move them (paper B §1.1: "setting one end's inverse mass to 0 constrains it").
-//
-// Attachments (paper B §3.2 geometric constraints): a particle moves rigidly with a joint. It is
-// stored with its position in the bind-pose asset frame; at a pose with skinning matrix S of that
-// joint its target is S * bind_position (see ClothSolver for the interpolation inside a frame).
-//
-// Solver layout. Springs are stored in flat arrays ordered by colour: within one colour no two
-// springs share a particle, so a colour is solved in parallel with per-particle writes only and
-// the result does not depend on the thread count. Each colour holds springs of one kind. The
-// colouring is deterministic (a function of the description only).
+// ClothDescription, the validating BuildCloth, the immutable Cloth it fills (springs coloured
+// for the solver, masses, pins and attachments), and the ClothState the caller owns and the
+// solver advances. Every triangle edge is a stretch spring; an edge shared by two triangles
+// also gives a bend spring between the opposite vertices. Pinned and attached particles have
+// inverse mass 0; an attached particle follows its joint (its target at a pose with skinning
+// matrix S is S * bind_position). Details: docs/ALGORITHMS.md §10.
 
 #include <cstdint>
 #include <span>

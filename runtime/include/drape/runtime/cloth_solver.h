@@ -1,78 +1,13 @@
 #pragma once
-// Advances a ClothState by one frame: both papers' integrators, substeps, continuous collision
-// against the character's colliders inside every substep, attachments to joints, and relative
-// simulation. Init allocates; Step allocates nothing.
+// Advances a ClothState by one frame: paper A's or paper B's integrator, substeps, continuous
+// collision against the character's colliders in every substep, attachments to joints, and
+// relative simulation. Init allocates; Step allocates nothing and gives the same bits at any
+// thread count. How a substep runs and how to choose substeps and iterations:
+// docs/ALGORITHMS.md §10; figures: docs/PERFORMANCE.md.
 //
-// One substep of length h = dt / substeps covers the fractions [s0, s1] of the frame. Its recipe
-// (ClothSolver::Step, paper B §3.3 order):
-//   BeginSubstep           back up positions and velocities (restored if the substep fails)
-//   ApplyRootMotion        relative simulation only: translate every particle by the root
-//                          joint's translation over [s0, s1] (see below)
-//   AccumulateSpringForces kExplicitEuler only: paper A's spring forces
-//   Integrate              x_start = x; external forces (gravity, damping, fluid drag with wind):
-//                            kVerlet (paper B eq. 4): x += h v + h^2 a_ext
-//                            kExplicitEuler (paper A eq. 1): v += h a, x += h v
-//                          Particles with inverse mass 0 do not integrate.
-//   ApplyAttachments       attached particles to their targets at s1
-//   SolveSprings           kVerlet only: `iterations` passes of paper B's length correction
-//                          (eq. 2-3) over the colours; an end with inverse mass 0 does not move
-//   UpdateVelocities       kVerlet: v = (x - x_start) / h (paper B: velocities estimated from
-//                          positions); kExplicitEuler: attached particles get (x - x_start) / h
-//   Collide                the hulls (SelectSubstep(s0, s1), CollideBatch over [s0, s1]), then
-//                          the body map, each continuous on the segment x_start -> x and applying
-//                          paper A eq. 5 (ResponseParams) to x and v
-//   RestoreKinematic       colliders never move pinned or attached particles: their
-//                          pre-collision positions and velocities are put back
-//   FirstNonFinite         positions and velocities must be finite; else the backup is restored
-//                          and Step returns kInvalidState naming the first bad particle
-//   CountContacts          the stats
-//
-// Invariants between substeps: positions and velocities are finite; previous_positions holds
-// x_start of the last substep (the segment the colliders tested); a pinned particle is where the
-// caller put it (plus root motion); an attached particle is exactly at its target.
-//
-// Springs. Verlet: a spring whose length L differs from its rest length R moves its ends by
-// correction * (L - R) along the spring, split by weight_a / weight_b (inverse masses). Explicit
-// Euler: force stiffness * (L - R) + damping * (relative velocity along the spring). With
-// `buckling` (paper A, after Choi and Ko), stretch springs act only when L > R and bend springs
-// only when L < R; without it both act both ways (paper B corrects over-compression too).
-//
-// Choosing substeps and iterations (measured on a 30 x 30, 1 m sheet draped over a sphere, see
-// the tests): Verlet's residual stretch grows with h^2 g times the number of particles a chain
-// of springs carries and shrinks only slowly with iterations. At 60 Hz with one substep and 3
-// iterations the worst spring is stretched 77 % (mean 8 %); 10 iterations: 28 %; 4 substeps of
-// 3 iterations: 9 % (mean 0.6 %). Substeps buy far more than iterations. Explicit Euler must stay
-// below Cloth::MaxStableEulerStep (RecommendedEulerSubsteps): about 90 substeps per 60 Hz frame
-// for 200 N/m springs on 0.16 g particles.
-//
-// Contact. Paper A's friction scales the tangential velocity by (1 - friction) at each contact;
-// it has no static part, so on a slope cloth creeps at about g_t h (1 - friction) / friction,
-// and under Verlet even friction 1 leaves the tangential displacement of each substep's spring
-// correction in place (a 1 m sheet draped over a 0.3 m sphere: about 2 mm/s at 4 substeps).
-// A separation > 0 puts a contact particle that far outside; the cloth's tension pulls it back
-// and it chatters with that amplitude (harmless at 0.1 mm, but it keeps the kinetic energy of
-// resting cloth from reaching 0).
-//
-// Attachments. The solver receives the skinning matrices at the start (S0) and end (S1) of the
-// frame. At fraction s the target of an attachment (particle, joint j, bind position p) is
-// (1 - s) * S0[j] p + s * S1[j] p (exactly S1[j] p at s = 1).
-//
-// Relative simulation (paper B §3.3 steps 1 and 4, after Oh et al.): with root_joint >= 0 the
-// root joint's translation change over the frame,
-//   delta = S1[root] * root_bind_position - S0[root] * root_bind_position,
-// is applied to the cloth as a rigid translation without inertia: every particle's position
-// (pinned ones included) moves by delta * (s1 - s0) at the start of each substep, velocities are
-// unchanged. The colliders still move with the full skinning matrices, so relative to the body
-// the cloth only feels the rotations and the non-root motion: a running character does not leave
-// its cloth behind and the cloth does not stream back from the root's speed. Damping and drag see
-// only the remaining velocity (the air moves with the character).
-//
-// Determinism and threads: OpenMP over particles, over fixed chunks of particles and over the
-// springs of one colour (see BuildSpringGroups: the partition depends on the particle count
-// only), every loop writing per-index slots; the only reductions are integer counts and ORs and
-// a float max (all order-independent). The result is bitwise identical at any thread count
-// (tested with 1 and 2). The solver's stages of a substep share one parallel region; the
-// colliders open their own.
+//   ClothSolver solver;
+//   solver.Init(cloth, ClothSolverSettings::PaperB());          // once
+//   solver.Step(&state, {&body_map, &hulls, response}, frame);   // per frame
 
 #include <cstdint>
 #include <span>
@@ -98,7 +33,7 @@ struct ClothSolverSettings {
   ClothIntegrator integrator = ClothIntegrator::kVerlet;
   uint32_t substeps = 1;    // per frame, in [1, 256]
   uint32_t iterations = 3;  // Verlet spring-correction passes per substep, in [1, 256] (paper B: 3)
-  bool buckling = false;    // paper A's buckling model (see above)
+  bool buckling = false;  // paper A's buckling model: stretch springs only stretch, bend only bend
   Float3 gravity{0.f, -9.81f, 0.f};  // m/s^2
   float damping = 0.1f;              // 1/s, finite, >= 0: F_damp = -damping * m * v
   float drag = 0.f;  // kg/(m^2 s), finite, >= 0: F_fluid = -drag * area * (v - wind)
@@ -133,7 +68,7 @@ struct ClothColliders {
 
 // Solver-internal layouts (see ClothSolver::BuildSpringGroups); not part of the API.
 namespace internal {
-struct alignas(16) Particle4 {
+struct alignas(16) Particle4 {  // 16 bytes
   float x = 0.f, y = 0.f, z = 0.f, w = 0.f;
 };
 // Four springs that share no particle, lane by lane (80 bytes). An unused lane is a null spring

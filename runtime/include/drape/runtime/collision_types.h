@@ -26,7 +26,7 @@ enum CollisionFlags : uint8_t {
 };
 
 // The answer for one query segment p0 -> p1 (a point query is p0 == p1).
-struct ContactQuery {
+struct ContactQuery {       // 40 bytes
   bool inside_end = false;  // p1 is inside the collider (discrete test)
   bool contact = false;     // a contact was found (continuous test, or p1 inside)
   float t = 1.f;            // contact parameter along p0 -> p1 in [0, 1]
