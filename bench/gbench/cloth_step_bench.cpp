@@ -3,7 +3,7 @@
 // joint spheres: hips, belly, thighs, knees, shins), with continuous collision and friction.
 // Arguments: OpenMP threads, substeps, colliders on (1) or off (0: the solver alone, the skirt
 // then falls freely below its waistband); 5 spring-correction iterations per substep (Verlet).
-// BM_BulletSkirt is the peer (issue #5): Bullet's soft body (bench/peers) on the same skirt
+// BM_BulletSkirt is the peer: Bullet's soft body (bench/peers) on the same skirt
 // mesh, masses and waistband, against the same 4 boxes (btConvexHullShape of their 8 corners)
 // and 16 spheres posed by the same walk, 5 position iterations per substep, single-threaded.
 // Both report the penetration of the particles into the boxes and spheres after each timed frame

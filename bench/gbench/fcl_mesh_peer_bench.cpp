@@ -30,20 +30,18 @@ namespace {
 // unit ball).
 std::vector<Float3> SphereBandPoints(float band, uint64_t seed) {
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<float> unit(-1.f, 1.f),
-      radius(0.5f - band, 0.5f + band);
+  std::uniform_real_distribution<float> unit(-1.f, 1.f), radius(0.5f - band, 0.5f + band);
   std::vector<Float3> points;
   while (points.size() < 20000) {
     const Float3 d{unit(rng), unit(rng), unit(rng)};
     const float len = Length(d);
-    if (len < 0.1f || len > 1.f)
-      continue;
+    if (len < 0.1f || len > 1.f) continue;
     points.push_back(d * (radius(rng) / len));
   }
   return points;
 }
 
-void BM_FclDistance(benchmark::State &state) {
+void BM_FclDistance(benchmark::State& state) {
   static const test::Mesh sphere = test::MakeIcosphere(5, 0.5);
   static const FclMeshPeer peer(sphere.positions, sphere.triangles);
   const float band = static_cast<float>(state.range(0)) * 1e-3f;
@@ -52,20 +50,16 @@ void BM_FclDistance(benchmark::State &state) {
   double sum = 0.0;
   Float3 closest;
   for (auto _ : state) {
-    for (const Float3 &p : points)
-      sum += peer.Distance(p, with_closest ? &closest : nullptr);
+    for (const Float3& p : points) sum += peer.Distance(p, with_closest ? &closest : nullptr);
     benchmark::DoNotOptimize(sum);
   }
-  state.counters["ns_per_query"] =
-      benchmark::Counter(static_cast<double>(points.size()) * 1e-9,
-                         benchmark::Counter::kIsIterationInvariantRate |
-                             benchmark::Counter::kInvert);
+  state.counters["ns_per_query"] = benchmark::Counter(
+      static_cast<double>(points.size()) * 1e-9,
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["triangles"] = static_cast<double>(peer.triangle_count());
   state.counters["memory_kb"] = static_cast<double>(peer.memory_bytes()) / 1e3;
 }
-BENCHMARK(BM_FclDistance)
-    ->ArgNames({"band_mm", "closest"})
-    ->ArgsProduct({{10, 150}, {0, 1}});
+BENCHMARK(BM_FclDistance)->ArgNames({"band_mm", "closest"})->ArgsProduct({{10, 150}, {0, 1}});
 
-} // namespace
-} // namespace drape::peers
+}  // namespace
+}  // namespace drape::peers

@@ -58,15 +58,14 @@ using test::V3;
 // The mesh of index `which` (0 icosphere, 1 mannequin, 2 CesiumMan), or false
 // when its file is absent or does not import. `small` makes the icosphere the
 // distance tests' coarser one.
-bool LoadMesh(int which, bool small, Mesh *mesh, std::string *why) {
+bool LoadMesh(int which, bool small, Mesh* mesh, std::string* why) {
   if (which == 0) {
-    *mesh = small ? MakeIcosphere(3, 0.25, {-0.1, 0.4, 0.2})
-                  : MakeIcosphere(4, 0.3, {0.1, -0.2, 0.05});
+    *mesh =
+        small ? MakeIcosphere(3, 0.25, {-0.1, 0.4, 0.2}) : MakeIcosphere(4, 0.3, {0.1, -0.2, 0.05});
     return true;
   }
-  const std::string path = which == 1
-                               ? test::MannequinPath()
-                               : test::CharacterPath("CesiumMan/CesiumMan.glb");
+  const std::string path =
+      which == 1 ? test::MannequinPath() : test::CharacterPath("CesiumMan/CesiumMan.glb");
   if (!std::filesystem::exists(path)) {
     *why = "shared asset absent: " + path;
     return false;
@@ -83,37 +82,33 @@ bool LoadMesh(int which, bool small, Mesh *mesh, std::string *why) {
 struct WindingCase {
   Mesh mesh;
   std::vector<V3> points;
-  std::vector<double> brute; // ExactMesh::WindingNumber at each point
-  std::string error;         // non-empty: the mesh is unavailable
+  std::vector<double> brute;  // ExactMesh::WindingNumber at each point
+  std::string error;          // non-empty: the mesh is unavailable
 };
 
-const WindingCase &GetWindingCase(int which) {
+const WindingCase& GetWindingCase(int which) {
   static WindingCase cache[3];
   static bool made[3] = {false, false, false};
-  WindingCase &c = cache[which];
-  if (made[which])
-    return c;
+  WindingCase& c = cache[which];
+  if (made[which]) return c;
   made[which] = true;
-  if (!LoadMesh(which, false, &c.mesh, &c.error))
-    return c;
+  if (!LoadMesh(which, false, &c.mesh, &c.error)) return c;
   c.points = BoxPoints(c.mesh, 1000, 31);
   const std::vector<V3> near = NearSurfacePoints(c.mesh, 1000, 0.01, 32);
   c.points.insert(c.points.end(), near.begin(), near.end());
   const ExactMesh brute(c.mesh.positions, c.mesh.triangles);
-  for (const V3 &p : c.points)
-    c.brute.push_back(brute.WindingNumber(Ptr(p)));
+  for (const V3& p : c.points) c.brute.push_back(brute.WindingNumber(Ptr(p)));
   return c;
 }
 
-void SetPerQuery(benchmark::State &state, size_t queries) {
-  state.counters["ns_per_query"] =
-      benchmark::Counter(static_cast<double>(queries) * 1e-9,
-                         benchmark::Counter::kIsIterationInvariantRate |
-                             benchmark::Counter::kInvert);
+void SetPerQuery(benchmark::State& state, size_t queries) {
+  state.counters["ns_per_query"] = benchmark::Counter(
+      static_cast<double>(queries) * 1e-9,
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
-void BM_WindingSetting(benchmark::State &state) {
-  const WindingCase &c = GetWindingCase(static_cast<int>(state.range(0)));
+void BM_WindingSetting(benchmark::State& state) {
+  const WindingCase& c = GetWindingCase(static_cast<int>(state.range(0)));
   if (!c.error.empty()) {
     state.SkipWithError(c.error.c_str());
     return;
@@ -125,8 +120,7 @@ void BM_WindingSetting(benchmark::State &state) {
   const MeshReference fast(c.mesh.positions, c.mesh.triangles, options);
   std::vector<double> w(c.points.size());
   for (auto _ : state) {
-    for (size_t i = 0; i < c.points.size(); ++i)
-      w[i] = fast.WindingNumber(Ptr(c.points[i]));
+    for (size_t i = 0; i < c.points.size(); ++i) w[i] = fast.WindingNumber(Ptr(c.points[i]));
     benchmark::DoNotOptimize(w.data());
   }
   double max_error = 0.0;
@@ -134,21 +128,18 @@ void BM_WindingSetting(benchmark::State &state) {
   for (size_t i = 0; i < c.points.size(); ++i) {
     max_error = std::max(max_error, std::fabs(w[i] - c.brute[i]));
     clear_disagreements +=
-        (w[i] > 0.5) != (c.brute[i] > 0.5) && std::fabs(c.brute[i] - 0.5) > 0.1
-            ? 1
-            : 0;
+        (w[i] > 0.5) != (c.brute[i] > 0.5) && std::fabs(c.brute[i] - 0.5) > 0.1 ? 1 : 0;
   }
   SetPerQuery(state, c.points.size());
   state.counters["max_error"] = max_error;
-  state.counters["clear_disagreements"] =
-      static_cast<double>(clear_disagreements);
+  state.counters["clear_disagreements"] = static_cast<double>(clear_disagreements);
 }
 BENCHMARK(BM_WindingSetting)
     ->ArgNames({"mesh", "beta10"})
     ->ArgsProduct({{0, 1, 2}, {20, 30, 35, 40}});
 
-void BM_BruteWindingNumber(benchmark::State &state) {
-  const WindingCase &c = GetWindingCase(static_cast<int>(state.range(0)));
+void BM_BruteWindingNumber(benchmark::State& state) {
+  const WindingCase& c = GetWindingCase(static_cast<int>(state.range(0)));
   if (!c.error.empty()) {
     state.SkipWithError(c.error.c_str());
     return;
@@ -156,15 +147,14 @@ void BM_BruteWindingNumber(benchmark::State &state) {
   const ExactMesh brute(c.mesh.positions, c.mesh.triangles);
   double sum = 0.0;
   for (auto _ : state) {
-    for (const V3 &p : c.points)
-      sum += brute.WindingNumber(Ptr(p));
+    for (const V3& p : c.points) sum += brute.WindingNumber(Ptr(p));
     benchmark::DoNotOptimize(sum);
   }
   SetPerQuery(state, c.points.size());
 }
 BENCHMARK(BM_BruteWindingNumber)->ArgName("mesh")->DenseRange(0, 2);
 
-void BM_Distance(benchmark::State &state) {
+void BM_Distance(benchmark::State& state) {
   const int which = static_cast<int>(state.range(0));
   Mesh mesh;
   std::string why;
@@ -173,27 +163,23 @@ void BM_Distance(benchmark::State &state) {
     return;
   }
   std::vector<V3> points = BoxPoints(mesh, 1000, which == 0 ? 41 : 51);
-  const std::vector<V3> near = which == 0
-                                   ? NearSurfacePoints(mesh, 500, 0.005, 42)
-                                   : NearSurfacePoints(mesh, 1000, 0.01, 52);
+  const std::vector<V3> near = which == 0 ? NearSurfacePoints(mesh, 500, 0.005, 42)
+                                          : NearSurfacePoints(mesh, 1000, 0.01, 52);
   points.insert(points.end(), near.begin(), near.end());
   const MeshReference fast(mesh.positions, mesh.triangles);
   const ExactMesh brute(mesh.positions, mesh.triangles);
   const bool aabb_tree = state.range(1) == 0;
   double sum = 0.0;
   for (auto _ : state) {
-    for (const V3 &p : points)
-      sum += aabb_tree ? fast.Distance(Ptr(p)) : brute.Distance(Ptr(p));
+    for (const V3& p : points) sum += aabb_tree ? fast.Distance(Ptr(p)) : brute.Distance(Ptr(p));
     benchmark::DoNotOptimize(sum);
   }
   SetPerQuery(state, points.size());
   state.counters["triangles"] = static_cast<double>(mesh.triangles.size() / 3);
 }
-BENCHMARK(BM_Distance)
-    ->ArgNames({"mesh", "method"})
-    ->ArgsProduct({{0, 1}, {0, 1}});
+BENCHMARK(BM_Distance)->ArgNames({"mesh", "method"})->ArgsProduct({{0, 1}, {0, 1}});
 
-void BM_Build(benchmark::State &state) {
+void BM_Build(benchmark::State& state) {
   Mesh mesh;
   std::string why;
   if (!LoadMesh(static_cast<int>(state.range(0)), false, &mesh, &why)) {
@@ -210,8 +196,7 @@ void BM_Build(benchmark::State &state) {
   state.counters["memory_mb"] = static_cast<double>(bytes) / 1e6;
   state.counters["bvh_nodes"] = static_cast<double>(nodes);
 }
-BENCHMARK(BM_Build)->ArgName("mesh")->DenseRange(0, 2)->Unit(
-    benchmark::kMillisecond);
+BENCHMARK(BM_Build)->ArgName("mesh")->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
-} // namespace
-} // namespace drape
+}  // namespace
+}  // namespace drape

@@ -1,6 +1,6 @@
 #pragma once
-// Speed against error at the simulation level (issue #6, "Peers in the same run"; issue #5's
-// side-by-side peer): the same garment on the same walking character against the same colliders
+// Speed against error at the simulation level (DESIGN.md, "Speed against error": the peers in
+// the same run): the same garment on the same walking character against the same colliders
 // (the character's baked hulls and joint spheres), stepped by drape's ClothSolver and by
 // Bullet's soft body. Every frame is timed, and after every frame each particle is tested
 // against the exact posed mesh (linear blend skinning of the original mesh, fast winding

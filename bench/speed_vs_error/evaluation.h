@@ -1,6 +1,6 @@
 #pragma once
 // What the exact mesh says about each query, and the metrics of one method on one query set
-// against it (issue #6, "Metrics"). Definitions, for a motion p0 -> p1:
+// against it. Definitions, for a motion p0 -> p1:
 //  - contact expected: p1 is inside the mesh (winding number > 1/2), or p0 and p1 are outside and
 //    the segment is inside somewhere between two consecutive crossings (tested at the middle of
 //    each interval): a thin part crossed in one step counts (tunnelling).

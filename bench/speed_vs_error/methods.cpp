@@ -281,7 +281,8 @@ ResponseParams BenchResponse() {
 }
 
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
-                                          std::string setting, size_t baked_bytes, InstructionSet lanes) {
+                                          std::string setting, size_t baked_bytes,
+                                          InstructionSet lanes) {
   auto method = std::make_unique<BodyMapMethod>(pose, sampling, lanes);
   method->family = "maps";
   method->setting = std::move(setting);

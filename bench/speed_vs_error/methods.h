@@ -60,7 +60,6 @@ class Method {
   bool speed_only = false;   // no accuracy metrics (its answers do not classify inside)
 };
 
-
 // Paper A's body maps of one pose.
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
                                           std::string setting, size_t baked_bytes,

@@ -1,6 +1,6 @@
 #pragma once
 // The particle motions every method is measured on, per character and pose, drawn with fixed
-// seeds so every method sees the same particles in the same order (issue #6, "Query sets").
+// seeds so every method sees the same particles in the same order.
 // A query is a motion previous -> current in the asset frame (metres); a point query has
 // previous == current.
 

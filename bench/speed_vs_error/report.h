@@ -40,7 +40,7 @@ bool WriteMarkdown(const std::string& path, const std::vector<Row>& rows,
 // character's chart is also written as <dir>/speed_vs_error.png. Returns the PNGs written.
 std::vector<std::string> WriteCharts(const std::string& dir, const std::vector<Row>& rows);
 
-// The headline checks of issue #6 per human character, as markdown; `ok` is false when a target
+// The headline targets per human character, as markdown; `ok` is false when a target
 // fails (the message says which).
 std::string TargetChecks(const std::vector<Row>& rows, bool* ok);
 

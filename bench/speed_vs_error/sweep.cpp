@@ -6,9 +6,7 @@
 #include <vector>
 
 namespace drape::bench {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 std::string Describe(const MapSetting& m) {
   std::ostringstream s;

@@ -23,7 +23,7 @@ struct MapSetting {
   float epsilon = 0.005f;
   DepthEncoding depth = DepthEncoding::kUnorm16;
   NormalEncoding normals = NormalEncoding::kOct16;
-  uint8_t layers = 1;                  // the slab plus layers - 1 air gaps per texel
+  uint8_t layers = 1;                            // the slab plus layers - 1 air gaps per texel
   InstructionSet lanes = InstructionSet::kAvx2;  // the widest CollideBatch may use (kNearest)
 };
 

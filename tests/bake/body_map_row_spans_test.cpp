@@ -139,7 +139,7 @@ TEST(BodyMapBaker, RowSpansHoldTheSameMapsAsDenseOnASphere) {
   }
 }
 
-// The built-in mannequin at N = 512 in the compact encodings (issue #3): measured 581,232 bytes
+// The built-in mannequin at N = 512 in the compact encodings: measured 581,232 bytes
 // in row spans (47,770 texels of the 424 x 508 rectangle, 18.2 % of the window) against
 // 2,584,704 bytes dense.
 TEST(BodyMapBaker, MannequinAt512CompactIsUnderTwoMegabytesInRowSpans) {

@@ -1,6 +1,6 @@
-// Tests of the body map bake's private CPU rasterizer (bake/src/body_map/cpu_rasterizer.h): the two-view
-// pass is bit-identical to two single-view passes, and images reused from an earlier call (the
-// same input again, or a bigger raster before a smaller one; the rasterizer keeps its working
+// Tests of the body map bake's private CPU rasterizer (bake/src/body_map/cpu_rasterizer.h): the
+// two-view pass is bit-identical to two single-view passes, and images reused from an earlier call
+// (the same input again, or a bigger raster before a smaller one; the rasterizer keeps its working
 // depths in them) give exactly what fresh images give, with no stale texel. The fragment pass
 // of the gap layers: its nearest fragments are the rasterizer's texels bit for bit, and on a
 // closed mesh every texel's facing signs sum to zero (even with texel centres on edges and

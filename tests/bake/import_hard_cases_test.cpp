@@ -1,4 +1,4 @@
-// Import hard cases (issue 7): small glTF 2.0 files written at test time, one per pitfall, each
+// Import hard cases: small glTF 2.0 files written at test time, one per pitfall, each
 // with the outcome asserted on concrete values. Expected positions are computed here by hand from
 // the transforms written into the file (translations and quarter turns), not by the importer's
 // own code, so a wrong frame, a dropped influence or a mislabelled joint shows as a number.

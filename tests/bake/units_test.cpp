@@ -1,5 +1,5 @@
 // The same character authored in centimetres, in millimetres, or 10 km from the origin gives the
-// same colliders in metres, within float tolerance (issue 7). The variants are the built-in
+// same colliders in metres, within float tolerance. The variants are the built-in
 // mannequin with its root node scaled or moved.
 
 #include <gtest/gtest.h>
