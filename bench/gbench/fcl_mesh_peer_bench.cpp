@@ -1,17 +1,13 @@
-// The cost of the FCL peer's point distance (bench/peers/fcl_mesh_peer.h), the
-// BVH query that paper A compares its body maps against, on an icosphere of
-// radius 0.5 m subdivided 5 times (20480 triangles), one thread.
+// The cost of the FCL peer's point distance (bench/peers/fcl_mesh_peer.h), the BVH query that
+// paper A compares its body maps against, on an icosphere of radius 0.5 m subdivided 5 times
+// (20480 triangles), one thread.
 //
-//  BM_FclDistance/<band mm>/<closest>  FclMeshPeer::Distance for 20000 points
-//  at radius
-//                                      0.5 m +- band (inside and outside, near
-//                                      the surface as cloth particles are);
-//                                      closest 1 also asks for the closest
-//                                      point. Counters: ns_per_query,
-//                                      triangles, memory_kb
+//  BM_FclDistance/<band mm>/<closest>  FclMeshPeer::Distance for 20000 points at radius
+//                                      0.5 m +- band (inside and outside, near the surface as
+//                                      cloth particles are); closest 1 also asks for the closest
+//                                      point. Counters: ns_per_query, triangles, memory_kb
 //
-// Built with -DDRAPE_BUILD_BENCH=ON (bench_fcl_mesh_peer). Run:
-// build-X/bin/bench_fcl_mesh_peer
+// Built with -DDRAPE_BUILD_BENCH=ON (bench_fcl_mesh_peer). Run: build-X/bin/bench_fcl_mesh_peer
 
 #include <benchmark/benchmark.h>
 
@@ -26,8 +22,7 @@
 namespace drape::peers {
 namespace {
 
-// 20000 points at radius 0.5 +- band, directions uniform (rejection from the
-// unit ball).
+// 20000 points at radius 0.5 +- band, directions uniform (rejection from the unit ball).
 std::vector<Float3> SphereBandPoints(float band, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> unit(-1.f, 1.f), radius(0.5f - band, 0.5f + band);

@@ -1,31 +1,22 @@
-// The exact reference's cost
-// (bench/reference/include/drape/bench/mesh_reference.h) on the meshes its
-// tests check it on (tests/bench/mesh_reference_test.cpp): mesh 0 is an
-// icosphere (5120 triangles; 1280 for BM_Distance), 1 the built-in mannequin's
-// rest pose (7584), 2 CesiumMan's (4672, skipped when ../shared is absent).
-// Points: half uniform in the mesh's box inflated by 10 %, half within 1 cm of
-// the surface (5 mm on the small icosphere), fixed seeds.
+// The exact reference's cost (bench/reference/include/drape/bench/mesh_reference.h) on the
+// meshes its tests check it on (tests/bench/mesh_reference_test.cpp): mesh 0 is an icosphere
+// (5120 triangles; 1280 for BM_Distance), 1 the built-in mannequin's rest pose (7584), 2
+// CesiumMan's (4672, skipped when ../shared is absent). Points: half uniform in the mesh's box
+// inflated by 10 %, half within 1 cm of the surface (5 mm on the small icosphere), fixed seeds.
 //
-//  BM_WindingSetting/<mesh>/<beta x 10>  MeshReference::WindingNumber at
-//  expansion order 2, leaf
-//                                        size 4 and the given beta: how the
-//                                        default was chosen. Counters:
-//                                        ns_per_query, max_error (|fast -
-//                                        brute| over the points),
-//                                        clear_disagreements (Inside differs
-//                                        where the brute force is farther than
-//                                        0.1 from 1/2; the tests hold it to 0)
-//  BM_BruteWindingNumber/<mesh>          ExactMesh::WindingNumber, every
-//  triangle's solid angle BM_Distance/<mesh>/<method>           distance to the
-//  surface: 0 CGAL's AABB tree
-//                                        (MeshReference), 1 brute force
-//                                        (ExactMesh)
-//  BM_Build/<mesh>                       MeshReference's constructor (BVH, AABB
-//  tree, KD-tree);
+//  BM_WindingSetting/<mesh>/<beta x 10>  MeshReference::WindingNumber at expansion order 2, leaf
+//                                        size 4 and the given beta: how the default was chosen.
+//                                        Counters: ns_per_query, max_error (|fast - brute| over
+//                                        the points), clear_disagreements (Inside differs where
+//                                        the brute force is farther than 0.1 from 1/2; the tests
+//                                        hold it to 0)
+//  BM_BruteWindingNumber/<mesh>          ExactMesh::WindingNumber, every triangle's solid angle
+//  BM_Distance/<mesh>/<method>           distance to the surface: 0 CGAL's AABB tree
+//                                        (MeshReference), 1 brute force (ExactMesh)
+//  BM_Build/<mesh>                       MeshReference's constructor (BVH, AABB tree, KD-tree);
 //                                        counters memory_mb, bvh_nodes
 //
-// Built with -DDRAPE_BUILD_BENCH=ON (bench_mesh_reference). Run:
-// build-X/bin/bench_mesh_reference
+// Built with -DDRAPE_BUILD_BENCH=ON (bench_mesh_reference). Run: build-X/bin/bench_mesh_reference
 
 #include <benchmark/benchmark.h>
 
@@ -55,9 +46,8 @@ using test::NearSurfacePoints;
 using test::Ptr;
 using test::V3;
 
-// The mesh of index `which` (0 icosphere, 1 mannequin, 2 CesiumMan), or false
-// when its file is absent or does not import. `small` makes the icosphere the
-// distance tests' coarser one.
+// The mesh of index `which` (0 icosphere, 1 mannequin, 2 CesiumMan), or false when its file is
+// absent or does not import. `small` makes the icosphere the distance tests' coarser one.
 bool LoadMesh(int which, bool small, Mesh* mesh, std::string* why) {
   if (which == 0) {
     *mesh =
@@ -77,8 +67,7 @@ bool LoadMesh(int which, bool small, Mesh* mesh, std::string* why) {
   return true;
 }
 
-// The mesh, its points and the brute-force winding numbers there, made once per
-// mesh.
+// The mesh, its points and the brute-force winding numbers there, made once per mesh.
 struct WindingCase {
   Mesh mesh;
   std::vector<V3> points;
