@@ -7,10 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "drape/bake/bake_pipeline.h"
 #include "drape/runtime/math.h"
@@ -140,8 +142,23 @@ TEST(SceneParse, BadFieldsNameTheirPath) {
        "/solver/gravity/1: ", "must be a number"},
       {"garments as object", [](json& j) { j["garments"] = json::object(); },
        "/garments: ", "non-empty array"},
-      {"unknown key", [](json& j) { j["solver"]["substepz"] = 2; },
-       "/solver/substepz: ", "unknown key"},
+      {"unknown key", [](json& j) { j["solver"]["substepz"] = 2; }, "/solver/substepz: ",
+       "unknown key: substepz is not a parameter of /solver (did you mean substeps? known here: "
+       "integrator | dt | substeps |"},
+      {"unknown garment key",
+       [](json& j) {
+         j["garments"][0]["colour"] = {1, 0, 0};
+       },
+       "/garments/0/colour: ", "did you mean color?"},
+      {"missing attach box corner",
+       [](json& j) {
+         j["garments"][0]["attach"] = {{"joint", "hips"}, {"box", {{"min", {0, 0, 0}}}}};
+       },
+       "/garments/0/attach/box/max: ", "missing (required: an array of 3 numbers [x, y, z])"},
+      {"auto substeps with verlet", [](json& j) { j["solver"]["substeps"] = "auto"; },
+       "/solver/substeps: ", "\"auto\" is for the euler integrator only"},
+      {"duplicate garment name", [](json& j) { j["garments"][1] = j["garments"][0]; },
+       "/garments/1/name: ", "'skirt' is already the name of /garments/0"},
       {"negative radius", [](json& j) { j["garments"][0]["shape"]["top_radius"] = -0.1; },
        "/garments/0/shape/top_radius: ", "out of range"},
       {"selection with two kinds",
@@ -172,6 +189,13 @@ TEST(SceneParse, BadFieldsNameTheirPath) {
        },
        "/animation/pose: ", "rest pose"},
       {"not an object", [](json& j) { j = json::array(); }, "", "must be a JSON object"},
+      {"bake section not an object", [](json& j) { j["bake"]["maps"] = 3; },
+       "/bake/maps: ", "must be an object, not a number"},
+      {"unknown bake key",
+       [](json& j) {
+         j["bake"]["hulls"] = {{"deltaa", 0.01}};
+       },
+       "/bake/hulls/deltaa: ", "did you mean delta?"},
   };
   for (const Case& c : cases) {
     json j = DemoJson();

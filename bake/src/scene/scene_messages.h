@@ -1,7 +1,6 @@
 #pragma once
 // How the scene code words its refusals: one line, the file, the JSON path, the reason.
 
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -15,8 +14,6 @@ Status Invalid(const std::string& message);
 std::string Quote(const std::string& s);
 // "a | b | c"
 std::string JoinNames(const std::vector<std::string>& names);
-// "null", "a boolean", "a number", "a string", "an array" or "an object".
-const char* TypeName(const nlohmann::json& value);
 
 }  // namespace drape::bake::detail
 
