@@ -1,4 +1,5 @@
 // drape-sim SCENE.json -o DIR [--frames N] [--threads T]
+// drape-sim --dump-scene-reference   (docs/SCENES.md: every scene field, from the parser's schema)
 // Bakes the scene's character when its cached asset is missing or stale, simulates the garments
 // against the colliders the scene names, and writes DIR/frames/frame_NNNN.png, an animation
 // (DIR/animation.mp4 or .gif through ffmpeg when it is on PATH, else DIR/contact_sheet.png),
@@ -567,15 +568,23 @@ int main(int argc, char** argv) {
       "drape-sim: bakes a scene's character if needed, simulates its garments and "
       "writes pictures and figures"};
   drape::sim::Options options;
-  app.add_option("SCENE", options.scene_path, "the scene JSON (see samples/scenes/README.md)")
-      ->required();
-  app.add_option("-o,--output", options.out_dir, "output directory (created)")->required();
+  bool dump_reference = false;
+  app.add_option("SCENE", options.scene_path, "the scene JSON (see docs/SCENES.md)");
+  app.add_option("-o,--output", options.out_dir, "output directory (created)");
   app.add_option("--frames", options.frames, "frames to simulate (overrides the scene's duration)")
       ->check(CLI::PositiveNumber);
   app.add_option("--threads", options.threads, "OpenMP threads (default: all)")
       ->check(CLI::PositiveNumber);
+  app.add_flag("--dump-scene-reference", dump_reference,
+               "print the scenes reference (docs/SCENES.md) as markdown and exit");
   try {
     app.parse(argc, argv);
+    if (dump_reference) {
+      std::fputs(drape::bake::SceneReferenceMarkdown().c_str(), stdout);
+      return 0;
+    }
+    if (options.scene_path.empty()) throw CLI::RequiredError("SCENE");
+    if (options.out_dir.empty()) throw CLI::RequiredError("--output");
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }

@@ -7,10 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -453,6 +456,62 @@ TEST_F(SceneTest, PlayedMapPosesAreThoseOfThePlayedTimes) {
   json left_out = json::array();
   PruneUnreachable(reach, &pruned, &left_out);
   EXPECT_EQ(pruned.body_maps.poses.size(), 4u);
+}
+
+// docs/SCENES.md is generated from the schema the parser reads with; a changed field, range or
+// default changes the document.
+TEST(SceneReference, DocumentIsTheGeneratedOne) {
+  const std::string path = test::SourceDir() + "/docs/SCENES.md";
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path << " is missing; generate it with: " << test::BinDir()
+                  << "/drape-sim --dump-scene-reference > docs/SCENES.md";
+  const std::string committed((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
+  const std::string generated = SceneReferenceMarkdown();
+  if (committed == generated) return;
+  // The first line that differs, for the message.
+  std::istringstream a(committed), b(generated);
+  std::string line_a, line_b;
+  int line = 0;
+  while (true) {
+    ++line;
+    const bool more_a = static_cast<bool>(std::getline(a, line_a));
+    const bool more_b = static_cast<bool>(std::getline(b, line_b));
+    if (!more_a || !more_b || line_a != line_b) break;
+  }
+  ADD_FAILURE() << "docs/SCENES.md differs from the generated reference at line " << line
+                << ":\n  committed: " << line_a << "\n  generated: " << line_b
+                << "\nRegenerate it with: " << test::BinDir()
+                << "/drape-sim --dump-scene-reference > docs/SCENES.md";
+}
+
+// Every scene in samples/scenes is in the reference's table of sample scenes, and parses (a scene
+// whose character is a shared asset is skipped when that asset is absent).
+TEST(SceneReference, ListsAndParsesEverySampleScene) {
+  const std::string reference = SceneReferenceMarkdown();
+  std::vector<std::string> absent;
+  size_t scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(ScenesDir())) {
+    if (entry.path().extension() != ".json") continue;
+    ++scenes;
+    const std::string name = entry.path().filename().string();
+    EXPECT_NE(reference.find("| `" + name + "` |"), std::string::npos)
+        << name << " is not in the sample scenes of docs/SCENES.md (scene_reference.cpp)";
+    std::ifstream in(entry.path());
+    const json j = json::parse(in);
+    const std::string character = ScenesDir() + "/" + j.value("character", std::string());
+    if (character.find("/shared/assets/") != std::string::npos &&
+        !std::filesystem::exists(character)) {
+      absent.push_back(name);
+      continue;
+    }
+    Scene scene;
+    const Status s = LoadScene(entry.path().string(), &scene);
+    EXPECT_TRUE(s.ok()) << s.message();
+  }
+  EXPECT_GE(scenes, 5u);
+  for (const std::string& name : absent)
+    std::printf("skipped %s: shared asset absent\n", name.c_str());
 }
 
 }  // namespace
