@@ -207,15 +207,15 @@ def hull_bake(doc, gb):
         return
     doc.add("## Bake: hulls", "",
             "`bench_hull_bake`: one limb-like bone (points on a tapered 25 cm capsule), δ 5 mm. "
-            "ms per bone (median of 3) and, in brackets, the growth beyond the inflated hull in "
-            "mm.", "", "| simplification, budget 100 triangles | 50 points | 200 points | "
+            "CPU ms per bone (median of 3; one thread, so CPU time is the figure a loaded machine "
+            "disturbs least) and, in brackets, the growth beyond the inflated hull in mm.", "", "| simplification, budget 100 triangles | 50 points | 200 points | "
             "400 points |", "|---|---|---|---|")
     modes = (("edge collapse (default)", 0), ("plane removal", 1), ("none", 2))
     for label, mode in modes:
         cells = []
         for points in (50, 200, 400):
             args = (points, mode, 100, 0)
-            t = value(gb, p, "BM_HullBake", args, "real_time")
+            t = value(gb, p, "BM_HullBake", args, "cpu_time")
             g = value(gb, p, "BM_HullBake", args, "growth_mm")
             cells.append(f"{mm(t)} ({mm(g, 2)})" if t is not None else "-")
         doc.add(f"| {label} | " + " | ".join(cells) + " |")
@@ -239,8 +239,8 @@ def hull_bake(doc, gb):
             f"{label} {mm(t, 2)} ms, {mm(v, 1)} cm³" for label, t, v in obb) + ".")
     bones = value(gb, p, "BM_CesiumManHulls", (), "bones")
     if bones:
-        doc.add("", f"Every bone of CesiumMan, one thread: "
-                f"{mm(value(gb, p, 'BM_CesiumManHulls', (), 'real_time'))} ms for {bones:.0f} "
+        doc.add("", f"Every bone of CesiumMan, one thread, CPU time: "
+                f"{mm(value(gb, p, 'BM_CesiumManHulls', (), 'cpu_time'))} ms for {bones:.0f} "
                 f"hulls (slowest bone {mm(value(gb, p, 'BM_CesiumManHulls', (), 'max_bone_ms'))} "
                 f"ms, mean {mm(value(gb, p, 'BM_CesiumManHulls', (), 'mean_tris'), 0)} "
                 "triangles).")
