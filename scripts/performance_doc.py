@@ -120,7 +120,7 @@ def passes(r):
 
 
 def lane_variant(r):  # the same maps with the batch kept to narrower lanes
-    return "SSE2 lanes" in r["setting"] or "AVX2 lanes" in r["setting"]
+    return "SSE2 lanes" in r["setting"] or "scalar lanes" in r["setting"]
 
 
 def default_maps(r):  # the bake's default body maps (bake config: N = 1024, slab only)
@@ -337,7 +337,7 @@ def speed_vs_error(doc, rows, sections):
 
 def lanes(doc, characters):
     """What the wider lanes buy: the same maps with the batch kept to narrower lanes."""
-    variants = [v for v in ("AVX2 lanes", "SSE2 lanes")
+    variants = [v for v in ("SSE2 lanes", "scalar lanes")
                 if any(v in r["setting"] for rs in characters.values() for r in rs)]
     if not variants:
         return
@@ -351,8 +351,8 @@ def lanes(doc, characters):
                         bases.append(base)
     doc.add("### Body-map batch lanes", "",
             "The same maps and motions with `CollideBatch` kept to narrower lanes (the answers are "
-            "the same bits): ns per particle at one thread, people at rest, as widest the CPU has "
-            "/ " + " / ".join(variants) + ".", "",
+            "the same bits): ns per particle at one thread, people at rest, as the widest the CPU "
+            "has / " + " / ".join(variants) + " (the plain C++ reference pack).", "",
             "| character | " + " | ".join(bases) + " |", "|---|" + "---|" * len(bases))
     for c, rs in characters.items():
         if rs[0]["posed"] or not rs[0]["human"]:

@@ -82,7 +82,7 @@ def body_map_queries(doc, gb):
         doc.add(f"| Query, nearest, {label} | {shapes('BM_Continuous', (0, m))} |")
     for label, m in motions:
         doc.add(f"| Query, bilinear, {label} | {shapes('BM_Continuous', (1, m))} |")
-    for lanes_count, lanes_name in ((8, "eight lanes"), (4, "four SSE2 lanes")):
+    for lanes_count, lanes_name in ((8, "eight AVX2 lanes"), (4, "four SSE2 lanes")):
         for label, m in motions:
             doc.add(f"| CollideBatch, {lanes_name}, {label} | "
                     f"{shapes('BM_CollideBatch', (m, lanes_count), threads=True)} |")
