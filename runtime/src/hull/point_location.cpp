@@ -1,6 +1,6 @@
 // Paper B's inside test: the point's projection located in the upper and the lower Kirkpatrick
 // hierarchy, each side answering with its leaf's plane or a fill leaf's guard planes
-// (docs/ALGORITHMS.md §4).
+// (docs/ALGORITHMS.md §4.4-4.5).
 #include <algorithm>
 #include <limits>
 

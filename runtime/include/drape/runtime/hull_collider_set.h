@@ -1,8 +1,8 @@
 #pragma once
 // Paper B's proxy colliders at run time: the per-bone convex hulls and the joint spheres of a
 // .drape asset, posed from the skeleton at the start and the end of each step, answering
-// continuous particle queries with a response. How it works: docs/ALGORITHMS.md (the hulls at run
-// time: inside tests, responses, screw motion, Gauss-Seidel); figures: docs/PERFORMANCE.md.
+// continuous particle queries with a response. How it works: docs/ALGORITHMS.md §8 (screw motion,
+// inside tests, responses, Gauss-Seidel) and §9 (joint spheres); figures: docs/PERFORMANCE.md.
 //
 //   HullColliderSet set;
 //   set.Build(asset.hulls, asset.joint_spheres, joint_count);         // once: allocates

@@ -107,7 +107,8 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   // Asking first whether any 8x8 block under a lane's walk has gaps (a summed-area table, four
   // reads per lane) saved 0.7-0.9 % of the instructions where few walks have gaps near
   // (CesiumMan, 27 % of walk groups) and cost 3.1-3.6 % where nearly all do (Animated_Human,
-  // RobotExpressive: the bodies that need the layers); docs/PERFORMANCE.md, sixteenth session.
+  // RobotExpressive: the bodies that need the layers), counted in instructions on the
+  // speed-vs-error mix.
   const bool gaps_near = gap_layers_ != 0;
   static_assert(sizeof(Slab) == 2 * sizeof(float), "LoadSlabsAt loads a slab as 8 bytes");
   const Slab* const slabs = slabs_.data();
