@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <utility>
 
 namespace drape::bake {
 
@@ -277,6 +278,17 @@ std::string UnknownKeyReason(const std::string& key, const std::string& parent,
          (parent.empty() ? std::string("the top level") : parent) + " (" +
          (suggestion.empty() ? "" : "did you mean " + suggestion + "? ") +
          "known here: " + JoinChoices(known) + ")";
+}
+
+JsonFieldInfo CustomFieldInfo(std::string key, std::string type, std::string what,
+                              std::string meaning) {
+  JsonFieldInfo info;
+  info.key = std::move(key);
+  info.range = type;
+  info.type = std::move(type);
+  info.what = std::move(what);
+  info.meaning = std::move(meaning);
+  return info;
 }
 
 json ReferenceEntry(const JsonFieldInfo& info, const json& default_value) {

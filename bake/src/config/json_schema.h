@@ -103,6 +103,11 @@ struct JsonFieldInfo {
   std::string default_text;  // as the scene reference shows it; empty: from the default value
 };
 
+// The description of a field read by its own code (JsonSchema::Custom): `type` is shown in the
+// references, `what` in messages ("must be <what>", "missing (required: <what>)").
+JsonFieldInfo CustomFieldInfo(std::string key, std::string type, std::string what,
+                              std::string meaning);
+
 // A row of a reference table: the field and its default as JSON (null when the field has none).
 struct JsonReferenceRow {
   const JsonFieldInfo* info;

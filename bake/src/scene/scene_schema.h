@@ -1,7 +1,7 @@
 #pragma once
-// The scene's schema: one table per JSON object of a scene file (/, /animation, /garments/i with
-// its shape, material, attach and pin, /collision, /solver, /output and /output/camera; /bake is
-// the bake config's schema). ParseScene reads a scene through it and then applies the rules that
+// The scene's schema: one table per JSON object of a scene file (/, /animation, /collision,
+// /solver, /output and /output/camera; /garments/i is the garment's schema, garment_schema.h, and
+// /bake the bake config's). ParseScene reads a scene through it and then applies the rules that
 // span objects; the scenes reference (docs/SCENES.md) prints it.
 
 #include "config/json_schema.h"
