@@ -16,7 +16,7 @@
 #   SOAK_OUT=out/soak    the output directory
 #   OMP_WAIT_POLICY      passive unless set: on a shared machine, threads spinning at the
 #                        solver's barriers while a neighbour holds a core make steps many times
-#                        slower (see samples/scenes/README.md, "The soak scene")
+#                        slower (see docs/SCENES.md, "The soak scene")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${SOAK_FRAMES:-10000}

@@ -96,7 +96,7 @@ std::vector<MapSetting> MapSweep(bool quick) {
     }
   }
   if (quick) {
-    // The one setting that meets the body-map target on every human (PERFORMANCE.md), so that
+    // The one setting that meets the body-map target on every human (docs/PERFORMANCE.md), so that
     // --check holds on the shared characters in the quick sweep too.
     MapSetting m;
     m.resolution = 1024;

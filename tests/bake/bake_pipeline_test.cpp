@@ -37,7 +37,7 @@ struct CharacterCase {
   // Paper A looks along the body's front axis. For an upright character the air between parts
   // along that axis is small; for a quadruped the slab from the chest to the tail spans the air
   // under the belly and between the legs, which the discrete test counts as inside (the measured
-  // slab bias of notes §5.1). Humanoids must reach 99.5 %; quadrupeds are held to what they give
+  // slab bias, docs/ALGORITHMS.md §6.5). Humanoids must reach 99.5 %; quadrupeds are held to what they give
   // with paper A's slab, and to 99.5 % with air-gap layers (BodyMapPose::layers = 4).
   double min_agreement;
 };

@@ -1,6 +1,6 @@
 #pragma once
 // Private to the body map baker: the render request both renderers take, and the in-house
-// orthographic rasterizer (notes/algorithms.md section 4.4), the deterministic reference.
+// orthographic rasterizer (docs/ALGORITHMS.md §6.7), the deterministic reference.
 
 #include <cstdint>
 #include <span>

@@ -84,7 +84,7 @@ Status CompileShader(GLenum type, const char* source, GLuint* shader) {
 
 Status CreateState(GlState* s) {
   // llvmpipe gives GL 4.5 core and bit-identical output across thread counts; softpipe is 2.5x
-  // slower and rasterises differently (notes 4.3). Pin it before the context exists.
+  // slower and rasterises differently (docs/ALGORITHMS.md §6.7). Pin it before the context exists.
   setenv("GALLIUM_DRIVER", "llvmpipe", 1);
   const int attributes[] = {OSMESA_FORMAT,
                             OSMESA_RGBA,

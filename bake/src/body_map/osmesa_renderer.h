@@ -1,5 +1,5 @@
 #pragma once
-// Private to the body map baker: paper A's GL render path on OSMesa (notes/algorithms.md 4.3).
+// Private to the body map baker: paper A's GL render path on OSMesa (docs/ALGORITHMS.md §6.7).
 // One OSMesa context (llvmpipe, core profile >= 3.3) is created lazily on first use and kept for
 // the life of the process, guarded by a mutex, so the ~60 ms of shader JIT is paid once. Renders
 // into float render targets (RGBA32F normals, R32F linear depth, DEPTH_COMPONENT32F), culling off,

@@ -251,9 +251,9 @@ std::string Fmt(double v) {
   return buffer;
 }
 
-// Closed character meshes can be wound inward (notes §1.6: winding number -1 inside). Orients
-// every connected component (triangles sharing vertices) so that its signed volume about its
-// centroid is positive. Returns how many components were flipped.
+// Closed character meshes can be wound inward (docs/ALGORITHMS.md §1.4: winding number -1 inside).
+// Orients every connected component (triangles sharing vertices) so that its signed volume about
+// its centroid is positive. Returns how many components were flipped.
 size_t OrientComponentsOutward(MeshData* mesh) {
   const uint32_t vertex_count = mesh->vertex_count();
   std::vector<uint32_t> root(vertex_count);
@@ -549,7 +549,7 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
   size_t mesh_space_mismatch = 0;
   for (const auto& [node, mesh_index] : mesh_instances) {
     const aiMesh* m = scene->mMeshes[mesh_index];
-    // Source-space bind transform of this mesh's vertices (see algorithms.md §1.2).
+    // Source-space bind transform of this mesh's vertices (docs/ALGORITHMS.md §1.1).
     Mat4 to_bind = Mat4::Identity();
     int rigid_joint = -1;
     if (synthetic_root) {

@@ -339,7 +339,7 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
               ? "; hulls.shape_threshold 0.51 (the default; " + value(config.shape_threshold) +
                     " here) lets the flexible vertices shape their heaviest bone's hull too "
                     "(CesiumMan: 0 % of the measured motions missed instead of 6 %; "
-                    "docs/PERFORMANCE.md)"
+                    "docs/ALGORITHMS.md §2.1)"
               : "; most vertices are blended with no bone above half their weight, which no "
                 "hull can follow: use the body maps for this character";
       character.warnings.push_back(
@@ -382,7 +382,7 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
             "the joint spheres reach every flexible vertex (paper B); their radii sum to " +
             metres(paper_b) + ", and spheres.cover left_by_hulls would shrink that to " +
             metres(shrunk) +
-            " (CesiumMan: 66 -> 47 % false contacts, normals 43 -> 25 deg; docs/PERFORMANCE.md)");
+            " (CesiumMan: 66 -> 47 % false contacts, normals 43 -> 25 deg; docs/ALGORITHMS.md §9)");
       }
     }
     json spheres = json::array();

@@ -40,7 +40,7 @@ struct BakeConfig {
   // A flexible vertex also shapes its heaviest bone's hull at min(this, rigid_threshold), (0.5, 1]
   // (it stays in its joint sphere too); 1: hulls are shaped by rigid vertices only (paper B).
   // 0.51 by default: on every measured character it misses fewer penetrations than paper B's
-  // rigid-only hulls, at the rest pose and posed (CesiumMan 6.2 -> 0 %; docs/PERFORMANCE.md).
+  // rigid-only hulls, at the rest pose and posed (docs/ALGORITHMS.md §2.1).
   float shape_threshold = 0.51f;
   HullOptions hull;
   KirkpatrickOptions kirkpatrick;

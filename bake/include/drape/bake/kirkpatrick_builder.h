@@ -1,41 +1,9 @@
 #pragma once
-// Paper B §2.3: the point-location hierarchies of a convex hull's upper and lower faces
-// (Kirkpatrick 1983), flattened into drape/formats/hull_collider_data.h KirkpatrickHierarchy.
-//
-// Projection. The faces are projected along an OBB axis a onto (u, v) = ((p - obb.center) .
-// projection_u, (p - obb.center) . projection_v), computed in float by
-// drape/runtime/hull_collider_set.h ProjectHullUv, so the runtime reproduces a vertex's (u, v) bit for
-// bit. (projection_u, projection_v, a) is right-handed. A face is "upper" when its plane normal n
-// has n.a > tau and its projected triangle is strictly counter-clockwise (exact predicate on the
-// stored floats), "lower" when n.a < -tau and it is strictly clockwise (stored reversed, so
-// counter-clockwise); the rest (vertical and nearly vertical faces, tau = vertical_tolerance) are
-// in neither set: a point over them projects onto the silhouette, which the runtime's tie rule
-// resolves towards the interior. Any axis gives a correct test (notes/algorithms.md §3.1);
-// ProjectionAxis::kAuto builds all three OBB axes and keeps the one with the fewest node tests
-// per location, measured on points sampled uniformly in the OBB (ties: the shortest axis).
-//
-// Triangulation. Per side, the shadow's boundary (directed edges whose reverse is missing) must
-// be one simple cycle. It is enclosed in a triangle whose circumradius is bounding_scale times
-// the shadow's radius, and the annulus is filled (each boundary edge joined to the corner with
-// the largest dot product against its outward normal, plus corner wedges where the assignment
-// changes; notes §3.2). Fill triangles have leaf plane -1. The whole triangulation is verified
-// with exact orientation predicates on the stored float coordinates: every triangle strictly
-// counter-clockwise, every directed edge used once, and the unmatched edges exactly the three
-// sides of the enclosing triangle, which makes it a proper triangulation of that triangle (each
-// point not on an edge is covered once: the winding number of the boundary). If a side fails,
-// tau is raised tenfold (up to 1e-3) and the side rebuilt.
-//
-// Hierarchy. Repeatedly remove a greedy independent set of interior vertices of degree <=
-// max_removal_degree (lowest degree first, then lowest index; the limit is raised when the set
-// would be empty), re-triangulate each star-shaped hole by ear clipping (strictly convex ears
-// with no other link vertex in the closed ear; the best-shaped ear first), and give each new
-// triangle as children the old triangles of the hole that overlap it with positive area
-// (separating-axis test on exact predicates, touching counts as separated). Surviving triangles
-// are shared nodes. Nodes are numbered in creation order, leaves (level 0) first, so every
-// child's index is below its parent's and the root (the enclosing triangle) is the last node.
-// Children are listed largest area first, so a walk usually accepts the first one.
-//
-// Deterministic (no unordered iteration, a fixed-seed generator for the auto samples), no CGAL.
+// Paper B's point-location hierarchies (Kirkpatrick 1983) of a convex hull's upper and lower
+// faces, projected along an OBB axis with the runtime's own ProjectHullUv, triangulated into an
+// enclosing triangle and verified with exact predicates on the stored floats, flattened into
+// KirkpatrickHierarchy (drape/formats/hull_collider_data.h). Deterministic, no CGAL. Projection,
+// triangulation, hierarchy and ties: docs/ALGORITHMS.md §4.
 
 #include <cstdint>
 #include <span>
@@ -48,7 +16,7 @@ namespace drape::bake {
 enum class ProjectionAxis : uint8_t {
   kAuto = 0,      // whichever OBB axis measures fewest node tests per location
   kLongest = 1,   // paper B
-  kShortest = 2,  // notes/algorithms.md §3.1 (fewer slivers on limbs)
+  kShortest = 2,  // docs/ALGORITHMS.md §4.1 (fewer slivers on limbs)
 };
 
 struct KirkpatrickOptions {

@@ -1,8 +1,8 @@
 #pragma once
 // Exact reference queries against a triangle mesh, in double: the ground truth the colliders are
 // measured against. Character meshes are open and self-overlapping, so inside/outside is the
-// generalised winding number (Jacobson et al. 2013), never a parity ray test (notes §6.1).
-// Brute force over all triangles: O(triangles) per query; fine for tests and reports.
+// generalised winding number (Jacobson et al. 2013), never a parity ray test (docs/ALGORITHMS.md
+// §11.1). Brute force over all triangles: O(triangles) per query; fine for tests and reports.
 
 #include <cstdint>
 #include <span>

@@ -1,5 +1,5 @@
 #pragma once
-// Paper B §2.1: the body split by skin weight into rigid regions (one bone) and flexible regions
+// Paper B §3.1: the body split by skin weight into rigid regions (one bone) and flexible regions
 // (blended, near joints). Positions are taken in the rest pose, whose scale is the animation's.
 
 #include <cstdint>
@@ -36,8 +36,8 @@ struct Regions {
 Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions,
                     float shape_threshold = 1.f);
 
-// Joint spheres (paper B §2.3): centred on the joint, radius covering its flexible vertices plus
-// delta (metres). Written into the bind-pose frame the runtime expects. With the bones' hulls
+// Joint spheres (paper B §1.3, §3.1): centred on the joint, radius covering its flexible vertices
+// plus delta (metres). Written into the bind-pose frame the runtime expects. With the bones' hulls
 // (inflated, built from `regions`) and the mesh's triangles, a sphere covers only what the hulls
 // leave out: the flexible corners of rest-pose triangles that no single hull holds.
 std::vector<JointSphereData> BuildJointSpheres(const Regions& regions, float delta,

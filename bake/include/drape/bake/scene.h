@@ -2,17 +2,10 @@
 // A scene: one character, the pose or clip it plays, the garments it wears and how they are
 // held, which collision methods run, the solver's parameters and what to output. The editable
 // description (Scene), its JSON parser (every refusal names the file and the JSON path of the bad
-// field, e.g. "scene.json: /garments/0/attach/joint: no joint named 'hipz'"), its resolution
-// against a skeleton (garment meshes, joint indices, the clip), and "model only what a scene
-// needs": the region the garments can reach over every frame the scene plays, the colliders that
-// region touches and the poses it plays (AnalyzeSceneReach). The format is documented field by
-// field in docs/SCENES.md, generated from the parser's schema (SceneReferenceMarkdown).
-//
-// Frames of a scene. The simulation advances in frames of solver.dt seconds. Frame k (k >= 0)
-// covers scene time [start + k dt, start + (k + 1) dt]; clip time is scene time wrapped by the
-// clip's duration when `loop`, else clamped to it. Before frame 0 the garments settle for
-// animation.settle seconds with the body held still at the start pose (these frames are not
-// output). A static scene (no clip) holds the rest or bind pose throughout.
+// field), its resolution against a skeleton, and "model only what a scene needs": the colliders
+// and poses the garments can reach over the frames the scene plays (AnalyzeSceneReach). The
+// format field by field: docs/SCENES.md (generated from the parser's schema); frames, settling
+// and reach: docs/ALGORITHMS.md §13.
 
 #include <array>
 #include <cstdint>
