@@ -100,9 +100,10 @@ size_t Cloth::memory_bytes() const {
          attachments_.capacity() * sizeof(ClothAttachment);
 }
 
-Status BuildCloth(const ClothDescription& d, Cloth* cloth) {
-  if (cloth == nullptr) return Invalid("cloth is null");
-  cloth->Clear();
+namespace {
+
+// Every count, index and value of the description (the messages name the field).
+Status ValidateDescription(const ClothDescription& d) {
   const size_t n_size = d.positions.size();
   if (n_size == 0) return Invalid("no particles (positions is empty)");
   if (n_size > kMaxParticles)
@@ -158,166 +159,212 @@ Status BuildCloth(const ClothDescription& d, Cloth* cloth) {
   }
   if (Status s = ValidateMaterial(d.stretch, "stretch"); !s.ok()) return s;
   if (Status s = ValidateMaterial(d.bend, "bend"); !s.ok()) return s;
+  return Status::Ok();
+}
 
-  Cloth& c = *cloth;
-  ClothBuildReport& report = c.report_;
-  c.rest_positions_ = d.positions;
-  c.stretch_ = d.stretch;
-  c.bend_ = d.bend;
+}  // namespace
 
-  // Triangles: drop repeated indices; area shares in double (order fixed by triangle index).
-  std::vector<double> area(n, 0.0);
-  c.triangles_.reserve(d.triangles.size());
-  for (size_t t = 0; t < d.triangles.size() / 3; ++t) {
-    const uint32_t i = d.triangles[3 * t], j = d.triangles[3 * t + 1], k = d.triangles[3 * t + 2];
-    if (i == j || j == k || k == i) {
-      ++report.dropped_triangles;
-      continue;
-    }
-    c.triangles_.insert(c.triangles_.end(), {i, j, k});
-    const Float3 pi = d.positions[i], pj = d.positions[j], pk = d.positions[k];
-    const double ux = double(pj.x) - pi.x, uy = double(pj.y) - pi.y, uz = double(pj.z) - pi.z;
-    const double vx = double(pk.x) - pi.x, vy = double(pk.y) - pi.y, vz = double(pk.z) - pi.z;
-    const double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
-    const double tri_area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-    if (!(tri_area >= kMinTriangleArea)) {
-      ++report.zero_area_triangles;
-      continue;
-    }
-    area[i] += tri_area / 3.0;
-    area[j] += tri_area / 3.0;
-    area[k] += tri_area / 3.0;
-  }
-
-  // Kinematic particles: pinned or attached.
-  std::vector<uint8_t> kinematic(n, 0);
-  for (const uint32_t p : d.pinned) kinematic[p] = 1;
-  c.attachments_ = d.attachments;
-  std::sort(
-      c.attachments_.begin(), c.attachments_.end(),
-      [](const ClothAttachment& a, const ClothAttachment& b) { return a.particle < b.particle; });
-  for (size_t k = 0; k < c.attachments_.size(); ++k) {
-    const ClothAttachment& a = c.attachments_[k];
-    if (k > 0 && c.attachments_[k - 1].particle == a.particle) {
-      const uint32_t particle = a.particle;  // `a` dies with Clear()
-      c.Clear();
-      return Invalid("particle " + std::to_string(particle) + " has more than one attachment");
-    }
-    kinematic[a.particle] = 1;
-    c.required_joints_ = std::max(c.required_joints_, static_cast<uint32_t>(a.joint) + 1);
-  }
-
-  // Masses: explicit, or by area (density; total_mass rescales the area masses to its value).
-  c.masses_.assign(n, 0.f);
-  c.inverse_masses_.assign(n, 0.f);
-  c.areas_.resize(n);
-  for (uint32_t i = 0; i < n; ++i) c.areas_[i] = static_cast<float>(area[i]);
-  if (!d.masses.empty()) {
-    c.masses_ = d.masses;
-  } else {
-    const double per_area = d.density > 0.f ? static_cast<double>(d.density) : 1.0;
-    double sum = 0.0;
-    for (uint32_t i = 0; i < n; ++i) sum += area[i] * per_area;
-    const double scale = d.total_mass > 0.f ? (sum > 0.0 ? d.total_mass / sum : 0.0) : 1.0;
-    for (uint32_t i = 0; i < n; ++i) c.masses_[i] = static_cast<float>(area[i] * per_area * scale);
-  }
-  double total = 0.0;
-  for (uint32_t i = 0; i < n; ++i) {
-    if (kinematic[i]) {
-      c.kinematic_.push_back(i);
-      continue;
-    }
-    if (!(c.masses_[i] > 0.f) || !std::isfinite(1.f / c.masses_[i])) {
-      c.Clear();
-      return Invalid("particle " + std::to_string(i) +
-                     " gets no mass (it is in no triangle with area and masses is empty) and is "
-                     "neither pinned nor attached");
-    }
-    c.inverse_masses_[i] = 1.f / c.masses_[i];
-    total += c.masses_[i];
-  }
-  c.total_mass_ = static_cast<float>(total);
-
-  // Edges: sorted uses give the stretch springs; edges used twice give bend candidates.
-  std::vector<EdgeUse> uses;
-  uses.reserve(c.triangles_.size());
-  for (size_t t = 0; t < c.triangles_.size() / 3; ++t) {
-    const uint32_t v[3] = {c.triangles_[3 * t], c.triangles_[3 * t + 1], c.triangles_[3 * t + 2]};
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = v[e], b = v[(e + 1) % 3], o = v[(e + 2) % 3];
-      uses.push_back({std::min(a, b), std::max(a, b), o});
-    }
-  }
-  std::sort(uses.begin(), uses.end());
-  std::vector<Pair> stretch_pairs, bend_pairs;
-  for (size_t k = 0; k < uses.size();) {
-    size_t end = k + 1;
-    while (end < uses.size() && uses[end].lo == uses[k].lo && uses[end].hi == uses[k].hi) ++end;
-    stretch_pairs.push_back({uses[k].lo, uses[k].hi});
-    const size_t count = end - k;
-    if (count == 2) {
-      const uint32_t o0 = uses[k].opposite, o1 = uses[k + 1].opposite;
-      if (o0 != o1) bend_pairs.push_back({std::min(o0, o1), std::max(o0, o1)});
-    } else if (count > 2) {
-      ++report.non_manifold_edges;
-    }
-    k = end;
-  }
-  std::sort(bend_pairs.begin(), bend_pairs.end());
-  bend_pairs.erase(std::unique(bend_pairs.begin(), bend_pairs.end()), bend_pairs.end());
-  if (!d.bend_springs) bend_pairs.clear();
-
-  const auto make_springs = [&](const std::vector<Pair>& pairs, bool skip_stretch_edges) {
-    std::vector<ClothSpring> springs;
-    springs.reserve(pairs.size());
-    for (const Pair& p : pairs) {
-      if (skip_stretch_edges && std::binary_search(stretch_pairs.begin(), stretch_pairs.end(), p))
-        continue;
-      const float rest = Length(d.positions[p.hi] - d.positions[p.lo]);
-      const float wa = c.inverse_masses_[p.lo], wb = c.inverse_masses_[p.hi];
-      if (!(rest >= kMinRestLength) || (wa == 0.f && wb == 0.f)) {
-        ++report.dropped_springs;
+// BuildCloth's stages, in order; each fills part of the cloth.
+struct Cloth::Builder {
+  // The triangles without repeated indices, and each particle's share (a third) of the area of
+  // its triangles, in double (the order is fixed by the triangle index).
+  static std::vector<double> Triangles(const ClothDescription& d, uint32_t n, Cloth* cloth) {
+    Cloth& c = *cloth;
+    ClothBuildReport& report = c.report_;
+    std::vector<double> area(n, 0.0);
+    c.triangles_.reserve(d.triangles.size());
+    for (size_t t = 0; t < d.triangles.size() / 3; ++t) {
+      const uint32_t i = d.triangles[3 * t], j = d.triangles[3 * t + 1], k = d.triangles[3 * t + 2];
+      if (i == j || j == k || k == i) {
+        ++report.dropped_triangles;
         continue;
       }
-      ClothSpring s;
-      s.a = p.lo;
-      s.b = p.hi;
-      s.rest_length = rest;
-      s.weight_a = wa / (wa + wb);
-      s.weight_b = wb / (wa + wb);
-      springs.push_back(s);
+      c.triangles_.insert(c.triangles_.end(), {i, j, k});
+      const Float3 pi = d.positions[i], pj = d.positions[j], pk = d.positions[k];
+      const double ux = double(pj.x) - pi.x, uy = double(pj.y) - pi.y, uz = double(pj.z) - pi.z;
+      const double vx = double(pk.x) - pi.x, vy = double(pk.y) - pi.y, vz = double(pk.z) - pi.z;
+      const double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
+      const double tri_area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+      if (!(tri_area >= kMinTriangleArea)) {
+        ++report.zero_area_triangles;
+        continue;
+      }
+      area[i] += tri_area / 3.0;
+      area[j] += tri_area / 3.0;
+      area[k] += tri_area / 3.0;
     }
-    return springs;
-  };
-  const std::vector<ClothSpring> stretch = make_springs(stretch_pairs, false);
-  const std::vector<ClothSpring> bend = make_springs(bend_pairs, true);
-  c.stretch_count_ = static_cast<uint32_t>(stretch.size());
-  c.bend_count_ = static_cast<uint32_t>(bend.size());
-  c.springs_.reserve(stretch.size() + bend.size());
-  report.stretch_colours =
-      ColourSprings(stretch, SpringKind::kStretch, n, &c.springs_, &c.colours_);
-  report.bend_colours = ColourSprings(bend, SpringKind::kBend, n, &c.springs_, &c.colours_);
+    return area;
+  }
+
+  // Pinned or attached particles (at most one attachment each), and the joints they need.
+  static Status Kinematic(const ClothDescription& d, uint32_t n, Cloth* cloth,
+                          std::vector<uint8_t>* kinematic_out) {
+    Cloth& c = *cloth;
+    std::vector<uint8_t>& kinematic = *kinematic_out;
+    kinematic.assign(n, 0);
+    for (const uint32_t p : d.pinned) kinematic[p] = 1;
+    c.attachments_ = d.attachments;
+    std::sort(
+        c.attachments_.begin(), c.attachments_.end(),
+        [](const ClothAttachment& a, const ClothAttachment& b) { return a.particle < b.particle; });
+    for (size_t k = 0; k < c.attachments_.size(); ++k) {
+      const ClothAttachment& a = c.attachments_[k];
+      if (k > 0 && c.attachments_[k - 1].particle == a.particle) {
+        const uint32_t particle = a.particle;  // `a` dies with Clear()
+        c.Clear();
+        return Invalid("particle " + std::to_string(particle) + " has more than one attachment");
+      }
+      kinematic[a.particle] = 1;
+      c.required_joints_ = std::max(c.required_joints_, static_cast<uint32_t>(a.joint) + 1);
+    }
+
+    return Status::Ok();
+  }
+
+  // Masses: explicit, or by area (density; total_mass rescales the area masses to its value);
+  // inverse masses, 0 for the kinematic particles.
+  static Status Masses(const ClothDescription& d, uint32_t n, const std::vector<double>& area,
+                       const std::vector<uint8_t>& kinematic, Cloth* cloth) {
+    Cloth& c = *cloth;
+    c.masses_.assign(n, 0.f);
+    c.inverse_masses_.assign(n, 0.f);
+    c.areas_.resize(n);
+    for (uint32_t i = 0; i < n; ++i) c.areas_[i] = static_cast<float>(area[i]);
+    if (!d.masses.empty()) {
+      c.masses_ = d.masses;
+    } else {
+      const double per_area = d.density > 0.f ? static_cast<double>(d.density) : 1.0;
+      double sum = 0.0;
+      for (uint32_t i = 0; i < n; ++i) sum += area[i] * per_area;
+      const double scale = d.total_mass > 0.f ? (sum > 0.0 ? d.total_mass / sum : 0.0) : 1.0;
+      for (uint32_t i = 0; i < n; ++i)
+        c.masses_[i] = static_cast<float>(area[i] * per_area * scale);
+    }
+    double total = 0.0;
+    for (uint32_t i = 0; i < n; ++i) {
+      if (kinematic[i]) {
+        c.kinematic_.push_back(i);
+        continue;
+      }
+      if (!(c.masses_[i] > 0.f) || !std::isfinite(1.f / c.masses_[i])) {
+        c.Clear();
+        return Invalid("particle " + std::to_string(i) +
+                       " gets no mass (it is in no triangle with area and masses is empty) and is "
+                       "neither pinned nor attached");
+      }
+      c.inverse_masses_[i] = 1.f / c.masses_[i];
+      total += c.masses_[i];
+    }
+    c.total_mass_ = static_cast<float>(total);
+
+    return Status::Ok();
+  }
+
+  // The stretch springs (every edge) and bend springs (between the vertices opposite an edge two
+  // triangles share), each weighted by its ends' inverse masses and coloured.
+  static void Springs(const ClothDescription& d, uint32_t n, Cloth* cloth) {
+    Cloth& c = *cloth;
+    ClothBuildReport& report = c.report_;
+    // Sorted edge uses give the stretch springs; edges used twice give bend candidates.
+    std::vector<EdgeUse> uses;
+    uses.reserve(c.triangles_.size());
+    for (size_t t = 0; t < c.triangles_.size() / 3; ++t) {
+      const uint32_t v[3] = {c.triangles_[3 * t], c.triangles_[3 * t + 1], c.triangles_[3 * t + 2]};
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = v[e], b = v[(e + 1) % 3], o = v[(e + 2) % 3];
+        uses.push_back({std::min(a, b), std::max(a, b), o});
+      }
+    }
+    std::sort(uses.begin(), uses.end());
+    std::vector<Pair> stretch_pairs, bend_pairs;
+    for (size_t k = 0; k < uses.size();) {
+      size_t end = k + 1;
+      while (end < uses.size() && uses[end].lo == uses[k].lo && uses[end].hi == uses[k].hi) ++end;
+      stretch_pairs.push_back({uses[k].lo, uses[k].hi});
+      const size_t count = end - k;
+      if (count == 2) {
+        const uint32_t o0 = uses[k].opposite, o1 = uses[k + 1].opposite;
+        if (o0 != o1) bend_pairs.push_back({std::min(o0, o1), std::max(o0, o1)});
+      } else if (count > 2) {
+        ++report.non_manifold_edges;
+      }
+      k = end;
+    }
+    std::sort(bend_pairs.begin(), bend_pairs.end());
+    bend_pairs.erase(std::unique(bend_pairs.begin(), bend_pairs.end()), bend_pairs.end());
+    if (!d.bend_springs) bend_pairs.clear();
+
+    const auto make_springs = [&](const std::vector<Pair>& pairs, bool skip_stretch_edges) {
+      std::vector<ClothSpring> springs;
+      springs.reserve(pairs.size());
+      for (const Pair& p : pairs) {
+        if (skip_stretch_edges && std::binary_search(stretch_pairs.begin(), stretch_pairs.end(), p))
+          continue;
+        const float rest = Length(d.positions[p.hi] - d.positions[p.lo]);
+        const float wa = c.inverse_masses_[p.lo], wb = c.inverse_masses_[p.hi];
+        if (!(rest >= kMinRestLength) || (wa == 0.f && wb == 0.f)) {
+          ++report.dropped_springs;
+          continue;
+        }
+        ClothSpring s;
+        s.a = p.lo;
+        s.b = p.hi;
+        s.rest_length = rest;
+        s.weight_a = wa / (wa + wb);
+        s.weight_b = wb / (wa + wb);
+        springs.push_back(s);
+      }
+      return springs;
+    };
+    const std::vector<ClothSpring> stretch = make_springs(stretch_pairs, false);
+    const std::vector<ClothSpring> bend = make_springs(bend_pairs, true);
+    c.stretch_count_ = static_cast<uint32_t>(stretch.size());
+    c.bend_count_ = static_cast<uint32_t>(bend.size());
+    c.springs_.reserve(stretch.size() + bend.size());
+    report.stretch_colours =
+        ColourSprings(stretch, SpringKind::kStretch, n, &c.springs_, &c.colours_);
+    report.bend_colours = ColourSprings(bend, SpringKind::kBend, n, &c.springs_, &c.colours_);
+  }
 
   // Explicit Euler stability rates (Gershgorin rows of M^-1 K and M^-1 C).
-  std::vector<double> k_sum(n, 0.0), c_sum(n, 0.0);
-  for (const SpringColour& colour : c.colours_) {
-    const SpringMaterial& m = c.material(colour.kind);
-    for (uint32_t s = colour.begin; s < colour.end; ++s) {
-      const ClothSpring& spring = c.springs_[s];
-      k_sum[spring.a] += m.stiffness;
-      k_sum[spring.b] += m.stiffness;
-      c_sum[spring.a] += m.damping;
-      c_sum[spring.b] += m.damping;
+  static void EulerRates(uint32_t n, Cloth* cloth) {
+    Cloth& c = *cloth;
+    std::vector<double> k_sum(n, 0.0), c_sum(n, 0.0);
+    for (const SpringColour& colour : c.colours_) {
+      const SpringMaterial& m = c.material(colour.kind);
+      for (uint32_t s = colour.begin; s < colour.end; ++s) {
+        const ClothSpring& spring = c.springs_[s];
+        k_sum[spring.a] += m.stiffness;
+        k_sum[spring.b] += m.stiffness;
+        c_sum[spring.a] += m.damping;
+        c_sum[spring.b] += m.damping;
+      }
     }
+    double w2 = 0.0, g = 0.0;
+    for (uint32_t i = 0; i < n; ++i) {
+      const double w = c.inverse_masses_[i];
+      w2 = std::max(w2, 2.0 * k_sum[i] * w);
+      g = std::max(g, 2.0 * c_sum[i] * w);
+    }
+    c.euler_stiffness_rate_ = static_cast<float>(w2);
+    c.euler_damping_rate_ = static_cast<float>(g);
   }
-  double w2 = 0.0, g = 0.0;
-  for (uint32_t i = 0; i < n; ++i) {
-    const double w = c.inverse_masses_[i];
-    w2 = std::max(w2, 2.0 * k_sum[i] * w);
-    g = std::max(g, 2.0 * c_sum[i] * w);
-  }
-  c.euler_stiffness_rate_ = static_cast<float>(w2);
-  c.euler_damping_rate_ = static_cast<float>(g);
+};
+
+Status BuildCloth(const ClothDescription& d, Cloth* cloth) {
+  if (cloth == nullptr) return Invalid("cloth is null");
+  cloth->Clear();
+  if (Status s = ValidateDescription(d); !s.ok()) return s;
+  const uint32_t n = static_cast<uint32_t>(d.positions.size());
+  cloth->rest_positions_ = d.positions;
+  cloth->stretch_ = d.stretch;
+  cloth->bend_ = d.bend;
+  const std::vector<double> area = Cloth::Builder::Triangles(d, n, cloth);
+  std::vector<uint8_t> kinematic;
+  if (Status s = Cloth::Builder::Kinematic(d, n, cloth, &kinematic); !s.ok()) return s;
+  if (Status s = Cloth::Builder::Masses(d, n, area, kinematic, cloth); !s.ok()) return s;
+  Cloth::Builder::Springs(d, n, cloth);
+  Cloth::Builder::EulerRates(n, cloth);
   return Status::Ok();
 }
 

@@ -134,6 +134,7 @@ class Cloth {
 
  private:
   friend Status BuildCloth(const ClothDescription& description, Cloth* cloth);
+  struct Builder;  // BuildCloth's stages (cloth/cloth.cpp)
   void Clear();
 
   float euler_stiffness_rate_ = 0.f;  // 1/s^2: max_i 2 sum_j k_ij / m_i over dynamic particles
