@@ -1,0 +1,19 @@
+#pragma once
+// One drape-sim run: load the scene, bake or reuse its asset, keep what the garments can reach,
+// settle, simulate and write the frames, the animation and the figures.
+
+#include <cstdint>
+#include <string>
+
+namespace drape::sim {
+
+struct RunOptions {
+  std::string scene_path, out_dir;
+  int64_t frames = 0;  // > 0: overrides the scene's frame count
+  int threads = 0;     // > 0: OpenMP threads
+};
+
+// Returns the process exit code: 0, or 1 after printing one line naming the input and the reason.
+int RunScene(const RunOptions& options);
+
+}  // namespace drape::sim
