@@ -56,8 +56,12 @@ compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' build-bench/CMakeCache.txt)
   echo "load_start=$load_start"
 } >"$out/run_info.txt"
 
+# --check holds every setting to its accuracy claims (the body-map targets of the people, the
+# hulls' own surfaces, the exact peer, the moving sets' start clearance); a failure is reported
+# at the end, after the figures are written.
+checks=0
 OMP_PROC_BIND=${OMP_PROC_BIND:-close} build-bench/bin/drape-speed-vs-error --out "$out" \
-  --character all "${quick[@]}"
+  --character all --check "${quick[@]}" || checks=$?
 if [ "$gbench" = 1 ]; then
   mkdir -p "$out/gbench"
   rm -f "$out"/gbench/*.json
@@ -76,3 +80,7 @@ echo "       $out/speed_vs_error.png (chart of the first character; one per char
 echo "       $out/PERFORMANCE.md (the current state, with its charts in $out/images/)."
 echo "To adopt this run's figures (an idle machine, the full sweep with --gbench):"
 echo "  cp $out/PERFORMANCE.md docs/ && cp $out/images/*.png docs/images/"
+if [ "$checks" != 0 ]; then
+  echo "bench: drape-speed-vs-error --check FAILED (exit $checks): see its output above" >&2
+  exit "$checks"
+fi

@@ -19,7 +19,7 @@
 //   collide with one another (collision filter groups), as in drape.
 // - Collision: see BulletClothCollision. SDF_RS (node against a signed distance field of each
 //   shape) is the default because it is the one that holds the cloth: on a 0.6 m sheet dropped
-//   onto a 0.2 m box (check_bench_peers) SDF_RS keeps it on the box with nodes at most 2.1 cm
+//   onto a 0.2 m box (BulletClothPeer.SheetOnBoxIsHeld) SDF_RS keeps it on the box with nodes at most 2.1 cm
 //   inside, while CL_RS (one cluster per triangle against the shape by GJK) lets the whole sheet
 //   fall through within 40 frames; k-means clusters would be worse still for cloth wrapped round
 //   a limb (a cluster's convex hull spans the limb). Both are discrete: a particle that crosses a

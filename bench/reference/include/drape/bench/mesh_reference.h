@@ -47,8 +47,8 @@ struct WindingNumberOptions {
   // A BVH node is summarised by its expansion when |q - centre| > beta * radius. Larger is more
   // accurate and slower; [Limit: > 1] (values <= 1 are raised to 1.0001; non-finite gives the
   // default). Measured max |fast - brute| at expansion order 2, leaf size 4, on 1000 points in the
-  // inflated bounding box and 1000 within 1 cm of the surface (tests/bake/mesh_reference_test.cpp,
-  // WindingSettingsTable) of an icosphere (5120 triangles), the mannequin (7584) and CesiumMan
+  // inflated bounding box and 1000 within 1 cm of the surface (bench/gbench/mesh_reference_bench.cpp,
+  // BM_WindingSetting) of an icosphere (5120 triangles), the mannequin (7584) and CesiumMan
   // (4672), and the time per query relative to beta = 2:
   //   beta 2: 4.6e-3 .. 6.4e-3 (1x); beta 3: 0.8e-3 .. 1.1e-3 (1.9x); beta 4: 2.1e-4 .. 3.5e-4 (3x)
   // Default 4: the reference stays 3x under 1e-3. Beta 2 (Barill et al.'s choice) suits speed;
