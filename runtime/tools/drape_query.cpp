@@ -2,10 +2,15 @@
 //             [--method maps|hulls|spheres|all] [--mesh F.obj]
 // The runtime's collision answers from the command line, for pipeline checks and debugging.
 // Input rows: "x y z" (points) or "x0 y0 z0 x1 y1 z1" (previous and current position), asset
-// frame, metres; '#' starts a comment. Output: CSV on stdout, one row per input row and method.
+// frame, metres; '#' starts a comment; "nan" and "inf" are read as such. Output: CSV on stdout,
+// one row per input row and method, ending with the CollisionFlags bits. A row with a coordinate
+// that is not finite, or beyond +-1e6 m (no body reaches there, and float positions that far are
+// metres apart), is not queried: it gets kCollisionInvalidInput (128), no contact, the position
+// unchanged, as the runtime's batch calls answer a non-finite particle.
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -16,6 +21,7 @@
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
+#include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
 
@@ -37,6 +43,29 @@ struct Segment {
   drape::Float3 p0, p1;
 };
 
+constexpr float kMaxCoordinate = 1e6f;  // metres
+
+bool Usable(drape::Float3 p) {
+  return drape::IsFinite(p) && std::fabs(p.x) <= kMaxCoordinate &&
+         std::fabs(p.y) <= kMaxCoordinate && std::fabs(p.z) <= kMaxCoordinate;
+}
+
+// The numbers of one row: every token must be one whole number (strtod's syntax, which reads
+// "nan" and "inf"); false names the first token that is not.
+bool ParseNumbers(const std::string& line, std::vector<double>* values, std::string* bad) {
+  std::istringstream tokens(line);
+  for (std::string token; tokens >> token;) {
+    char* end = nullptr;
+    const double v = std::strtod(token.c_str(), &end);
+    if (end == token.c_str() || *end != '\0') {
+      *bad = token;
+      return false;
+    }
+    values->push_back(v);
+  }
+  return true;
+}
+
 bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows,
               std::string* error) {
   std::ifstream in(path);
@@ -47,11 +76,10 @@ bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    std::istringstream fields(line);
     std::vector<double> values;
-    for (double v; fields >> v;) values.push_back(v);
-    if (!fields.eof()) {
-      *error = path + ":" + std::to_string(number) + ": not a number";
+    std::string bad;
+    if (!ParseNumbers(line, &values, &bad)) {
+      *error = path + ":" + std::to_string(number) + ": '" + bad + "' is not a number";
       return false;
     }
     if (values.empty()) continue;
@@ -74,9 +102,19 @@ void PrintRow(size_t row, const char* method, const drape::ContactQuery& q, cons
   drape::Float3 position = s.p1;
   drape::Float3 velocity = s.p1 - s.p0;
   if (q.contact) drape::ApplyResponse(q, drape::ResponseParams{}, &position, &velocity);
-  std::printf("%zu,%s,%d,%d,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g\n", row, method,
-              q.inside_end ? 1 : 0, q.contact ? 1 : 0, q.t, q.point.x, q.point.y, q.point.z,
-              q.normal.x, q.normal.y, q.normal.z, q.depth, position.x, position.y, position.z);
+  std::printf("%zu,%s,%d,%d,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%.7g,%u\n", row,
+              method, q.inside_end ? 1 : 0, q.contact ? 1 : 0, q.t, q.point.x, q.point.y, q.point.z,
+              q.normal.x, q.normal.y, q.normal.z, q.depth, position.x, position.y, position.z,
+              static_cast<unsigned>(q.flags));
+}
+
+// The collider's answer, or the invalid-input answer for a row no collider is asked about.
+template <class Query>
+drape::ContactQuery Answer(const Segment& s, const Query& query) {
+  if (Usable(s.p0) && Usable(s.p1)) return query();
+  drape::ContactQuery invalid;
+  invalid.flags = drape::kCollisionInvalidInput;
+  return invalid;
 }
 
 }  // namespace
@@ -194,12 +232,19 @@ int main(int argc, char** argv) {
       return Fail(path + ": " + s.message());
   }
 
-  std::printf("row,method,inside,contact,t,px,py,pz,nx,ny,nz,depth,x_after,y_after,z_after\n");
+  std::printf(
+      "row,method,inside,contact,t,px,py,pz,nx,ny,nz,depth,x_after,y_after,z_after,flags\n");
   for (size_t r = 0; r < rows.size(); ++r) {
     const Segment& s = rows[r];
-    if (want_maps && !maps.empty()) PrintRow(r, "maps", maps.Query(s.p0, s.p1), s);
-    if (want_hulls) PrintRow(r, "hulls", hulls.Query(s.p0, s.p1, drape::kColliderHulls), s);
-    if (want_spheres) PrintRow(r, "spheres", hulls.Query(s.p0, s.p1, drape::kColliderSpheres), s);
+    if (want_maps && !maps.empty())
+      PrintRow(r, "maps", Answer(s, [&] { return maps.Query(s.p0, s.p1); }), s);
+    if (want_hulls)
+      PrintRow(r, "hulls",
+               Answer(s, [&] { return hulls.Query(s.p0, s.p1, drape::kColliderHulls); }), s);
+    if (want_spheres) {
+      PrintRow(r, "spheres",
+               Answer(s, [&] { return hulls.Query(s.p0, s.p1, drape::kColliderSpheres); }), s);
+    }
   }
   return 0;
 }

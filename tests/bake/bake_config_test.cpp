@@ -55,6 +55,41 @@ TEST(BakeConfig, OutOfRangeAndUnknownKeysNameTheirPath) {
 
 // The reference prints every float as the shortest decimal that reads back as it (0.005, not
 // 0.004999999888241291), and ranges the same way.
+// What drape-bake reads from a --config file's bytes: a number beyond a double, a key given
+// twice, an unknown section and a config that leaves nothing to bake are refused with the JSON
+// path, never thrown or silently resolved.
+TEST(BakeConfig, FileBytesAreReadStrictly) {
+  BakeConfig config;
+  Status s = ParseBakeConfig(R"({"maps": {"resolution": 1e400}})", "c.json", &config);
+  EXPECT_EQ(s.message(),
+            "c.json: /maps/resolution: the number 1e400 is beyond what a double holds");
+  s = ParseBakeConfig(R"({"maps": {"epsilon": [1, -1e999]}})", "c.json", &config);
+  EXPECT_EQ(s.message(),
+            "c.json: /maps/epsilon/1: the number -1e999 is beyond what a double holds");
+  s = ParseBakeConfig(R"({"maps": {"resolution": 64, "resolution": 128}})", "c.json", &config);
+  EXPECT_EQ(s.message(), "c.json: /maps/resolution: appears twice in its object");
+  s = ParseBakeConfig(R"({"maps": {}, "maps": {}})", "c.json", &config);
+  EXPECT_EQ(s.message(), "c.json: /maps: appears twice in its object");
+  s = ParseBakeConfig(R"({"mapz": {}})", "c.json", &config);
+  EXPECT_EQ(s.message().rfind("c.json: /mapz: unknown key: mapz is not a parameter of the top "
+                              "level (did you mean maps?",
+                              0),
+            0u)
+      << s.message();
+  s = ParseBakeConfig(
+      R"({"maps": {"enabled": false}, "hulls": {"enabled": false}, "spheres": {"enabled": false}})",
+      "c.json", &config);
+  EXPECT_EQ(s.message(),
+            "c.json: /: maps.enabled, hulls.enabled and spheres.enabled are all false: the asset "
+            "would hold no collider");
+  s = ParseBakeConfig("{\"maps\": ", "c.json", &config);
+  EXPECT_EQ(s.message().rfind("c.json: not valid JSON: ", 0), 0u) << s.message();
+  EXPECT_EQ(config.maps.resolution, BakeConfig{}.maps.resolution);  // untouched by the failures
+  s = ParseBakeConfig(R"({"maps": {"resolution": 64}})", "c.json", &config);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(config.maps.resolution, 64u);
+}
+
 TEST(BakeConfig, ReferenceNumbersAreTheShortestDecimals) {
   const nlohmann::json reference = BakeConfigReference();
   EXPECT_EQ(reference["hulls"]["delta"]["default"].dump(), "0.005");

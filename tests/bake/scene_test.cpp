@@ -228,6 +228,23 @@ TEST(SceneParse, LoadNamesTheFile) {
   EXPECT_EQ(s.message().rfind(path + ": not valid JSON", 0), 0u) << s.message();
 }
 
+// What drape-sim reads from a scene file's bytes: a number beyond a double and a key given twice
+// are refused with the JSON path, never thrown or silently resolved.
+TEST(SceneParse, FileBytesAreReadStrictly) {
+  Scene scene;
+  Status s = ParseSceneText(R"({"character": "a.glb", "garments": [{"type": "skirt",
+      "shape": {"length": 1e400}}]})",
+                            "s.json", "/nonexistent", &scene);
+  EXPECT_EQ(s.message(),
+            "s.json: /garments/0/shape/length: the number 1e400 is beyond what a double holds");
+  s = ParseSceneText(R"({"character": "a.glb", "character": "b.glb", "garments": []})", "s.json",
+                     "/nonexistent", &scene);
+  EXPECT_EQ(s.message(), "s.json: /character: appears twice in its object");
+  s = ParseSceneText(R"({"character": "a.glb", "solver": {"dt": 0.01, "dt": 0.02}})", "s.json",
+                     "/nonexistent", &scene);
+  EXPECT_EQ(s.message(), "s.json: /solver/dt: appears twice in its object");
+}
+
 TEST(SceneParse, BakeConfigFollowsTheScene) {
   Scene scene;
   ASSERT_TRUE(LoadScene(DemoPath(), &scene).ok());

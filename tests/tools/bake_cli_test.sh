@@ -128,7 +128,36 @@ if [ -e "$WORK/mannequin.drape" ]; then
   if "$QUERY" "$WORK/mannequin.drape" --clip nope --points "$WORK/points.txt" 2>"$WORK/q.err" >/dev/null; then
     fail "query accepted a missing clip"
   elif grep -q "no clip named 'nope'" "$WORK/q.err"; then passed=$((passed + 1)); else fail "query message: $(cat "$WORK/q.err")"; fi
+  # Coordinates that are not finite or beyond +-1e6 m are read and answered as invalid input
+  # (flags 128, the last column), with no contact and the position unchanged; a word is refused.
+  printf '1e30 0 0\nnan 0 0\n0 -inf 0\n0 0 -1e7\n0 1.32 0.02\n' >"$WORK/huge.txt"
+  printf '0 1.32 0.02 1e30 1.32 0.02\n' >"$WORK/huge_segments.txt"
+  if "$QUERY" "$WORK/mannequin.drape" --points "$WORK/huge.txt" >"$WORK/huge.csv" 2>"$WORK/q.err" &&
+    "$QUERY" "$WORK/mannequin.drape" --segments "$WORK/huge_segments.txt" >>"$WORK/huge.csv" 2>>"$WORK/q.err"; then
+    invalid=$(awk -F, '$1 ~ /^[0-9]+$/ && $4 == 0 && $16 == 128' "$WORK/huge.csv" | wc -l)
+    chest=$(awk -F, '$1 == 4 && $2 == "hulls" {print $3 "," $16}' "$WORK/huge.csv")
+    if [ "$invalid" -eq 15 ] && [ "$chest" = "1,2" ]; then passed=$((passed + 1)); else fail "query on huge and non-finite rows: $invalid invalid rows of 15, chest '$chest': $(cat "$WORK/huge.csv")"; fi
+  else
+    fail "query refused huge or non-finite rows: $(cat "$WORK/q.err")"
+  fi
+  printf '0 1 zero\n' >"$WORK/word.txt"
+  if "$QUERY" "$WORK/mannequin.drape" --points "$WORK/word.txt" >/dev/null 2>"$WORK/q.err"; then
+    fail "query accepted a word as a coordinate"
+  elif grep -q "word.txt:1: 'zero' is not a number" "$WORK/q.err"; then passed=$((passed + 1)); else fail "query message: $(cat "$WORK/q.err")"; fi
 fi
+# --- configs: a number beyond a double and a key given twice are errors naming the JSON path
+# (exit 1, no output), never an abort.
+printf '{"maps": {"resolution": 1e400}}' >"$WORK/overflow.json"
+printf '{"maps": {"resolution": 64, "resolution": 128}}' >"$WORK/twice.json"
+for config in overflow twice; do
+  "$BAKE" "$SOURCE/samples/mannequin/mannequin.gltf" -o "$WORK/$config.drape" --config "$WORK/$config.json" 2>"$WORK/$config.err"
+  code=$?
+  if [ $code -eq 1 ] && [ ! -e "$WORK/$config.drape" ] && grep -q "$config.json: /maps/resolution: " "$WORK/$config.err"; then
+    passed=$((passed + 1))
+  else
+    fail "config $config: exit $code, $(cat "$WORK/$config.err")"
+  fi
+done
 if "$BAKE" --dump-config | grep -q '"unit_scale"'; then passed=$((passed + 1)); else fail "--dump-config"; fi
 
 echo "$passed passed, $failures failed"

@@ -1,5 +1,7 @@
 #include "drape/bake/bake_config.h"
 
+#include "json_document.h"
+
 #include <fstream>
 
 #include "bake_config_schema.h"  // beside this file: see json_schema.h on the fuzz target
@@ -183,7 +185,13 @@ const JsonSchema<BakeConfig>& BakeConfigSchema() {
           .Object("hulls", HullsSection(), "paper B's per-bone convex colliders",
                   [](BakeConfig& c) -> BakeConfig& { return c; })
           .Object("spheres", SpheresSection(), "paper B's joint spheres",
-                  [](BakeConfig& c) -> BakeConfig& { return c; });
+                  [](BakeConfig& c) -> BakeConfig& { return c; })
+          .Rule([](const JsonAt& at, BakeConfig& c) {
+            if (c.maps_enabled || c.hulls_enabled || c.spheres_enabled) return Status::Ok();
+            return at.Error(
+                "maps.enabled, hulls.enabled and spheres.enabled are all false: the asset would "
+                "hold no collider");
+          });
   return schema;
 }
 
@@ -198,15 +206,15 @@ Status ApplyBakeConfig(const json& config, const std::string& source, BakeConfig
 }
 
 Status LoadBakeConfig(const std::string& path, BakeConfig* config) {
-  std::ifstream in(path);
-  if (!in) return Status(StatusCode::kIoError, path + ": cannot open the config file");
   json parsed;
-  try {
-    parsed = json::parse(in);
-  } catch (const json::parse_error& e) {
-    return Status(StatusCode::kInvalidArgument, path + ": not valid JSON: " + e.what());
-  }
+  if (Status s = ReadJsonFile(path, "config", &parsed); !s.ok()) return s;
   return ApplyBakeConfig(parsed, path, config);
+}
+
+Status ParseBakeConfig(std::string_view text, const std::string& source, BakeConfig* config) {
+  json parsed;
+  if (Status s = ParseJsonText(text, source, &parsed); !s.ok()) return s;
+  return ApplyBakeConfig(parsed, source, config);
 }
 
 json BakeConfigReference() { return BakeConfigSchema().Reference(BakeConfig{}); }

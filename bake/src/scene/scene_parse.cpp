@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "config/json_document.h"
 #include "drape/bake/scene.h"
 #include "scene/scene_frames.h"
 #include "scene/scene_messages.h"
@@ -41,19 +42,17 @@ Status ParseScene(const json& value, const std::string& source, const std::strin
 }
 
 Status LoadScene(const std::string& path, Scene* scene) {
-  std::ifstream in(path);
-  if (!in) {
-    return Status(StatusCode::kIoError, path + ": cannot open the scene file" +
-                                            (std::filesystem::exists(path) ? "" : " (not found)"));
-  }
   json parsed;
-  try {
-    parsed = json::parse(in);
-  } catch (const json::parse_error& e) {
-    return Invalid(path + ": not valid JSON: " + e.what());
-  }
+  if (Status s = ReadJsonFile(path, "scene", &parsed); !s.ok()) return s;
   const std::string directory = std::filesystem::path(path).parent_path().string();
   return ParseScene(parsed, path, directory, scene);
+}
+
+Status ParseSceneText(std::string_view text, const std::string& source,
+                      const std::string& directory, Scene* scene) {
+  json parsed;
+  if (Status s = ParseJsonText(text, source, &parsed); !s.ok()) return s;
+  return ParseScene(parsed, source, directory, scene);
 }
 
 Status ApplySceneToBakeConfig(const Scene& scene, BakeConfig* config) {

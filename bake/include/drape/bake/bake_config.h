@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 
 #include "drape/bake/body_map_baker.h"
 #include "drape/bake/hull_builder.h"
@@ -55,6 +56,9 @@ struct BakeConfig {
 
 // Reads a JSON config file over the defaults in `config`. `path` names the file in messages.
 Status LoadBakeConfig(const std::string& path, BakeConfig* config);
+// The same from the file's bytes; `source` names it in messages. A key given twice, a number
+// beyond a double and any schema error are refused with the JSON path; nothing throws.
+Status ParseBakeConfig(std::string_view text, const std::string& source, BakeConfig* config);
 Status ApplyBakeConfig(const nlohmann::json& json, const std::string& source, BakeConfig* config);
 
 // {"section.key": {"default", "unit", "range", "description"}, ...}

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "drape/bake/bake_config.h"
@@ -143,6 +144,9 @@ struct Scene {
 
 // Reads and parses a scene file. Relative paths in it resolve against its directory.
 Status LoadScene(const std::string& path, Scene* scene);
+// The same from the file's bytes (relative paths resolve against `directory`); nothing throws.
+Status ParseSceneText(std::string_view text, const std::string& source,
+                      const std::string& directory, Scene* scene);
 // Parses a scene already read; `source` names it in messages, `directory` resolves paths.
 Status ParseScene(const nlohmann::json& json, const std::string& source,
                   const std::string& directory, Scene* scene);
