@@ -150,13 +150,7 @@ double MaxPlaneDistance(const HullColliderData& hull, const V& p) {
   return m;
 }
 
-}  // namespace
-
-Status BuildMapTable(HullColliderData* hull, const MapTableOptions& options, MapTableStats* stats) {
-  MapTableStats local_stats;
-  if (stats == nullptr) stats = &local_stats;
-  *stats = MapTableStats{};
-  hull->map = MapTableData{};
+Status ValidateMapTableInput(const HullColliderData& hull, const MapTableOptions& options) {
   if (!(options.cylinder_elongation >= 1.f && options.cylinder_elongation <= 1000.f))
     return Fail("cylinder_elongation is not in [1, 1000]");
   for (uint32_t n :
@@ -166,21 +160,33 @@ Status BuildMapTable(HullColliderData* hull, const MapTableOptions& options, Map
     return Fail("margin_fraction is not in [0, 1]");
   if (!(options.source_inset >= 0.f && options.source_inset <= 0.45f))
     return Fail("source_inset is not in [0, 0.45]");
-  if (hull->vertices.empty() || hull->triangles.empty() || hull->triangles.size() % 3 != 0 ||
-      hull->planes.empty())
+  if (hull.vertices.empty() || hull.triangles.empty() || hull.triangles.size() % 3 != 0 ||
+      hull.planes.empty())
     return Fail("the hull has no vertices, triangles or planes");
-  for (uint32_t i : hull->triangles)
-    if (i >= hull->vertices.size()) return Fail("a triangle index is out of range");
-  for (const Float3& v : hull->vertices)
+  for (uint32_t i : hull.triangles)
+    if (i >= hull.vertices.size()) return Fail("a triangle index is out of range");
+  for (const Float3& v : hull.vertices)
     if (!IsFinite(v)) return Fail("a vertex is not finite");
-  for (const Plane& p : hull->planes)
+  for (const Plane& p : hull.planes)
     if (!IsFinite(p.normal) || !std::isfinite(p.offset)) return Fail("a plane is not finite");
-  const Obb& obb = hull->obb;
+  const Obb& obb = hull.obb;
   for (int a = 0; a < 3; ++a)
     if (!IsFinite(obb.axes[a]) || std::fabs(Length(obb.axes[a]) - 1.f) > 1e-3f)
       return Fail("an OBB axis is not unit length");
   if (!IsFinite(obb.center) || !IsFinite(obb.half_extents)) return Fail("the OBB is not finite");
+  return Status::Ok();
+}
 
+// The hull's proportions: which OBB axis is longest, the larger of the two other half extents,
+// and the hull's size (the largest distance of a vertex from the OBB centre, metres).
+struct HullShape {
+  int longest = 0, second = 1;
+  float longest_half = 0.f, middle_half = 0.f;
+  double size = 0.0;
+};
+
+Status MeasureHull(const HullColliderData& hull, HullShape* shape) {
+  const Obb& obb = hull.obb;
   const float h[3] = {obb.half_extents.x, obb.half_extents.y, obb.half_extents.z};
   int longest = 0;
   for (int k = 1; k < 3; ++k)
@@ -188,165 +194,266 @@ Status BuildMapTable(HullColliderData* hull, const MapTableOptions& options, Map
   const int second = (longest + 1) % 3, third = (longest + 2) % 3;
   const float middle = std::max(h[second], h[third]);
   double size = 0.0;
-  for (const Float3& v : hull->vertices) size = std::max(size, Norm(ToV(v) - ToV(obb.center)));
+  for (const Float3& v : hull.vertices) size = std::max(size, Norm(ToV(v) - ToV(obb.center)));
   if (!(size > 0.0)) return Fail("the hull has zero size");
+  shape->longest = longest;
+  shape->second = second;
+  shape->longest_half = h[longest];
+  shape->middle_half = middle;
+  shape->size = size;
+  return Status::Ok();
+}
 
-  // A point strictly inside.
-  V inside = ToV(obb.center);
+// A point strictly inside the hull (by inside_margin): the OBB centre, else the vertex mean.
+Status FindInsidePoint(const HullColliderData& hull, double inside_margin, V* inside_point,
+                       MapTableStats* stats) {
+  V inside = ToV(hull.obb.center);
   stats->source_at_obb_center = true;
-  const double inside_margin = 1e-4 * size;
-  if (!(MaxPlaneDistance(*hull, inside) < -inside_margin)) {
+  if (!(MaxPlaneDistance(hull, inside) < -inside_margin)) {
     stats->source_at_obb_center = false;
     inside = V{};
-    for (const Float3& v : hull->vertices) inside = inside + ToV(v);
-    inside = inside * (1.0 / static_cast<double>(hull->vertices.size()));
-    if (!(MaxPlaneDistance(*hull, inside) < -inside_margin))
+    for (const Float3& v : hull.vertices) inside = inside + ToV(v);
+    inside = inside * (1.0 / static_cast<double>(hull.vertices.size()));
+    if (!(MaxPlaneDistance(hull, inside) < -inside_margin))
       return Fail("neither the OBB centre nor the vertex mean is inside the hull (flat hull?)");
   }
+  *inside_point = inside;
+  return Status::Ok();
+}
 
-  MapTableData& t = hull->map;
-  bool cylinder =
-      options.kind == MapTableChoice::kCylinder ||
-      (options.kind == MapTableChoice::kAuto && h[longest] >= options.cylinder_elongation * middle);
-  const V axis = ToV(obb.axes[longest]) * (1.0 / Norm(ToV(obb.axes[longest])));
-  V reference = ToV(obb.axes[second]);
+// The table's frame: Z along the OBB's longest axis, X its second axis made orthogonal to Z.
+struct TableFrame {
+  V axis, reference, binormal;
+};
+
+TableFrame FrameAlongLongestAxis(const Obb& obb, const HullShape& shape) {
+  TableFrame f;
+  const V axis = ToV(obb.axes[shape.longest]) * (1.0 / Norm(ToV(obb.axes[shape.longest])));
+  V reference = ToV(obb.axes[shape.second]);
   reference = reference - axis * Dot(reference, axis);
   reference = reference * (1.0 / Norm(reference));
-  const V binormal = Cross(axis, reference);
+  f.axis = axis;
+  f.reference = reference;
+  f.binormal = Cross(axis, reference);
+  return f;
+}
+
+// A cylinder's source segment: the axis line through `inside`, clipped to the hull and trimmed by
+// source_inset at both ends, with ends that stay strictly inside once stored as floats. Clears
+// *cylinder (and puts the origin back at `inside`) when nothing of the segment is left.
+Status PlaceCylinderSource(const HullColliderData& hull, const MapTableOptions& options,
+                           const V& inside, const V& axis, double inside_margin, bool* cylinder,
+                           V* origin_out, double* length_out) {
+  double t_lo = -std::numeric_limits<double>::infinity(),
+         t_hi = std::numeric_limits<double>::infinity();
+  for (const Plane& pl : hull.planes) {
+    const V n = ToV(pl.normal);
+    const double rate = Dot(n, axis), room = pl.offset - Dot(n, inside);
+    if (rate > 0.0) t_hi = std::min(t_hi, room / rate);
+    if (rate < 0.0) t_lo = std::max(t_lo, room / rate);
+  }
+  if (!(std::isfinite(t_lo) && std::isfinite(t_hi) && t_hi > t_lo))
+    return Fail("the hull is unbounded along its axis");
+  const double span = t_hi - t_lo;
+  const double a0 = t_lo + options.source_inset * span, a1 = t_hi - options.source_inset * span;
+  V origin = inside + axis * a0;
+  double length = std::max(0.0, a1 - a0);
+  // The stored (float) ends must be strictly inside; trim further if rounding says otherwise.
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    const Float3 o{static_cast<float>(origin.x), static_cast<float>(origin.y),
+                   static_cast<float>(origin.z)};
+    const V end = ToV(o) + axis * static_cast<float>(length);
+    if (MaxPlaneDistance(hull, ToV(o)) < -inside_margin &&
+        MaxPlaneDistance(hull, end) < -inside_margin)
+      break;
+    origin = origin + axis * (0.05 * length);
+    length *= 0.9;
+  }
+  if (!(length > 0.0)) *cylinder = false;
+  if (!*cylinder) origin = inside;
+  *origin_out = origin;
+  *length_out = length;
+  return Status::Ok();
+}
+
+// The cells of the table and how far a triangle may miss one and still be listed in it.
+struct CellGrid {
+  bool cylinder = false;
+  uint32_t rows = 0, cols = 0;
+  double col_width = 0.0, phi_margin = 0.0;   // radians
+  double row_height = 0.0, row_margin = 0.0;  // metres (cylinder) or radians (sphere)
+  double axis_tolerance = 0.0;                // metres
+};
+
+CellGrid GridOf(const MapTableData& t, const MapTableOptions& options, bool cylinder, double size) {
+  CellGrid g;
+  g.cylinder = cylinder;
+  const uint32_t rows = t.rows, cols = t.cols;
+  g.rows = rows;
+  g.cols = cols;
+  g.col_width = 2.0 * kPi / cols;
+  g.phi_margin = options.margin_fraction * g.col_width + 1e-4;
+  g.row_height = cylinder ? t.length / static_cast<double>(rows) : kPi / rows;
+  g.row_margin = cylinder ? options.margin_fraction * g.row_height + 1e-6 * size
+                          : options.margin_fraction * g.row_height + 1e-4;
+  g.axis_tolerance = 1e-7 * size;
+  return g;
+}
+
+// Triangles in the table frame (X = reference, Y = binormal, Z = axis), relative to the stored
+// (float) origin.
+std::vector<std::array<V, 3>> TrianglesInTableFrame(const HullColliderData& hull,
+                                                    const MapTableData& t,
+                                                    const TableFrame& frame) {
+  const V o = ToV(t.origin);
+  const size_t tri_count = hull.triangles.size() / 3;
+  std::vector<std::array<V, 3>> local(tri_count);
+  for (size_t i = 0; i < tri_count; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const V p = ToV(hull.vertices[hull.triangles[3 * i + c]]) - o;
+      local[i][c] = {Dot(p, frame.reference), Dot(p, frame.binormal), Dot(p, frame.axis)};
+    }
+  return local;
+}
+
+// Whether triangle (a, b, c) reaches cell (row, col) grown by the margins: its azimuth range
+// [alpha, beta] is cut into `pieces` wedges narrower than pi (one piece for a full turn).
+bool ReachesCell(const CellGrid& g, const V& a, const V& b, const V& c, uint32_t row, double alpha,
+                 double beta, bool full_turn, int pieces) {
+  bool hit = false;
+  for (int piece = 0; piece < pieces && !hit; ++piece) {
+    Polygon poly;
+    poly.p[0] = a;
+    poly.p[1] = b;
+    poly.p[2] = c;
+    poly.n = 3;
+    if (!full_turn) {
+      const double w = (beta - alpha) / pieces;
+      ClipWedge(&poly, alpha + piece * w, alpha + (piece + 1) * w);
+      if (poly.n == 0) continue;
+    }
+    if (g.cylinder) {
+      // Interior rows: the z slab; the first/last rows extend to the ends' sources.
+      if (row > 0) {
+        const double lo = row * g.row_height - g.row_margin;
+        Clip(&poly, [&](const V& p) { return p.z - lo; });
+        if (poly.n == 0) continue;
+      }
+      if (row + 1 < g.rows) {
+        const double hi = (row + 1) * g.row_height + g.row_margin;
+        Clip(&poly, [&](const V& p) { return hi - p.z; });
+        if (poly.n == 0) continue;
+      }
+      hit = true;
+    } else {
+      double cos_min, cos_max;
+      PolarCosRange(poly, a, b, c, g.axis_tolerance, &cos_min, &cos_max);
+      const double theta_min = std::acos(std::clamp(cos_max, -1.0, 1.0));
+      const double theta_max = std::acos(std::clamp(cos_min, -1.0, 1.0));
+      hit = theta_max >= row * g.row_height - g.row_margin &&
+            theta_min <= (row + 1) * g.row_height + g.row_margin;
+    }
+  }
+  return hit;
+}
+
+// Appends triangle i (a, b, c) to the list of every cell it reaches.
+void ListTriangle(const CellGrid& g, const V& a, const V& b, const V& c, uint32_t i,
+                  std::vector<std::vector<uint32_t>>* lists) {
+  const uint32_t rows = g.rows, cols = g.cols;
+  uint32_t col_first, col_count;
+  AzimuthColumns(a, b, c, cols, g.phi_margin, g.axis_tolerance, &col_first, &col_count);
+  // Rows the triangle can reach (a coarse filter before the exact per-cell test).
+  uint32_t row_lo = 0, row_hi = rows - 1;
+  if (g.cylinder) {
+    const double zmin = std::min({a.z, b.z, c.z}) - g.row_margin,
+                 zmax = std::max({a.z, b.z, c.z}) + g.row_margin;
+    row_lo =
+        static_cast<uint32_t>(std::clamp(std::floor(zmin / g.row_height), 0.0, double(rows - 1)));
+    row_hi =
+        static_cast<uint32_t>(std::clamp(std::floor(zmax / g.row_height), 0.0, double(rows - 1)));
+  }
+  for (uint32_t k = 0; k < col_count; ++k) {
+    const uint32_t col = (col_first + k) % cols;
+    // The cell's grown azimuth range, in pieces narrower than pi.
+    const double alpha = col * g.col_width - g.phi_margin,
+                 beta = (col + 1) * g.col_width + g.phi_margin;
+    const bool full_turn = beta - alpha >= 2.0 * kPi;
+    const int pieces = full_turn ? 1 : static_cast<int>(std::ceil((beta - alpha) / (0.5 * kPi)));
+    for (uint32_t row = row_lo; row <= row_hi; ++row) {
+      if (ReachesCell(g, a, b, c, row, alpha, beta, full_turn, pieces))
+        (*lists)[static_cast<size_t>(row) * cols + col].push_back(i);
+    }
+  }
+}
+
+// The cell lists into the table's flat arrays, and their statistics.
+void FlattenCellLists(const std::vector<std::vector<uint32_t>>& lists, MapTableData* t,
+                      MapTableStats* stats) {
+  t->cell_offsets.reserve(lists.size() + 1);
+  t->cell_offsets.push_back(0);
+  for (const auto& list : lists) {
+    t->cell_triangles.insert(t->cell_triangles.end(), list.begin(), list.end());
+    t->cell_offsets.push_back(static_cast<uint32_t>(t->cell_triangles.size()));
+    stats->max_list = std::max(stats->max_list, static_cast<uint32_t>(list.size()));
+    if (list.empty()) ++stats->empty_cells;
+  }
+  stats->kind = t->kind;
+  stats->rows = t->rows;
+  stats->cols = t->cols;
+  stats->entries = static_cast<uint32_t>(t->cell_triangles.size());
+  stats->mean_list = static_cast<double>(stats->entries) / static_cast<double>(lists.size());
+}
+
+}  // namespace
+
+Status BuildMapTable(HullColliderData* hull, const MapTableOptions& options, MapTableStats* stats) {
+  MapTableStats local_stats;
+  if (stats == nullptr) stats = &local_stats;
+  *stats = MapTableStats{};
+  hull->map = MapTableData{};
+  if (Status s = ValidateMapTableInput(*hull, options); !s.ok()) return s;
+
+  HullShape shape;
+  if (Status s = MeasureHull(*hull, &shape); !s.ok()) return s;
+  const double inside_margin = 1e-4 * shape.size;
+  V inside;
+  if (Status s = FindInsidePoint(*hull, inside_margin, &inside, stats); !s.ok()) return s;
+
+  // The table's shape and source: a cylinder along an elongated hull's axis, else a sphere
+  // around the inside point.
+  MapTableData& t = hull->map;
+  bool cylinder = options.kind == MapTableChoice::kCylinder ||
+                  (options.kind == MapTableChoice::kAuto &&
+                   shape.longest_half >= options.cylinder_elongation * shape.middle_half);
+  const TableFrame frame = FrameAlongLongestAxis(hull->obb, shape);
   V origin = inside;
   double length = 0.0;
   if (cylinder) {
-    // The axis line through `inside`, clipped to the hull, trimmed.
-    double t_lo = -std::numeric_limits<double>::infinity(),
-           t_hi = std::numeric_limits<double>::infinity();
-    for (const Plane& pl : hull->planes) {
-      const V n = ToV(pl.normal);
-      const double rate = Dot(n, axis), room = pl.offset - Dot(n, inside);
-      if (rate > 0.0) t_hi = std::min(t_hi, room / rate);
-      if (rate < 0.0) t_lo = std::max(t_lo, room / rate);
+    if (Status s = PlaceCylinderSource(*hull, options, inside, frame.axis, inside_margin, &cylinder,
+                                       &origin, &length);
+        !s.ok()) {
+      return s;
     }
-    if (!(std::isfinite(t_lo) && std::isfinite(t_hi) && t_hi > t_lo))
-      return Fail("the hull is unbounded along its axis");
-    const double span = t_hi - t_lo;
-    const double a0 = t_lo + options.source_inset * span, a1 = t_hi - options.source_inset * span;
-    origin = inside + axis * a0;
-    length = std::max(0.0, a1 - a0);
-    // The stored (float) ends must be strictly inside; trim further if rounding says otherwise.
-    for (int attempt = 0; attempt < 8; ++attempt) {
-      const Float3 o{static_cast<float>(origin.x), static_cast<float>(origin.y),
-                     static_cast<float>(origin.z)};
-      const V end = ToV(o) + axis * static_cast<float>(length);
-      if (MaxPlaneDistance(*hull, ToV(o)) < -inside_margin &&
-          MaxPlaneDistance(*hull, end) < -inside_margin)
-        break;
-      origin = origin + axis * (0.05 * length);
-      length *= 0.9;
-    }
-    if (!(length > 0.0)) cylinder = false;
-    if (!cylinder) origin = inside;
   }
   t.kind = cylinder ? MapTableKind::kCylinder : MapTableKind::kSphere;
   t.rows = cylinder ? options.cylinder_rows : options.sphere_rows;
   t.cols = cylinder ? options.cylinder_cols : options.sphere_cols;
   t.origin = {static_cast<float>(origin.x), static_cast<float>(origin.y),
               static_cast<float>(origin.z)};
-  t.axis = {static_cast<float>(axis.x), static_cast<float>(axis.y), static_cast<float>(axis.z)};
-  t.reference = {static_cast<float>(reference.x), static_cast<float>(reference.y),
-                 static_cast<float>(reference.z)};
+  t.axis = {static_cast<float>(frame.axis.x), static_cast<float>(frame.axis.y),
+            static_cast<float>(frame.axis.z)};
+  t.reference = {static_cast<float>(frame.reference.x), static_cast<float>(frame.reference.y),
+                 static_cast<float>(frame.reference.z)};
   t.length = cylinder ? static_cast<float>(length) : 0.f;
 
-  // Triangles in the table frame (X = reference, Y = binormal, Z = axis), relative to the stored
-  // (float) origin.
-  const V o = ToV(t.origin);
-  const size_t tri_count = hull->triangles.size() / 3;
-  std::vector<std::array<V, 3>> local(tri_count);
-  for (size_t i = 0; i < tri_count; ++i)
-    for (int c = 0; c < 3; ++c) {
-      const V p = ToV(hull->vertices[hull->triangles[3 * i + c]]) - o;
-      local[i][c] = {Dot(p, reference), Dot(p, binormal), Dot(p, axis)};
-    }
-  const uint32_t rows = t.rows, cols = t.cols;
-  const double col_width = 2.0 * kPi / cols;
-  const double phi_margin = options.margin_fraction * col_width + 1e-4;
-  const double row_height = cylinder ? t.length / static_cast<double>(rows) : kPi / rows;
-  const double row_margin = cylinder ? options.margin_fraction * row_height + 1e-6 * size
-                                     : options.margin_fraction * row_height + 1e-4;
-  const double axis_tolerance = 1e-7 * size;
-  std::vector<std::vector<uint32_t>> lists(static_cast<size_t>(rows) * cols);
-  for (size_t i = 0; i < tri_count; ++i) {
-    const V& a = local[i][0];
-    const V& b = local[i][1];
-    const V& c = local[i][2];
-    uint32_t col_first, col_count;
-    AzimuthColumns(a, b, c, cols, phi_margin, axis_tolerance, &col_first, &col_count);
-    // Rows the triangle can reach (a coarse filter before the exact per-cell test).
-    uint32_t row_lo = 0, row_hi = rows - 1;
-    if (cylinder) {
-      const double zmin = std::min({a.z, b.z, c.z}) - row_margin,
-                   zmax = std::max({a.z, b.z, c.z}) + row_margin;
-      row_lo =
-          static_cast<uint32_t>(std::clamp(std::floor(zmin / row_height), 0.0, double(rows - 1)));
-      row_hi =
-          static_cast<uint32_t>(std::clamp(std::floor(zmax / row_height), 0.0, double(rows - 1)));
-    }
-    for (uint32_t k = 0; k < col_count; ++k) {
-      const uint32_t col = (col_first + k) % cols;
-      // The cell's grown azimuth range, in pieces narrower than pi.
-      const double alpha = col * col_width - phi_margin, beta = (col + 1) * col_width + phi_margin;
-      const bool full_turn = beta - alpha >= 2.0 * kPi;
-      const int pieces = full_turn ? 1 : static_cast<int>(std::ceil((beta - alpha) / (0.5 * kPi)));
-      for (uint32_t row = row_lo; row <= row_hi; ++row) {
-        bool hit = false;
-        for (int piece = 0; piece < pieces && !hit; ++piece) {
-          Polygon poly;
-          poly.p[0] = a;
-          poly.p[1] = b;
-          poly.p[2] = c;
-          poly.n = 3;
-          if (!full_turn) {
-            const double w = (beta - alpha) / pieces;
-            ClipWedge(&poly, alpha + piece * w, alpha + (piece + 1) * w);
-            if (poly.n == 0) continue;
-          }
-          if (cylinder) {
-            // Interior rows: the z slab; the first/last rows extend to the ends' sources.
-            if (row > 0) {
-              const double lo = row * row_height - row_margin;
-              Clip(&poly, [&](const V& p) { return p.z - lo; });
-              if (poly.n == 0) continue;
-            }
-            if (row + 1 < rows) {
-              const double hi = (row + 1) * row_height + row_margin;
-              Clip(&poly, [&](const V& p) { return hi - p.z; });
-              if (poly.n == 0) continue;
-            }
-            hit = true;
-          } else {
-            double cos_min, cos_max;
-            PolarCosRange(poly, a, b, c, axis_tolerance, &cos_min, &cos_max);
-            const double theta_min = std::acos(std::clamp(cos_max, -1.0, 1.0));
-            const double theta_max = std::acos(std::clamp(cos_min, -1.0, 1.0));
-            hit = theta_max >= row * row_height - row_margin &&
-                  theta_min <= (row + 1) * row_height + row_margin;
-          }
-        }
-        if (hit) lists[static_cast<size_t>(row) * cols + col].push_back(static_cast<uint32_t>(i));
-      }
-    }
-  }
-  t.cell_offsets.reserve(lists.size() + 1);
-  t.cell_offsets.push_back(0);
-  for (const auto& list : lists) {
-    t.cell_triangles.insert(t.cell_triangles.end(), list.begin(), list.end());
-    t.cell_offsets.push_back(static_cast<uint32_t>(t.cell_triangles.size()));
-    stats->max_list = std::max(stats->max_list, static_cast<uint32_t>(list.size()));
-    if (list.empty()) ++stats->empty_cells;
-  }
-  stats->kind = t.kind;
-  stats->rows = rows;
-  stats->cols = cols;
-  stats->entries = static_cast<uint32_t>(t.cell_triangles.size());
-  stats->mean_list = static_cast<double>(stats->entries) / static_cast<double>(lists.size());
+  // Each cell lists the triangles it can reach.
+  const std::vector<std::array<V, 3>> local = TrianglesInTableFrame(*hull, t, frame);
+  const CellGrid grid = GridOf(t, options, cylinder, shape.size);
+  std::vector<std::vector<uint32_t>> lists(static_cast<size_t>(grid.rows) * grid.cols);
+  for (size_t i = 0; i < local.size(); ++i)
+    ListTriangle(grid, local[i][0], local[i][1], local[i][2], static_cast<uint32_t>(i), &lists);
+  FlattenCellLists(lists, &t, stats);
   return Status::Ok();
 }
 
