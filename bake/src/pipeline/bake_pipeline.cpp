@@ -145,21 +145,9 @@ Status BakeMaps(const BakeConfig& config, const Regions& regions, const Characte
   return Status::Ok();
 }
 
-Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& character,
-                 CharacterAsset* asset, json* report) {
-  const SkeletonData& skeleton = character.skeleton;
-  const uint32_t joints = skeleton.joint_count();
-  std::vector<HullColliderData> built(joints);
-  std::vector<HullStats> stats(joints);
-  std::vector<Status> status(joints);
-  std::vector<KirkpatrickStats> kirkpatrick(joints);
-  std::vector<MapTableStats> tables(joints);
-  // One resolution setting for both shapes: rows x cols of whichever table a collider gets.
-  MapTableOptions map_options = config.map_table;
-  map_options.cylinder_rows = map_options.sphere_rows;
-  map_options.cylinder_cols = map_options.sphere_cols;
+// Each bone's collider points in its collider frame: its rigid vertices, then its shaping ones.
+std::vector<std::vector<Float3>> ColliderPoints(const Regions& regions, uint32_t joints) {
   std::vector<std::vector<Float3>> points(joints);
-  const ExactMesh rest_mesh(regions.rest_positions, character.mesh.triangles);
   for (uint32_t j = 0; j < joints; ++j) {
     const Mat34 to_collider = InverseRigid(regions.collider_frames[j]);
     for (uint32_t v : regions.rigid_vertices[j]) {
@@ -169,41 +157,120 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
       points[j].push_back(TransformPoint(to_collider, regions.rest_positions[v]));
     }
   }
+  return points;
+}
+
+// One bone's collider as built: the hull, its hierarchies and map table, or why it failed.
+struct BoneHull {
+  HullColliderData hull;
+  HullStats stats;
+  Status status;
+  KirkpatrickStats kirkpatrick;
+  MapTableStats table;
+};
+
+// Hull geometry, Kirkpatrick hierarchies and map table of every bone that has collider points.
+std::vector<BoneHull> BuildBoneHulls(const BakeConfig& config,
+                                     const std::vector<std::vector<Float3>>& points) {
+  const uint32_t joints = static_cast<uint32_t>(points.size());
+  std::vector<BoneHull> built(joints);
+  // One resolution setting for both shapes: rows x cols of whichever table a collider gets.
+  MapTableOptions map_options = config.map_table;
+  map_options.cylinder_rows = map_options.sphere_rows;
+  map_options.cylinder_cols = map_options.sphere_cols;
   // One bone per iteration, results in per-bone slots: identical output at any thread count.
 #pragma omp parallel for schedule(dynamic, 1)
   for (int64_t j = 0; j < static_cast<int64_t>(joints); ++j) {
     if (points[j].empty()) continue;
-    status[j] = BuildHullGeometry(points[j], config.hull, &built[j], &stats[j]);
-    if (status[j].ok())
-      status[j] = BuildKirkpatrick(&built[j], config.kirkpatrick, &kirkpatrick[j]);
-    if (status[j].ok()) status[j] = BuildMapTable(&built[j], map_options, &tables[j]);
+    BoneHull& b = built[j];
+    b.status = BuildHullGeometry(points[j], config.hull, &b.hull, &b.stats);
+    if (b.status.ok()) b.status = BuildKirkpatrick(&b.hull, config.kirkpatrick, &b.kirkpatrick);
+    if (b.status.ok()) b.status = BuildMapTable(&b.hull, map_options, &b.table);
   }
+  return built;
+}
+
+// Too few points for a solid: the joint sphere shared with the parent covers the rigid vertices
+// (the shaping ones are in their joint spheres already). Returns where they went, for the report.
+std::string LeaveToJointSphere(const SkeletonData& skeleton, uint32_t j, Regions& regions) {
+  std::string where = "not covered (no parent joint)";
+  for (JointRegion& region : regions.joints) {
+    if (region.child == static_cast<int32_t>(j) || region.parent == static_cast<int32_t>(j)) {
+      region.flexible_vertices.insert(region.flexible_vertices.end(),
+                                      regions.rigid_vertices[j].begin(),
+                                      regions.rigid_vertices[j].end());
+      where = "left to the joint sphere of '" + skeleton.joint_names[region.child] + "'";
+      break;
+    }
+  }
+  return where;
+}
+
+json HullReport(const std::string& bone, const Regions& regions, uint32_t j, const BoneHull& b,
+                double stand_off) {
+  const HullStats& st = b.stats;
+  const KirkpatrickStats& kirkpatrick = b.kirkpatrick;
+  const MapTableStats& table = b.table;
+  return {{"bone", bone},
+          {"kind", "hull"},
+          {"rigid_vertices", regions.rigid_vertices[j].size()},
+          {"shaping_vertices", regions.shaping_vertices[j].size()},
+          {"triangles_before", st.hull_triangles_before},
+          {"triangles_after", st.triangles_after},
+          {"planes_before", st.planes_before},
+          {"planes_after", st.planes_after},
+          {"budget_reached", st.budget_reached},
+          {"growth_mm", st.growth_mm},
+          {"distance_to_mesh_mm", stand_off * 1000.0},
+          {"kirkpatrick",
+           {{"axis", kirkpatrick.axis_index},
+            {"upper_nodes", kirkpatrick.upper.nodes},
+            {"lower_nodes", kirkpatrick.lower.nodes},
+            {"levels", std::max(kirkpatrick.upper.levels, kirkpatrick.lower.levels)},
+            {"mean_tests", kirkpatrick.mean_tests}}},
+          {"map_table",
+           {{"kind", table.kind == MapTableKind::kSphere ? "sphere" : "cylinder"},
+            {"rows", table.rows},
+            {"cols", table.cols},
+            {"entries", table.entries},
+            {"max_list", table.max_list},
+            {"empty_cells", table.empty_cells}}},
+          {"bytes", HullBytes(b.hull)},
+          {"ms", st.ms}};
+}
+
+// The fractions of the vertices that are rigid, and that shape a hull (rigid or shaping).
+void ReportVertexFractions(const Regions& regions, json* report) {
+  size_t rigid = 0, shaping = 0;
+  for (const std::vector<uint32_t>& vertices : regions.rigid_vertices) rigid += vertices.size();
+  for (const std::vector<uint32_t>& vertices : regions.shaping_vertices) shaping += vertices.size();
+  const double vertices = static_cast<double>(std::max<size_t>(regions.rest_positions.size(), 1));
+  (*report)["rigid_vertex_fraction"] = static_cast<double>(rigid) / vertices;
+  (*report)["hull_vertex_fraction"] = static_cast<double>(rigid + shaping) / vertices;
+}
+
+Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& character,
+                 CharacterAsset* asset, json* report) {
+  const SkeletonData& skeleton = character.skeleton;
+  const uint32_t joints = skeleton.joint_count();
+  const std::vector<std::vector<Float3>> points = ColliderPoints(regions, joints);
+  const ExactMesh rest_mesh(regions.rest_positions, character.mesh.triangles);
+  std::vector<BoneHull> built = BuildBoneHulls(config, points);
   json colliders = json::array();
   json left_out = json::array();
   for (uint32_t j = 0; j < joints; ++j) {
     const std::string& bone = skeleton.joint_names[j];
     if (points[j].empty()) continue;  // no rigid or shaping vertices: nothing to cover
-    if (!status[j].ok()) {
-      // Too few points for a solid: the joint sphere shared with the parent covers the rigid
-      // vertices (the shaping ones are in their joint spheres already).
-      std::string where = "not covered (no parent joint)";
-      for (JointRegion& region : regions.joints) {
-        if (region.child == static_cast<int32_t>(j) || region.parent == static_cast<int32_t>(j)) {
-          region.flexible_vertices.insert(region.flexible_vertices.end(),
-                                          regions.rigid_vertices[j].begin(),
-                                          regions.rigid_vertices[j].end());
-          where = "left to the joint sphere of '" + skeleton.joint_names[region.child] + "'";
-          break;
-        }
-      }
+    if (!built[j].status.ok()) {
+      const std::string where = LeaveToJointSphere(skeleton, j, regions);
       left_out.push_back({{"bone", bone},
                           {"rigid_vertices", regions.rigid_vertices[j].size()},
                           {"shaping_vertices", regions.shaping_vertices[j].size()},
-                          {"reason", status[j].message()},
+                          {"reason", built[j].status.message()},
                           {"covered_by", where}});
       continue;
     }
-    HullColliderData& hull = built[j];
+    HullColliderData& hull = built[j].hull;
     hull.joint = static_cast<int32_t>(j);
     Mat34 rest_to_bind;
     if (!InverseAffine(regions.rest_skinning[j], &rest_to_bind)) {
@@ -215,44 +282,12 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
     for (const Float3& v : hull.vertices)
       world.push_back(TransformPoint(regions.collider_frames[j], v));
     const double stand_off = MaxDistanceToMesh(world, rest_mesh);
-    const HullStats& st = stats[j];
-    colliders.push_back(
-        {{"bone", bone},
-         {"kind", "hull"},
-         {"rigid_vertices", regions.rigid_vertices[j].size()},
-         {"shaping_vertices", regions.shaping_vertices[j].size()},
-         {"triangles_before", st.hull_triangles_before},
-         {"triangles_after", st.triangles_after},
-         {"planes_before", st.planes_before},
-         {"planes_after", st.planes_after},
-         {"budget_reached", st.budget_reached},
-         {"growth_mm", st.growth_mm},
-         {"distance_to_mesh_mm", stand_off * 1000.0},
-         {"kirkpatrick",
-          {{"axis", kirkpatrick[j].axis_index},
-           {"upper_nodes", kirkpatrick[j].upper.nodes},
-           {"lower_nodes", kirkpatrick[j].lower.nodes},
-           {"levels", std::max(kirkpatrick[j].upper.levels, kirkpatrick[j].lower.levels)},
-           {"mean_tests", kirkpatrick[j].mean_tests}}},
-         {"map_table",
-          {{"kind", tables[j].kind == MapTableKind::kSphere ? "sphere" : "cylinder"},
-           {"rows", tables[j].rows},
-           {"cols", tables[j].cols},
-           {"entries", tables[j].entries},
-           {"max_list", tables[j].max_list},
-           {"empty_cells", tables[j].empty_cells}}},
-         {"bytes", HullBytes(hull)},
-         {"ms", st.ms}});
+    colliders.push_back(HullReport(bone, regions, j, built[j], stand_off));
     asset->hulls.push_back(std::move(hull));
   }
   (*report)["colliders"] = colliders;
   (*report)["left_out"] = left_out;
-  size_t rigid = 0, shaping = 0;
-  for (const std::vector<uint32_t>& vertices : regions.rigid_vertices) rigid += vertices.size();
-  for (const std::vector<uint32_t>& vertices : regions.shaping_vertices) shaping += vertices.size();
-  const double vertices = static_cast<double>(std::max<size_t>(regions.rest_positions.size(), 1));
-  (*report)["rigid_vertex_fraction"] = static_cast<double>(rigid) / vertices;
-  (*report)["hull_vertex_fraction"] = static_cast<double>(rigid + shaping) / vertices;
+  ReportVertexFractions(regions, report);
   return Status::Ok();
 }
 
@@ -264,177 +299,210 @@ constexpr double kLowHullVertexFraction = 0.5;
 // radii (CesiumMan: 43 %; the mannequin: 14 %, RobotExpressive 5 %, the others under 3 %).
 constexpr double kSphereShrinkWorthWarning = 0.8;
 
-}  // namespace
+// The report's header: what was baked, by which tool, for which format, with which config.
+void StartReport(const std::string& input, const BakeConfig& config, json* report) {
+  *report = json::object();
+  (*report)["input"] = input;
+  (*report)["tool_version"] = DRAPE_VERSION_STRING;
+  (*report)["format_version"] = kAssetFormatVersion;
+  (*report)["config"] = BakeConfigToJson(config);
+}
 
-Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result,
-                     const std::string& preview_dir, const Scene* scene) {
-  json& report = result->report;
-  report = json::object();
-  report["input"] = input;
-  report["tool_version"] = DRAPE_VERSION_STRING;
-  report["format_version"] = kAssetFormatVersion;
-  report["config"] = BakeConfigToJson(config);
-  json timings = json::object();
+// The asset starts as the imported character; the report says what was imported.
+void StartAsset(const Character& character, CharacterAsset* asset, json* report) {
+  *asset = CharacterAsset{};
+  asset->info = character.info;
+  asset->skeleton = character.skeleton;
+  asset->clips = character.clips;
+  asset->mesh = character.mesh;
 
-  auto start = Clock::now();
-  Character character;
-  if (Status s = ImportCharacter(input, config.import, &character); !s.ok()) return s;
-  timings["import_ms"] = MillisecondsSince(start);
-
-  CharacterAsset& asset = result->asset;
-  asset = CharacterAsset{};
-  asset.info = character.info;
-  asset.skeleton = character.skeleton;
-  asset.clips = character.clips;
-  asset.mesh = character.mesh;
-
-  report["unit_scale"] = character.info.unit_scale;
-  report["up_axis"] = character.info.up_axis;
+  (*report)["unit_scale"] = character.info.unit_scale;
+  (*report)["up_axis"] = character.info.up_axis;
   json matrix = json::array();
   for (int r = 0; r < 4; ++r) {
     matrix.push_back({character.source_to_asset[4 * r], character.source_to_asset[4 * r + 1],
                       character.source_to_asset[4 * r + 2], character.source_to_asset[4 * r + 3]});
   }
-  report["source_to_asset"] = matrix;
-  report["joint_count"] = asset.skeleton.joint_count();
+  (*report)["source_to_asset"] = matrix;
+  (*report)["joint_count"] = asset->skeleton.joint_count();
   json clips = json::array();
-  for (const ClipData& clip : asset.clips) {
+  for (const ClipData& clip : asset->clips) {
     clips.push_back(
         {{"name", clip.name}, {"duration_s", clip.duration}, {"frames", clip.frame_count}});
   }
-  report["clips"] = clips;
-  report["mesh"] = {{"vertices", asset.mesh.vertex_count()},
-                    {"triangles", asset.mesh.triangle_count()}};
+  (*report)["clips"] = clips;
+  (*report)["mesh"] = {{"vertices", asset->mesh.vertex_count()},
+                       {"triangles", asset->mesh.triangle_count()}};
+}
+
+// A warning when the hulls shape less than kLowHullVertexFraction of the vertices, with advice.
+void WarnIfHullsCoverLittle(const BakeConfig& config, double fraction, size_t hull_count,
+                            std::vector<std::string>* warnings) {
+  if (fraction >= kLowHullVertexFraction) return;
+  const auto value = [](float v) { return std::to_string(v).substr(0, 4); };
+  std::string advice =
+      config.shape_threshold > 0.51f
+          ? "; hulls.shape_threshold 0.51 (the default; " + value(config.shape_threshold) +
+                " here) lets the flexible vertices shape their heaviest bone's hull too "
+                "(CesiumMan: 0 % of the measured motions missed instead of 6 %; "
+                "docs/ALGORITHMS.md §2.1)"
+          : "; most vertices are blended with no bone above half their weight, which no "
+            "hull can follow: use the body maps for this character";
+  warnings->push_back("only " + std::to_string(static_cast<int>(std::lround(fraction * 100.0))) +
+                      " % of the vertices shape a hull at hulls.rigid_threshold " +
+                      value(config.rigid_threshold) + " and hulls.shape_threshold " +
+                      value(config.shape_threshold) + " (" + std::to_string(hull_count) +
+                      " hulls): the skin weights are smooth and the joint spheres carry most of "
+                      "the body" +
+                      advice);
+}
+
+// Smoothly weighted rigs get spheres of a limb's size: a warning when spheres.cover
+// left_by_hulls would shrink the paper's spheres by more than kSphereShrinkWorthWarning.
+void AdviseSphereCover(const BakeConfig& config, const Regions& regions, const Character& character,
+                       const CharacterAsset& asset, std::vector<std::string>* warnings) {
+  const auto radius_sum = [](const std::vector<JointSphereData>& spheres) {
+    double sum = 0.0;
+    for (const JointSphereData& s : spheres) sum += s.radius;
+    return sum;
+  };
+  const double paper_b = radius_sum(asset.joint_spheres);
+  const double shrunk = radius_sum(
+      BuildJointSpheres(regions, config.sphere_delta, asset.hulls, character.mesh.triangles));
+  if (shrunk < kSphereShrinkWorthWarning * paper_b) {
+    const auto metres = [](double m) {
+      char text[32];
+      std::snprintf(text, sizeof(text), "%.2f m", m);
+      return std::string(text);
+    };
+    warnings->push_back(
+        "the joint spheres reach every flexible vertex (paper B); their radii sum to " +
+        metres(paper_b) + ", and spheres.cover left_by_hulls would shrink that to " +
+        metres(shrunk) +
+        " (CesiumMan: 66 -> 47 % false contacts, normals 43 -> 25 deg; docs/ALGORITHMS.md §9)");
+  }
+}
+
+// The joint spheres (paper B's, or only what the hulls leave uncovered), and the report's list.
+void BakeSpheres(const BakeConfig& config, const Regions& regions, Character& character,
+                 CharacterAsset* asset, json* report) {
+  const bool left_by_hulls = config.sphere_cover == SphereCover::kLeftByHulls;
+  if (left_by_hulls && asset->hulls.empty()) {
+    character.warnings.push_back(
+        "spheres.cover is left_by_hulls but no hull was baked: the joint spheres cover every "
+        "flexible vertex (paper B)");
+  }
+  asset->joint_spheres = left_by_hulls ? BuildJointSpheres(regions, config.sphere_delta,
+                                                           asset->hulls, character.mesh.triangles)
+                                       : BuildJointSpheres(regions, config.sphere_delta);
+  if (!left_by_hulls && !asset->hulls.empty()) {
+    AdviseSphereCover(config, regions, character, *asset, &character.warnings);
+  }
+  json spheres = json::array();
+  for (const JointSphereData& s : asset->joint_spheres) {
+    spheres.push_back(
+        {{"joint", asset->skeleton.joint_names[s.joint]},
+         {"parent", s.parent_joint >= 0 ? asset->skeleton.joint_names[s.parent_joint] : ""},
+         {"radius_mm", s.radius * 1000.f}});
+  }
+  (*report)["joint_spheres"] = spheres;
+}
+
+// What the scene's garment can reach; the rest is left out of the asset and the report says so.
+Status ApplySceneReach(const Scene& scene, CharacterAsset* asset, json* report) {
+  SceneReach reach;
+  if (Status s = AnalyzeSceneReach(scene, *asset, &reach); !s.ok()) return s;
+  json left_out = json::array();
+  PruneUnreachable(reach, asset, &left_out);
+  (*report)["scene"] = SceneReachToJson(reach);
+  (*report)["scene"]["source"] = scene.source;
+  (*report)["scene"]["left_out"] = left_out;
+  return Status::Ok();
+}
+
+// The file validator, then the runtime's own builders: a bake the runtime would refuse fails
+// here.
+Status CheckRuntimeAccepts(const std::string& input, const CharacterAsset& asset) {
+  if (Status s = ValidateAsset(asset); !s.ok()) {
+    return Status(s.code(), input + ": the baked asset does not validate: " + s.message());
+  }
+  HullColliderSet hulls;
+  if (Status s = hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
+      !s.ok()) {
+    return Status(s.code(), input + ": the runtime refuses the baked colliders: " + s.message());
+  }
+  for (const BodyMapPose& pose : asset.body_maps.poses) {
+    BodyMapCollider maps;
+    if (Status s = maps.Build(pose); !s.ok()) {
+      return Status(s.code(), input + ": the runtime refuses the baked body maps: " + s.message());
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result,
+                     const std::string& preview_dir, const Scene* scene) {
+  json& report = result->report;
+  StartReport(input, config, &report);
+  json timings = json::object();
+  // A stage's error, prefixed with the input's name.
+  const auto failed = [&](const Status& s) { return Status(s.code(), input + ": " + s.message()); };
+
+  auto start = Clock::now();
+  Character character;
+  if (Status s = ImportCharacter(input, config.import, &character); !s.ok()) return s;
+  timings["import_ms"] = MillisecondsSince(start);
+  CharacterAsset& asset = result->asset;
+  StartAsset(character, &asset, &report);
 
   start = Clock::now();
   Regions regions;
   if (Status s = SplitRegions(character, config.rigid_threshold, &regions, config.shape_threshold);
       !s.ok()) {
-    return Status(s.code(), input + ": " + s.message());
+    return failed(s);
   }
   timings["regions_ms"] = MillisecondsSince(start);
 
   if (config.maps_enabled) {
     start = Clock::now();
     json maps = {{"renderer", RendererName(config.maps.renderer)}, {"poses", json::array()}};
-    if (Status s = BakeMaps(config, regions, character, preview_dir, &asset, &maps); !s.ok()) {
-      return Status(s.code(), input + ": " + s.message());
-    }
+    if (Status s = BakeMaps(config, regions, character, preview_dir, &asset, &maps); !s.ok())
+      return failed(s);
     report["body_maps"] = maps;
     timings["maps_ms"] = MillisecondsSince(start);
   }
   if (config.hulls_enabled) {
     start = Clock::now();
     json hulls = json::object();
-    if (Status s = BakeHulls(config, regions, character, &asset, &hulls); !s.ok()) {
-      return Status(s.code(), input + ": " + s.message());
-    }
+    if (Status s = BakeHulls(config, regions, character, &asset, &hulls); !s.ok()) return failed(s);
     report["hulls"] = hulls;
     timings["hulls_ms"] = MillisecondsSince(start);
-    const double fraction = hulls["hull_vertex_fraction"].get<double>();
-    if (fraction < kLowHullVertexFraction) {
-      const auto value = [](float v) { return std::to_string(v).substr(0, 4); };
-      std::string advice =
-          config.shape_threshold > 0.51f
-              ? "; hulls.shape_threshold 0.51 (the default; " + value(config.shape_threshold) +
-                    " here) lets the flexible vertices shape their heaviest bone's hull too "
-                    "(CesiumMan: 0 % of the measured motions missed instead of 6 %; "
-                    "docs/ALGORITHMS.md §2.1)"
-              : "; most vertices are blended with no bone above half their weight, which no "
-                "hull can follow: use the body maps for this character";
-      character.warnings.push_back(
-          "only " + std::to_string(static_cast<int>(std::lround(fraction * 100.0))) +
-          " % of the vertices shape a hull at hulls.rigid_threshold " +
-          value(config.rigid_threshold) + " and hulls.shape_threshold " +
-          value(config.shape_threshold) + " (" + std::to_string(asset.hulls.size()) +
-          " hulls): the skin weights are smooth and the joint spheres carry most of the body" +
-          advice);
-    }
+    WarnIfHullsCoverLittle(config, hulls["hull_vertex_fraction"].get<double>(), asset.hulls.size(),
+                           &character.warnings);
   }
   if (config.spheres_enabled) {
     start = Clock::now();
-    const bool left_by_hulls = config.sphere_cover == SphereCover::kLeftByHulls;
-    if (left_by_hulls && asset.hulls.empty()) {
-      character.warnings.push_back(
-          "spheres.cover is left_by_hulls but no hull was baked: the joint spheres cover every "
-          "flexible vertex (paper B)");
-    }
-    asset.joint_spheres = left_by_hulls ? BuildJointSpheres(regions, config.sphere_delta,
-                                                            asset.hulls, character.mesh.triangles)
-                                        : BuildJointSpheres(regions, config.sphere_delta);
-    if (!left_by_hulls && !asset.hulls.empty()) {
-      // Smoothly weighted rigs get spheres of a limb's size; say when the option would help.
-      const auto radius_sum = [](const std::vector<JointSphereData>& spheres) {
-        double sum = 0.0;
-        for (const JointSphereData& s : spheres) sum += s.radius;
-        return sum;
-      };
-      const double paper_b = radius_sum(asset.joint_spheres);
-      const double shrunk = radius_sum(
-          BuildJointSpheres(regions, config.sphere_delta, asset.hulls, character.mesh.triangles));
-      if (shrunk < kSphereShrinkWorthWarning * paper_b) {
-        const auto metres = [](double m) {
-          char text[32];
-          std::snprintf(text, sizeof(text), "%.2f m", m);
-          return std::string(text);
-        };
-        character.warnings.push_back(
-            "the joint spheres reach every flexible vertex (paper B); their radii sum to " +
-            metres(paper_b) + ", and spheres.cover left_by_hulls would shrink that to " +
-            metres(shrunk) +
-            " (CesiumMan: 66 -> 47 % false contacts, normals 43 -> 25 deg; docs/ALGORITHMS.md §9)");
-      }
-    }
-    json spheres = json::array();
-    for (const JointSphereData& s : asset.joint_spheres) {
-      spheres.push_back(
-          {{"joint", asset.skeleton.joint_names[s.joint]},
-           {"parent", s.parent_joint >= 0 ? asset.skeleton.joint_names[s.parent_joint] : ""},
-           {"radius_mm", s.radius * 1000.f}});
-    }
-    report["joint_spheres"] = spheres;
+    BakeSpheres(config, regions, character, &asset, &report);
     timings["spheres_ms"] = MillisecondsSince(start);
   }
   if (!preview_dir.empty() && (config.hulls_enabled || config.spheres_enabled)) {
     if (Status s =
             WriteColliderPreview(asset, regions.rest_positions, regions.rest_skinning, preview_dir);
         !s.ok()) {
-      return Status(s.code(), input + ": " + s.message());
+      return failed(s);
     }
   }
   if (scene != nullptr) {
     start = Clock::now();
-    SceneReach reach;
-    if (Status s = AnalyzeSceneReach(*scene, asset, &reach); !s.ok()) return s;
-    json left_out = json::array();
-    PruneUnreachable(reach, &asset, &left_out);
-    report["scene"] = SceneReachToJson(reach);
-    report["scene"]["source"] = scene->source;
-    report["scene"]["left_out"] = left_out;
+    if (Status s = ApplySceneReach(*scene, &asset, &report); !s.ok()) return s;
     timings["reach_ms"] = MillisecondsSince(start);
   }
   report["warnings"] = character.warnings;
 
   start = Clock::now();
-  // The file validator, then the runtime's own builders: a bake the runtime would refuse fails
-  // here.
-  if (Status s = ValidateAsset(asset); !s.ok()) {
-    return Status(s.code(), input + ": the baked asset does not validate: " + s.message());
-  }
-  {
-    HullColliderSet hulls;
-    if (Status s = hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
-        !s.ok()) {
-      return Status(s.code(), input + ": the runtime refuses the baked colliders: " + s.message());
-    }
-    for (const BodyMapPose& pose : asset.body_maps.poses) {
-      BodyMapCollider maps;
-      if (Status s = maps.Build(pose); !s.ok()) {
-        return Status(s.code(),
-                      input + ": the runtime refuses the baked body maps: " + s.message());
-      }
-    }
-  }
+  if (Status s = CheckRuntimeAccepts(input, asset); !s.ok()) return s;
   timings["validate_ms"] = MillisecondsSince(start);
   report["timings"] = timings;
   return Status::Ok();
