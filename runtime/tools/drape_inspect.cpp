@@ -1,16 +1,20 @@
 // drape-inspect FILE.drape [--json | --dump-json]
 // What a .drape file holds, loaded through formats + runtime alone (no bake dependency).
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <span>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
+#include "drape/runtime/skinning.h"
 
 namespace {
 
@@ -75,7 +79,51 @@ const char* NormalName(drape::NormalEncoding e) {
   return "?";
 }
 
-std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path) {
+// Where a garment is placed: each joint's position and the body's box, at bind and at rest.
+struct Placement {
+  std::vector<drape::Float3> bind_joints, rest_joints;   // asset frame, metres
+  drape::Float3 bind_min, bind_max, rest_min, rest_max;  // the skinned body's box
+};
+
+void BoundingBox(std::span<const drape::Float3> points, drape::Float3* lo, drape::Float3* hi) {
+  *lo = {0.f, 0.f, 0.f};
+  *hi = {0.f, 0.f, 0.f};
+  for (size_t i = 0; i < points.size(); ++i) {
+    const drape::Float3 p = points[i];
+    *lo = i == 0 ? p
+                 : drape::Float3{std::min(lo->x, p.x), std::min(lo->y, p.y), std::min(lo->z, p.z)};
+    *hi = i == 0 ? p
+                 : drape::Float3{std::max(hi->x, p.x), std::max(hi->y, p.y), std::max(hi->z, p.z)};
+  }
+}
+
+drape::Status Place(const drape::CharacterAsset& a, Placement* out) {
+  drape::SkeletonPose pose;
+  if (drape::Status s = pose.Init(a.skeleton); !s.ok()) return s;
+  std::vector<drape::Float3> skinned(a.mesh.vertex_count());
+  for (const bool rest : {false, true}) {
+    if (rest) {
+      pose.SetRest();
+    } else {
+      pose.SetBind();
+    }
+    std::vector<drape::Float3>& joints = rest ? out->rest_joints : out->bind_joints;
+    for (const drape::Mat34& m : pose.world()) joints.push_back({m.m[3], m.m[7], m.m[11]});
+    if (drape::Status s = drape::SkinMesh(a.mesh, pose.skinning(), skinned); !s.ok()) return s;
+    BoundingBox(skinned, rest ? &out->rest_min : &out->bind_min,
+                rest ? &out->rest_max : &out->bind_max);
+  }
+  return drape::Status::Ok();
+}
+
+std::string Vec(drape::Float3 p) {
+  std::ostringstream o;
+  o << "[" << p.x << ", " << p.y << ", " << p.z << "]";
+  return o.str();
+}
+
+std::string JsonSummary(const drape::CharacterAsset& a, const Placement& place,
+                        const std::string& path) {
   std::ostringstream o;
   o << "{\n  \"file\": " << Quote(path) << ",\n  \"format_version\": " << FileFormatVersion(path)
     << ",\n  \"source\": " << Quote(a.info.source_name)
@@ -84,9 +132,16 @@ std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path)
     << ",\n  \"joints\": [";
   for (size_t j = 0; j < a.skeleton.joint_names.size(); ++j) {
     o << (j ? ", " : "") << "{\"name\": " << Quote(a.skeleton.joint_names[j])
-      << ", \"parent\": " << a.skeleton.parents[j] << "}";
+      << ", \"parent\": " << a.skeleton.parents[j]
+      << ", \"bind_position\": " << Vec(place.bind_joints[j])
+      << ", \"rest_position\": " << Vec(place.rest_joints[j]) << "}";
   }
-  o << "],\n  \"clips\": [";
+  o << "],\n  \"body\": {\"bind_min\": " << Vec(place.bind_min)
+    << ", \"bind_max\": " << Vec(place.bind_max)
+    << ", \"bind_height\": " << place.bind_max.y - place.bind_min.y
+    << ", \"rest_min\": " << Vec(place.rest_min) << ", \"rest_max\": " << Vec(place.rest_max)
+    << ", \"rest_height\": " << place.rest_max.y - place.rest_min.y << "}";
+  o << ",\n  \"clips\": [";
   for (size_t c = 0; c < a.clips.size(); ++c) {
     const auto& clip = a.clips[c];
     o << (c ? ", " : "") << "{\"name\": " << Quote(clip.name) << ", \"duration\": " << clip.duration
@@ -123,16 +178,26 @@ std::string JsonSummary(const drape::CharacterAsset& a, const std::string& path)
   return o.str();
 }
 
-void PrintText(const drape::CharacterAsset& a, const std::string& path) {
+void PrintText(const drape::CharacterAsset& a, const Placement& place, const std::string& path) {
   std::printf("%s: drape asset, format version %u, baked by drape %s from '%s'\n", path.c_str(),
               FileFormatVersion(path), a.info.tool_version.c_str(), a.info.source_name.c_str());
   std::printf("  units: %g m per source unit, source up axis %s\n", a.info.unit_scale,
               a.info.up_axis.c_str());
-  std::printf("  skeleton: %u joints\n", a.skeleton.joint_count());
+  const auto box = [](const char* name, drape::Float3 lo, drape::Float3 hi) {
+    std::printf("  body at %s: x %.3f .. %.3f, y %.3f .. %.3f (height %.3f m), z %.3f .. %.3f\n",
+                name, lo.x, hi.x, lo.y, hi.y, hi.y - lo.y, lo.z, hi.z);
+  };
+  box("bind", place.bind_min, place.bind_max);
+  box("rest", place.rest_min, place.rest_max);
+  std::printf("  skeleton: %u joints (positions in the asset frame, metres: bind / rest)\n",
+              a.skeleton.joint_count());
   for (size_t j = 0; j < a.skeleton.joint_names.size(); ++j) {
     const int32_t parent = a.skeleton.parents[j];
-    std::printf("    %3zu %-28s parent %s\n", j, a.skeleton.joint_names[j].c_str(),
-                parent < 0 ? "-" : a.skeleton.joint_names[parent].c_str());
+    const drape::Float3 b = place.bind_joints[j], r = place.rest_joints[j];
+    std::printf("    %3zu %-28s parent %-20s (%7.3f %7.3f %7.3f) / (%7.3f %7.3f %7.3f)\n", j,
+                a.skeleton.joint_names[j].c_str(),
+                parent < 0 ? "-" : a.skeleton.joint_names[parent].c_str(), b.x, b.y, b.z, r.x, r.y,
+                r.z);
   }
   std::printf("  clips: %zu\n", a.clips.size());
   for (const auto& clip : a.clips) {
@@ -223,10 +288,17 @@ int main(int argc, char** argv) {
   if (dump) {
     std::fputs(drape::AssetToJson(asset).c_str(), stdout);
     std::fputc('\n', stdout);
-  } else if (json) {
-    std::fputs(JsonSummary(asset, path).c_str(), stdout);
+    return 0;
+  }
+  Placement place;
+  if (drape::Status status = Place(asset, &place); !status.ok()) {
+    std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
+    return 1;
+  }
+  if (json) {
+    std::fputs(JsonSummary(asset, place, path).c_str(), stdout);
   } else {
-    PrintText(asset, path);
+    PrintText(asset, place, path);
   }
   return 0;
 }

@@ -1,9 +1,10 @@
 // drape-sim SCENE.json -o DIR [--frames N] [--threads T]
 // drape-sim --dump-scene-reference   (docs/SCENES.md: every scene field, from the parser's schema)
 // Bakes the scene's character when its cached asset is missing or stale, simulates the garments
-// against the colliders the scene names, and writes DIR/frames/frame_NNNN.png, an animation
-// (DIR/animation.mp4 or .gif through ffmpeg when it is on PATH, else DIR/contact_sheet.png),
-// optionally DIR/obj/<garment>_NNNN.obj, DIR/stats.json and DIR/reach.json.
+// against the colliders the scene names, and writes DIR/frames/frame_NNNN.png (NNNN: the
+// simulation frame), an animation (DIR/animation.mp4 or .gif through ffmpeg when it is on PATH,
+// else DIR/contact_sheet.png), optionally DIR/obj/<garment>_NNNN.obj, DIR/stats.json and
+// DIR/reach.json.
 // Progress goes to stderr (a bar on a terminal, else a line per 10 %), log lines to stdout. On
 // any error: one line on stderr naming the input and the reason, exit code 1.
 
@@ -22,9 +23,9 @@ int main(int argc, char** argv) {
   app.add_option("SCENE", options.scene_path, "the scene JSON (see docs/SCENES.md)");
   app.add_option("-o,--output", options.out_dir, "output directory (created)");
   app.add_option("--frames", options.frames, "frames to simulate (overrides the scene's duration)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(int64_t{1}, int64_t{10000000}));
   app.add_option("--threads", options.threads, "OpenMP threads (default: all)")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 1024));
   app.add_flag("--dump-scene-reference", dump_reference,
                "print the scenes reference (docs/SCENES.md) as markdown and exit");
   try {

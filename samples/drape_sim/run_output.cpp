@@ -45,6 +45,16 @@ bool Run(const std::vector<std::string>& argv) {
   return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
+// `text` with glob(3)'s special characters escaped, for a pattern that must match it literally.
+std::string GlobEscaped(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '*' || c == '?' || c == '[' || c == ']' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
 }  // namespace
 
 Progress::Progress(int64_t total) : total_(std::max<int64_t>(total, 1)), tty_(isatty(2) != 0) {}
@@ -117,9 +127,16 @@ Status WriteAnimation(const bake::SceneOutput& output, const std::string& dir, d
       const std::string target = dir + (want_gif ? "/animation.gif" : "/animation.mp4");
       char rate[32];
       std::snprintf(rate, sizeof(rate), "%.4f", fps);
-      std::vector<std::string> args = {
-          ffmpeg,       "-y", "-loglevel", "error",
-          "-framerate", rate, "-i",        dir + "/frames/frame_%04d.png"};
+      std::vector<std::string> args = {ffmpeg,
+                                       "-y",
+                                       "-loglevel",
+                                       "error",
+                                       "-framerate",
+                                       rate,
+                                       "-pattern_type",
+                                       "glob",
+                                       "-i",
+                                       GlobEscaped(dir) + "/frames/frame_*.png"};
       if (want_gif) {
         args.insert(args.end(), {"-vf", "split[a][b];[a]palettegen[p];[b][p]paletteuse"});
       } else {

@@ -112,15 +112,14 @@ struct FrameLoop {
   Status failure = Status::Ok();  // the step that failed, if one did
 };
 
-// Writes picture `written` of the run (and its OBJ meshes), keeping a thumbnail when the
-// contact sheet shows it.
-Status WriteFrameOutputs(const bake::Scene& scene, const std::string& dir,
+// Writes the picture of simulation frame `frame` (and its OBJ meshes), named by the frame,
+// keeping a thumbnail when the contact sheet shows it (sheet_frames counts pictures).
+Status WriteFrameOutputs(const bake::Scene& scene, const std::string& dir, int64_t frame,
                          const SceneSimulation& sim, FrameRenderer* renderer,
                          const std::vector<int64_t>& sheet_frames, FrameLoop* loop) {
   const std::vector<uint8_t> rgb = renderer->Render(sim);
   char name[64];
-  std::snprintf(name, sizeof(name), "/frames/frame_%04lld.png",
-                static_cast<long long>(loop->written));
+  std::snprintf(name, sizeof(name), "/frames/frame_%04lld.png", static_cast<long long>(frame));
   const int w = static_cast<int>(scene.output.width), h = static_cast<int>(scene.output.height);
   if (Status s = WritePng(dir + name, w, h, rgb); !s.ok()) return s;
   if (std::find(sheet_frames.begin(), sheet_frames.end(), loop->written) != sheet_frames.end()) {
@@ -130,7 +129,7 @@ Status WriteFrameOutputs(const bake::Scene& scene, const std::string& dir,
   }
   if (scene.output.obj) {
     for (size_t g = 0; g < sim.garment_count(); ++g) {
-      std::snprintf(name, sizeof(name), "_%04lld.obj", static_cast<long long>(loop->written));
+      std::snprintf(name, sizeof(name), "_%04lld.obj", static_cast<long long>(frame));
       const std::string path = dir + "/obj/" + scene.garments[g].name + name;
       if (Status s = WriteObj(path, sim.garment_positions(g), sim.garment_triangles(g)); !s.ok())
         return s;
@@ -167,7 +166,7 @@ Status SimulateFrames(const bake::Scene& scene, const std::string& dir, SceneSim
     if (!loop->failure.ok()) break;
     if (k % every == 0) {
       const auto render_start = Clock::now();
-      if (Status s = WriteFrameOutputs(scene, dir, *sim, renderer, sheet_frames, loop); !s.ok())
+      if (Status s = WriteFrameOutputs(scene, dir, k, *sim, renderer, sheet_frames, loop); !s.ok())
         return s;
       loop->render_ms +=
           std::chrono::duration<double, std::milli>(Clock::now() - render_start).count();

@@ -17,8 +17,19 @@ static bool Check(const drape::Status& s) {
 }
 
 int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: engine_sample FILE.drape\n");
+    return 2;
+  }
   drape::CharacterAsset asset;
-  if (argc != 2 || !Check(drape::ReadAssetFile(argv[1], &asset)) || asset.clips.empty()) return 1;
+  if (!Check(drape::ReadAssetFile(argv[1], &asset))) return 1;
+  if (asset.clips.empty()) {
+    std::fprintf(stderr,
+                 "engine_sample: %s: no clip to animate the skeleton with (this sample stands in "
+                 "for an engine's animation with the file's first clip)\n",
+                 argv[1]);
+    return 1;
+  }
   drape::SkeletonPose engine_animation, pose;  // the engine's animation; drape's view of it
   drape::HullColliderSet colliders;
   const uint32_t joints = asset.skeleton.joint_count();

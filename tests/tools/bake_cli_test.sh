@@ -2,7 +2,7 @@
 # drape-bake / drape-inspect contract: every bad input -> exit != 0, one stderr line that names
 # the input and the reason, no output file. Good input -> a file drape-inspect loads.
 set -u
-BAKE=$1 INSPECT=$2 SOURCE=$3 SHARED=$4 QUERY=$5
+BAKE=$1 INSPECT=$2 SOURCE=$3 SHARED=$4 QUERY=$5 ENGINE_SAMPLE=${6:-}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 failures=0 passed=0
@@ -85,6 +85,48 @@ if "$BAKE" "$MANNEQUIN" -o "$WORK/mannequin.drape" --report "$WORK/mannequin.jso
     passed=$((passed + 1))
   else
     fail "inspect of the baked mannequin: $(cat "$WORK/inspect.txt")"
+  fi
+  # What placing a garment needs: the body's box and height, each joint's position (the
+  # mannequin stands 1.75 m tall with its hips at 0.95 m).
+  if grep -q "body at rest: .*(height 1.750 m)" "$WORK/inspect.txt" &&
+    grep -qE "^ +0 hips +parent - +\( *-?0\.000 +0\.950 +-?0\.000\) / \( *-?0\.000 +0\.950" "$WORK/inspect.txt" &&
+    "$INSPECT" "$WORK/mannequin.drape" --json | grep -q '"rest_height": 1.75'; then
+    passed=$((passed + 1))
+  else
+    fail "inspect lacks the body's box or the joints' positions: $(head -8 "$WORK/inspect.txt")"
+  fi
+  # The engine sample on an asset without a clip says why it stops.
+  if [ -n "$ENGINE_SAMPLE" ]; then
+    cat >"$WORK/post.obj" <<'OBJ'
+v -0.15 0 -0.15
+v 0.15 0 -0.15
+v 0.15 0 0.15
+v -0.15 0 0.15
+v -0.15 1.7 -0.15
+v 0.15 1.7 -0.15
+v 0.15 1.7 0.15
+v -0.15 1.7 0.15
+f 1 3 2
+f 1 4 3
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 2 3 7
+f 2 7 6
+f 3 4 8
+f 3 8 7
+f 4 1 5
+f 4 5 8
+OBJ
+    "$BAKE" "$WORK/post.obj" -o "$WORK/no_clip.drape" 2>"$WORK/post.err" || fail "baking a post: $(cat "$WORK/post.err")"
+    if "$ENGINE_SAMPLE" "$WORK/no_clip.drape" >/dev/null 2>"$WORK/engine.err"; then
+      fail "engine_sample ran on an asset without a clip"
+    elif grep -q "no_clip.drape: no clip to animate" "$WORK/engine.err"; then
+      passed=$((passed + 1))
+    else
+      fail "engine_sample on an asset without a clip: '$(cat "$WORK/engine.err")'"
+    fi
   fi
   for field in source_to_asset unit_scale up_axis joint_count clips warnings timings tool_version format_version; do
     if grep -q "\"$field\"" "$WORK/mannequin.json"; then passed=$((passed + 1)); else fail "report lacks $field"; fi

@@ -46,14 +46,16 @@ else
   fail "first run exited non-zero: $(cat "$WORK/run1.err")"
 fi
 grep -q "drape-sim: baked" "$WORK/run1.out" && pass || fail "first run did not report a bake: $(cat "$WORK/run1.out")"
-for k in 0 1 2 3; do
+# Pictures are named by the simulation frame they show: 0, 3, 6, 9.
+for k in 0 3 6 9; do
   f=$(printf "%s/frames/frame_%04d.png" "$OUT" "$k")
   [ -s "$f" ] && pass || fail "missing picture $f"
 done
-[ ! -e "$OUT/frames/frame_0004.png" ] && pass || fail "12 frames every 3rd should give 4 pictures"
+[ "$(ls "$OUT/frames" | wc -l)" -eq 4 ] && pass || fail "12 frames every 3rd should give 4 pictures: $(ls "$OUT/frames")"
 head -c 8 "$OUT/frames/frame_0000.png" | od -An -c | grep -q "P   N   G" && pass || fail "frame_0000.png is not a PNG"
 { [ -s "$OUT/contact_sheet.png" ] || [ -s "$OUT/animation.mp4" ]; } && pass || fail "no animation or contact sheet"
-[ -s "$OUT/obj/skirt_0003.obj" ] && pass || fail "missing OBJ output"
+[ -s "$OUT/obj/skirt_0009.obj" ] && [ ! -e "$OUT/obj/skirt_0001.obj" ] && pass ||
+  fail "OBJ output not named by simulation frame: $(ls "$OUT/obj")"
 STATS="$OUT/stats.json"
 if [ -s "$STATS" ]; then
   [ "$(json_number "$STATS" nan_frames)" = "0" ] && pass || fail "stats.json reports NaN frames"
@@ -114,6 +116,15 @@ if [ $? -ne 0 ] && grep -qF "$WORK/bad_joint.json: /garments/0/attach/joint: no 
   pass
 else
   fail "unknown joint: $(cat "$WORK/joint.err")"
+fi
+
+# --- 6. Bad command lines: a readable range, not the range of a double.
+"$SIM" "$WORK/scene.json" -o "$WORK/zero" --frames 0 >/dev/null 2>"$WORK/zero.err"
+rc=$?
+if [ $rc -ne 0 ] && grep -q "not in range 1 to 10000000" "$WORK/zero.err" && ! grep -q 1797 "$WORK/zero.err"; then
+  pass
+else
+  fail "--frames 0: exit $rc, $(cat "$WORK/zero.err")"
 fi
 
 echo "sim_cli_test: $passed passed, $failures failed"

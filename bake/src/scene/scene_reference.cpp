@@ -48,8 +48,9 @@ drape-sim samples/scenes/demo.json -o out/demo [--frames N] [--threads T]
 
 It bakes the character into `out/demo/character.drape` when that file is missing or stale (see
 [Cache](#cache)), keeps only the colliders the garments can reach (see [Reach](#reach)),
-simulates, and writes `frames/frame_NNNN.png`, `animation.mp4` (or `.gif`) when `ffmpeg` is on
-`PATH` and `contact_sheet.png` otherwise, `obj/<garment>_NNNN.obj` on request, `stats.json`,
+simulates, and writes `frames/frame_NNNN.png` (NNNN: the simulation frame, every `output.every`-th),
+`animation.mp4` (or `.gif`) when `ffmpeg` is on `PATH` and `contact_sheet.png` otherwise,
+`obj/<garment>_NNNN.obj` on request, `stats.json`,
 `reach.json` and, after a bake, `bake_report.json`. Progress goes to stderr (a bar on a terminal,
 else a line per 10 %), log lines to stdout. On any error it prints one line on stderr naming the
 file and the reason, for a scene field its JSON path, and exits with 1:
