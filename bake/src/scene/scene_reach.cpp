@@ -31,23 +31,18 @@ float DistanceToBox(Float3 p, Float3 center, const Float3 axes[3], Float3 half) 
   return std::sqrt(squared);
 }
 
-}  // namespace
+// A particle a garment holds (attached to a joint, or pinned in the world) and how far the
+// garment reaches from it.
+struct Held {
+  int32_t joint;    // -1: pinned in the world
+  Float3 position;  // bind frame (attached) or world (pinned)
+  float radius;
+};
 
-Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneReach* out) {
-  *out = SceneReach{};
-  Scene resolved = scene;  // frame_count and the clip, without touching the caller's scene
-  int32_t clip = -1;
-  DRAPE_RETURN_IF_ERROR(ResolveSceneClip(asset, &resolved, &clip));
-  out->clip = clip;
-
-  // Garments: held particles and reach radii.
-  struct Held {
-    int32_t joint;    // -1: pinned in the world
-    Float3 position;  // bind frame (attached) or world (pinned)
-    float radius;
-  };
-  std::vector<Held> held;
-  bool bounded = true;
+// Each garment's reach (report) and held particles; *bounded is false when some garment has a
+// particle no held one connects to (its reach is then unbounded).
+Status GarmentReaches(const Scene& resolved, const CharacterAsset& asset, SceneReach* out,
+                      std::vector<Held>* held, bool* bounded) {
   for (size_t g = 0; g < resolved.garments.size(); ++g) {
     ResolvedGarment garment;
     DRAPE_RETURN_IF_ERROR(ResolveGarment(resolved, g, asset.skeleton, &garment));
@@ -67,15 +62,20 @@ Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneR
     reach.radius = reach.bounded
                        ? (1.f + resolved.reach_stretch) * reach.max_path + resolved.reach_margin
                        : kInf;
-    bounded = bounded && reach.bounded;
+    *bounded = *bounded && reach.bounded;
     for (const ClothAttachment& a : d.attachments)
-      held.push_back({a.joint, a.bind_position, reach.radius});
-    for (uint32_t p : d.pinned) held.push_back({-1, d.positions[p], reach.radius});
+      held->push_back({a.joint, a.bind_position, reach.radius});
+    for (uint32_t p : d.pinned) held->push_back({-1, d.positions[p], reach.radius});
     out->garments.push_back(reach);
   }
+  return Status::Ok();
+}
 
-  HullColliderSet colliders;
-  if (Status s = colliders.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
+// The asset's colliders as the runtime poses them, and one reach entry per collider: reachable
+// with no bound to measure when a garment's reach is unbounded, else clearance to be measured.
+Status ListColliders(const CharacterAsset& asset, bool bounded, HullColliderSet* colliders,
+                     SceneReach* out) {
+  if (Status s = colliders->Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
       !s.ok()) {
     return Status(s.code(), asset.info.source_name + ": the asset's colliders: " + s.message());
   }
@@ -88,8 +88,12 @@ Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneR
     out->hulls.push_back({h.joint, joint_name(h.joint), !bounded, bounded ? kInf : -kInf});
   for (const JointSphereData& s : asset.joint_spheres)
     out->spheres.push_back({s.joint, joint_name(s.joint), !bounded, bounded ? kInf : -kInf});
+  return Status::Ok();
+}
 
-  // The poses played: the start (settle), then every substep boundary of every frame.
+// The poses played: the start (settle), then every substep boundary of every frame; a static
+// pose is one pose.
+std::vector<float> PlayedTimes(const Scene& resolved, int32_t clip) {
   const SceneAnimation& anim = resolved.animation;
   const uint32_t substeps = resolved.auto_substeps ? 4u : std::max(resolved.solver.substeps, 1u);
   std::vector<float> times;
@@ -102,20 +106,60 @@ Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneR
     }
   }
   if (clip < 0) times.resize(1);  // a static pose is one pose
-  out->sampled_poses = static_cast<uint32_t>(times.size());
+  return times;
+}
 
+// The root joint's bind position (asset frame); the origin when its bind matrix is singular.
+Float3 RootBindPosition(const SkeletonData& skeleton) {
+  Float3 root_bind;
+  Mat34 m;
+  if (!skeleton.inverse_bind.empty() && InverseAffine(skeleton.inverse_bind[0], &m))
+    root_bind = Translation(m);
+  return root_bind;
+}
+
+// Lowers each collider's clearance to the held particles' reach spheres at the current pose:
+// hulls by their world OBB, joint spheres by their centre and radius.
+void LowerClearances(const CharacterAsset& asset, const HullColliderSet& colliders,
+                     const std::vector<Held>& held, const std::vector<Float3>& centers,
+                     SceneReach* out) {
+  for (uint32_t h = 0; h < colliders.hull_count(); ++h) {
+    const Mat34 world = colliders.HullWorldTransform(h, 0.f);
+    const Obb& obb = asset.hulls[h].obb;
+    const Float3 center = TransformPoint(world, obb.center);
+    const Float3 axes[3] = {NormalizeOr(TransformVector(world, obb.axes[0]), {1, 0, 0}),
+                            NormalizeOr(TransformVector(world, obb.axes[1]), {0, 1, 0}),
+                            NormalizeOr(TransformVector(world, obb.axes[2]), {0, 0, 1})};
+    float& clearance = out->hulls[h].clearance;
+    for (size_t i = 0; i < held.size(); ++i) {
+      clearance = std::min(
+          clearance, DistanceToBox(centers[i], center, axes, asset.hulls[h].obb.half_extents) -
+                         held[i].radius);
+    }
+  }
+  for (uint32_t s = 0; s < colliders.sphere_count(); ++s) {
+    const Float3 center = colliders.SphereCenter(s, 0.f);
+    float& clearance = out->spheres[s].clearance;
+    for (size_t i = 0; i < held.size(); ++i) {
+      clearance = std::min(
+          clearance, Length(centers[i] - center) - asset.joint_spheres[s].radius - held[i].radius);
+    }
+  }
+}
+
+// Plays every time of `times`: the clip time range played, and (when the reach is bounded) each
+// collider's clearance over all of them.
+Status SweepPlayedPoses(const Scene& resolved, const CharacterAsset& asset,
+                        const ClipData* clip_data, const std::vector<float>& times,
+                        const std::vector<Held>& held, bool bounded, HullColliderSet* colliders,
+                        SceneReach* out) {
+  const SceneAnimation& anim = resolved.animation;
   SkeletonPose pose;
   DRAPE_RETURN_IF_ERROR(pose.Init(asset.skeleton));
   const int32_t root = 0;
-  Float3 root_bind;
-  {
-    Mat34 m;
-    if (!asset.skeleton.inverse_bind.empty() && InverseAffine(asset.skeleton.inverse_bind[0], &m))
-      root_bind = Translation(m);
-  }
+  const Float3 root_bind = RootBindPosition(asset.skeleton);
   Float3 root_start;
   std::vector<Float3> centers(held.size());
-  const ClipData* clip_data = clip >= 0 ? &asset.clips[static_cast<size_t>(clip)] : nullptr;
   if (clip_data != nullptr) {
     out->clip_time_min = kInf;
     out->clip_time_max = -kInf;
@@ -133,7 +177,7 @@ Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneR
     }
     const std::span<const Mat34> skinning = pose.skinning();
     if (!bounded) continue;
-    DRAPE_RETURN_IF_ERROR(colliders.SetPose(skinning, skinning));
+    DRAPE_RETURN_IF_ERROR(colliders->SetPose(skinning, skinning));
     // Relative simulation carries pinned particles with the root's translation.
     const Float3 root_now = skinning.empty() ? Float3{} : TransformPoint(skinning[root], root_bind);
     if (t == 0) root_start = root_now;
@@ -143,40 +187,16 @@ Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneR
                                                        held[i].position)
                                       : held[i].position + root_shift;
     }
-    for (uint32_t h = 0; h < colliders.hull_count(); ++h) {
-      const Mat34 world = colliders.HullWorldTransform(h, 0.f);
-      const Obb& obb = asset.hulls[h].obb;
-      const Float3 center = TransformPoint(world, obb.center);
-      const Float3 axes[3] = {NormalizeOr(TransformVector(world, obb.axes[0]), {1, 0, 0}),
-                              NormalizeOr(TransformVector(world, obb.axes[1]), {0, 1, 0}),
-                              NormalizeOr(TransformVector(world, obb.axes[2]), {0, 0, 1})};
-      float& clearance = out->hulls[h].clearance;
-      for (size_t i = 0; i < held.size(); ++i) {
-        clearance = std::min(
-            clearance, DistanceToBox(centers[i], center, axes, asset.hulls[h].obb.half_extents) -
-                           held[i].radius);
-      }
-    }
-    for (uint32_t s = 0; s < colliders.sphere_count(); ++s) {
-      const Float3 center = colliders.SphereCenter(s, 0.f);
-      float& clearance = out->spheres[s].clearance;
-      for (size_t i = 0; i < held.size(); ++i) {
-        clearance = std::min(clearance, Length(centers[i] - center) -
-                                            asset.joint_spheres[s].radius - held[i].radius);
-      }
-    }
+    LowerClearances(asset, *colliders, held, centers, out);
   }
-  for (ColliderReach& c : out->hulls) c.reachable = c.clearance <= 0.f;
-  for (ColliderReach& c : out->spheres) c.reachable = c.clearance <= 0.f;
+  return Status::Ok();
+}
 
-  if (clip_data != nullptr) {
-    const float end_time = anim.start + static_cast<float>(resolved.frame_count) * resolved.dt;
-    out->whole_clip = (anim.loop && end_time - anim.start >= clip_data->duration) ||
-                      (out->clip_time_min <= 0.f && out->clip_time_max >= clip_data->duration);
-  }
-
-  // Body-map poses: those of the scene's clip (or the static poses) nearest to and bracketing
-  // the time at the end of each frame, where the solver reads them.
+// Body-map poses: those of the scene's clip (or the static poses) nearest to and bracketing
+// the time at the end of each frame, where the solver reads them. Ascending indices.
+std::vector<uint32_t> PlayedMapPoses(const Scene& resolved, const CharacterAsset& asset,
+                                     int32_t clip, const ClipData* clip_data) {
+  const SceneAnimation& anim = resolved.animation;
   std::vector<uint32_t> candidates;
   for (size_t p = 0; p < asset.body_maps.poses.size(); ++p) {
     if (asset.body_maps.poses[p].clip == clip) candidates.push_back(static_cast<uint32_t>(p));
@@ -203,8 +223,42 @@ Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneR
       if (above != UINT32_MAX) played[above] = 1;
     }
   }
+  std::vector<uint32_t> indices;
   for (size_t p = 0; p < played.size(); ++p)
-    if (played[p]) out->played_map_poses.push_back(static_cast<uint32_t>(p));
+    if (played[p]) indices.push_back(static_cast<uint32_t>(p));
+  return indices;
+}
+
+}  // namespace
+
+Status AnalyzeSceneReach(const Scene& scene, const CharacterAsset& asset, SceneReach* out) {
+  *out = SceneReach{};
+  Scene resolved = scene;  // frame_count and the clip, without touching the caller's scene
+  int32_t clip = -1;
+  DRAPE_RETURN_IF_ERROR(ResolveSceneClip(asset, &resolved, &clip));
+  out->clip = clip;
+
+  std::vector<Held> held;
+  bool bounded = true;
+  DRAPE_RETURN_IF_ERROR(GarmentReaches(resolved, asset, out, &held, &bounded));
+  HullColliderSet colliders;
+  DRAPE_RETURN_IF_ERROR(ListColliders(asset, bounded, &colliders, out));
+
+  const std::vector<float> times = PlayedTimes(resolved, clip);
+  out->sampled_poses = static_cast<uint32_t>(times.size());
+  const ClipData* clip_data = clip >= 0 ? &asset.clips[static_cast<size_t>(clip)] : nullptr;
+  DRAPE_RETURN_IF_ERROR(
+      SweepPlayedPoses(resolved, asset, clip_data, times, held, bounded, &colliders, out));
+  for (ColliderReach& c : out->hulls) c.reachable = c.clearance <= 0.f;
+  for (ColliderReach& c : out->spheres) c.reachable = c.clearance <= 0.f;
+
+  if (clip_data != nullptr) {
+    const SceneAnimation& anim = resolved.animation;
+    const float end_time = anim.start + static_cast<float>(resolved.frame_count) * resolved.dt;
+    out->whole_clip = (anim.loop && end_time - anim.start >= clip_data->duration) ||
+                      (out->clip_time_min <= 0.f && out->clip_time_max >= clip_data->duration);
+  }
+  out->played_map_poses = PlayedMapPoses(resolved, asset, clip, clip_data);
   return Status::Ok();
 }
 
