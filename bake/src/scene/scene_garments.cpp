@@ -98,6 +98,157 @@ Status SelectParticles(const Scene& scene, const SceneGarment& g, const GarmentM
   return Status::Ok();
 }
 
+// Joint positions in the garment's frame (bind or rest), and each joint's frame -> bind matrix
+// (identity in the bind frame).
+Status JointFrames(const std::string& prefix, const SceneGarment& g, const SkeletonData& skeleton,
+                   const SkeletonPose& rest, std::vector<Float3>* joint_positions,
+                   std::vector<Mat34>* frame_to_bind) {
+  const uint32_t joints = skeleton.joint_count();
+  frame_to_bind->assign(joints, Mat34{});
+  joint_positions->assign(joints, Float3{});
+  for (uint32_t j = 0; j < joints; ++j) {
+    Mat34 bind_world;
+    if (!InverseAffine(skeleton.inverse_bind[j], &bind_world)) bind_world = Mat34{};
+    if (g.frame == GarmentFrame::kBind) {
+      (*joint_positions)[j] = Translation(bind_world);
+    } else {
+      (*joint_positions)[j] = Translation(rest.world()[j]);
+      if (!InverseAffine(rest.skinning()[j], &(*frame_to_bind)[j])) {
+        return Invalid(prefix + g.path + "/frame: the rest skinning matrix of joint " +
+                       Quote(skeleton.joint_names[j]) + " is singular; use \"bind\"");
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+// The joint named `name`; the refusal at `path` suggests the joints sharing the name's first
+// letter (a few names help more than seventy), else says how many joints there are.
+Status FindNamedJoint(const std::string& prefix, const SkeletonData& skeleton,
+                      const std::string& name, const std::string& path, int32_t* j) {
+  *j = FindJoint(skeleton, name);
+  if (*j >= 0) return Status::Ok();
+  std::vector<std::string> similar;
+  for (const std::string& n : skeleton.joint_names)
+    if (!n.empty() && !name.empty() && std::tolower(n[0]) == std::tolower(name[0]))
+      similar.push_back(n);
+  if (similar.empty() || similar.size() > 12) similar.clear();
+  return Invalid(prefix + path + ": no joint named " + Quote(name) +
+                 (similar.empty() ? " (" + std::to_string(skeleton.joint_count()) + " joints)"
+                                  : " (did you mean " + JoinNames(similar) + "?)"));
+}
+
+// The garment's particles and triangles: a generated shape placed at the anchor, or an OBJ file
+// scaled, offset and placed at the anchor.
+Status MakeGarmentMesh(const std::string& prefix, const SceneGarment& g, Float3 anchor,
+                       GarmentMesh* mesh) {
+  Status made;
+  switch (g.type) {
+    case GarmentType::kSheet: {
+      SheetShape s = g.sheet;
+      s.center += anchor;
+      made = MakeSheet(s, mesh);
+      break;
+    }
+    case GarmentType::kSkirt: {
+      SkirtShape s = g.skirt;
+      s.top_center += anchor;
+      made = MakeSkirt(s, mesh);
+      break;
+    }
+    case GarmentType::kCape: {
+      CapeShape s = g.cape;
+      s.top_center += anchor;
+      made = MakeCape(s, mesh);
+      break;
+    }
+    case GarmentType::kSleeve: {
+      SleeveShape s = g.sleeve;
+      s.start += anchor;
+      made = MakeSleeve(s, mesh);
+      break;
+    }
+    case GarmentType::kObj: {
+      made =
+          ReadObj(g.obj_file, prefix + g.path + "/shape/file", &mesh->positions, &mesh->triangles);
+      if (!made.ok()) return made;
+      for (Float3& p : mesh->positions) p = p * g.obj_scale + g.obj_offset + anchor;
+      break;
+    }
+  }
+  if (!made.ok()) return Invalid(prefix + g.path + "/shape: " + made.message());
+  if (mesh->positions.size() > kMaxGarmentParticles) {
+    return Invalid(prefix + g.path + "/shape: " + std::to_string(mesh->positions.size()) +
+                   " particles: at most " + std::to_string(kMaxGarmentParticles));
+  }
+  return Status::Ok();
+}
+
+// Which selection holds each particle (for messages about conflicts) and how: -2 free, -1 pinned,
+// else the joint it is attached to.
+struct Holds {
+  std::vector<const std::string*> held_by;
+  std::vector<int32_t> held_joint;
+};
+
+// The garment's attachments into d->attachments (bind-frame positions), then its pins into
+// d->pinned. A particle held twice the same way is kept once; held two ways, refused.
+Status HoldParticles(const Scene& scene, const std::string& prefix, const SceneGarment& g,
+                     const SkeletonData& skeleton, const GarmentMesh& mesh, Float3 anchor,
+                     const std::vector<Mat34>& frame_to_bind, ClothDescription* d, Holds* holds) {
+  std::vector<const std::string*>& held_by = holds->held_by;
+  std::vector<int32_t>& held_joint = holds->held_joint;
+  held_by.assign(mesh.positions.size(), nullptr);
+  held_joint.assign(mesh.positions.size(), -2);
+  for (const SceneAttachment& a : g.attachments) {
+    int32_t joint = -1;
+    DRAPE_RETURN_IF_ERROR(
+        FindNamedJoint(prefix, skeleton, a.joint, a.particles.path + "/joint", &joint));
+    std::vector<uint32_t> particles;
+    DRAPE_RETURN_IF_ERROR(SelectParticles(scene, g, mesh, a.particles, anchor, &particles));
+    for (uint32_t p : particles) {
+      if (held_by[p] != nullptr) {
+        if (held_joint[p] == joint) continue;  // the same hold twice
+        return Invalid(prefix + a.particles.path + ": particle " + std::to_string(p) +
+                       " is already held by " + *held_by[p]);
+      }
+      held_by[p] = &a.particles.path;
+      held_joint[p] = joint;
+      d->attachments.push_back(
+          {p, joint, TransformPoint(frame_to_bind[static_cast<size_t>(joint)], mesh.positions[p])});
+    }
+  }
+  for (const SceneSelection& pin : g.pins) {
+    std::vector<uint32_t> particles;
+    DRAPE_RETURN_IF_ERROR(SelectParticles(scene, g, mesh, pin, anchor, &particles));
+    for (uint32_t p : particles) {
+      if (held_by[p] != nullptr) {
+        if (held_joint[p] == -1) continue;
+        return Invalid(prefix + pin.path + ": particle " + std::to_string(p) +
+                       " is already held by " + *held_by[p]);
+      }
+      held_by[p] = &pin.path;
+      held_joint[p] = -1;
+      d->pinned.push_back(p);
+    }
+  }
+  return Status::Ok();
+}
+
+// Each particle's carrier: the joint of its nearest held particle along the cloth (-1 for a pin
+// or a particle no held one connects to).
+std::vector<int32_t> CarrierJoints(const ClothDescription& d,
+                                   const std::vector<int32_t>& held_joint) {
+  std::vector<float> distance;
+  std::vector<uint32_t> nearest;
+  NearestHeldParticles(d, &distance, &nearest);
+  std::vector<int32_t> carrier_joint(d.positions.size(), -1);
+  for (size_t i = 0; i < d.positions.size(); ++i) {
+    if (nearest[i] != UINT32_MAX) carrier_joint[i] = std::max(held_joint[nearest[i]], -1);
+  }
+  return carrier_joint;
+}
+
 }  // namespace
 
 const char* ToString(GarmentType type) {
@@ -142,83 +293,18 @@ Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skel
   SkeletonPose rest;
   DRAPE_RETURN_IF_ERROR(rest.Init(skeleton));
   rest.SetRest();
-  const uint32_t joints = skeleton.joint_count();
 
-  // Joint positions and frame -> bind matrices in the garment's frame.
-  out->frame_to_bind.assign(joints, Mat34{});
-  std::vector<Float3> joint_positions(joints);
-  for (uint32_t j = 0; j < joints; ++j) {
-    Mat34 bind_world;
-    if (!InverseAffine(skeleton.inverse_bind[j], &bind_world)) bind_world = Mat34{};
-    if (g.frame == GarmentFrame::kBind) {
-      joint_positions[j] = Translation(bind_world);
-    } else {
-      joint_positions[j] = Translation(rest.world()[j]);
-      if (!InverseAffine(rest.skinning()[j], &out->frame_to_bind[j])) {
-        return Invalid(prefix + g.path + "/frame: the rest skinning matrix of joint " +
-                       Quote(skeleton.joint_names[j]) + " is singular; use \"bind\"");
-      }
-    }
-  }
-  const auto find_joint = [&](const std::string& name, const std::string& path, int32_t* j) {
-    *j = FindJoint(skeleton, name);
-    if (*j >= 0) return Status::Ok();
-    // A few names help more than seventy: the joints sharing the name's first letter, else all.
-    std::vector<std::string> similar;
-    for (const std::string& n : skeleton.joint_names)
-      if (!n.empty() && !name.empty() && std::tolower(n[0]) == std::tolower(name[0]))
-        similar.push_back(n);
-    if (similar.empty() || similar.size() > 12) similar.clear();
-    return Invalid(prefix + path + ": no joint named " + Quote(name) +
-                   (similar.empty() ? " (" + std::to_string(joints) + " joints)"
-                                    : " (did you mean " + JoinNames(similar) + "?)"));
-  };
+  std::vector<Float3> joint_positions;
+  DRAPE_RETURN_IF_ERROR(
+      JointFrames(prefix, g, skeleton, rest, &joint_positions, &out->frame_to_bind));
   Float3 anchor;
   if (!g.anchor.empty()) {
     int32_t j = -1;
-    DRAPE_RETURN_IF_ERROR(find_joint(g.anchor, g.path + "/anchor", &j));
+    DRAPE_RETURN_IF_ERROR(FindNamedJoint(prefix, skeleton, g.anchor, g.path + "/anchor", &j));
     anchor = joint_positions[static_cast<size_t>(j)];
   }
-
   GarmentMesh mesh;
-  Status made;
-  switch (g.type) {
-    case GarmentType::kSheet: {
-      SheetShape s = g.sheet;
-      s.center += anchor;
-      made = MakeSheet(s, &mesh);
-      break;
-    }
-    case GarmentType::kSkirt: {
-      SkirtShape s = g.skirt;
-      s.top_center += anchor;
-      made = MakeSkirt(s, &mesh);
-      break;
-    }
-    case GarmentType::kCape: {
-      CapeShape s = g.cape;
-      s.top_center += anchor;
-      made = MakeCape(s, &mesh);
-      break;
-    }
-    case GarmentType::kSleeve: {
-      SleeveShape s = g.sleeve;
-      s.start += anchor;
-      made = MakeSleeve(s, &mesh);
-      break;
-    }
-    case GarmentType::kObj: {
-      made = ReadObj(g.obj_file, prefix + g.path + "/shape/file", &mesh.positions, &mesh.triangles);
-      if (!made.ok()) return made;
-      for (Float3& p : mesh.positions) p = p * g.obj_scale + g.obj_offset + anchor;
-      break;
-    }
-  }
-  if (!made.ok()) return Invalid(prefix + g.path + "/shape: " + made.message());
-  if (mesh.positions.size() > kMaxGarmentParticles) {
-    return Invalid(prefix + g.path + "/shape: " + std::to_string(mesh.positions.size()) +
-                   " particles: at most " + std::to_string(kMaxGarmentParticles));
-  }
+  DRAPE_RETURN_IF_ERROR(MakeGarmentMesh(prefix, g, anchor, &mesh));
 
   ClothDescription& d = out->description;
   d.positions = mesh.positions;
@@ -228,54 +314,15 @@ Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skel
   d.stretch = g.stretch;
   d.bend = g.bend;
   d.bend_springs = g.bend_springs;
-  // Which selection holds each particle, for messages about conflicts.
-  std::vector<const std::string*> held_by(mesh.positions.size(), nullptr);
-  std::vector<int32_t> held_joint(mesh.positions.size(), -2);  // -2 free, -1 pinned
-  for (const SceneAttachment& a : g.attachments) {
-    int32_t joint = -1;
-    DRAPE_RETURN_IF_ERROR(find_joint(a.joint, a.particles.path + "/joint", &joint));
-    std::vector<uint32_t> particles;
-    DRAPE_RETURN_IF_ERROR(SelectParticles(scene, g, mesh, a.particles, anchor, &particles));
-    for (uint32_t p : particles) {
-      if (held_by[p] != nullptr) {
-        if (held_joint[p] == joint) continue;  // the same hold twice
-        return Invalid(prefix + a.particles.path + ": particle " + std::to_string(p) +
-                       " is already held by " + *held_by[p]);
-      }
-      held_by[p] = &a.particles.path;
-      held_joint[p] = joint;
-      d.attachments.push_back(
-          {p, joint,
-           TransformPoint(out->frame_to_bind[static_cast<size_t>(joint)], mesh.positions[p])});
-    }
-  }
-  for (const SceneSelection& pin : g.pins) {
-    std::vector<uint32_t> particles;
-    DRAPE_RETURN_IF_ERROR(SelectParticles(scene, g, mesh, pin, anchor, &particles));
-    for (uint32_t p : particles) {
-      if (held_by[p] != nullptr) {
-        if (held_joint[p] == -1) continue;
-        return Invalid(prefix + pin.path + ": particle " + std::to_string(p) +
-                       " is already held by " + *held_by[p]);
-      }
-      held_by[p] = &pin.path;
-      held_joint[p] = -1;
-      d.pinned.push_back(p);
-    }
-  }
+  Holds holds;
+  DRAPE_RETURN_IF_ERROR(
+      HoldParticles(scene, prefix, g, skeleton, mesh, anchor, out->frame_to_bind, &d, &holds));
 
   // Validate the cloth now, so that a bad garment is refused with its path.
   Cloth check;
   if (Status s = BuildCloth(d, &check); !s.ok())
     return Invalid(prefix + g.path + ": " + s.message());
-
-  std::vector<float> distance;
-  std::vector<uint32_t> nearest;
-  NearestHeldParticles(d, &distance, &nearest);
-  out->carrier_joint.assign(d.positions.size(), -1);
-  for (size_t i = 0; i < d.positions.size(); ++i) {
-    if (nearest[i] != UINT32_MAX) out->carrier_joint[i] = std::max(held_joint[nearest[i]], -1);
-  }
+  out->carrier_joint = CarrierJoints(d, holds.held_joint);
   return Status::Ok();
 }
 
