@@ -151,6 +151,47 @@ void AppendArrays(const BodyMapPose& from, BodyMapPose* to) {
   }
 }
 
+// Writes the texel's kept gaps, front to back, at entry `entry` of the gap layers: each gap goes
+// to the next free layer when it stays strictly nested under both decoders (`depths` starts with
+// the slab's decoded depths), else it is dropped and counted. Returns how many were stored.
+size_t StoreTexelGaps(const MapRasterInput& input, std::span<const Fragment> sorted,
+                      std::span<const GapCandidate> gaps, uint32_t raster_i, uint32_t raster_j,
+                      const BodyMapPose& pose, float max_valid_depth, size_t entry,
+                      NestingDepths depths[2], BodyMapPose* gap_layers, GapCounts* counts) {
+  size_t stored = 0;  // gaps stored at this texel: the next one goes to gap_layers[stored]
+  for (const GapCandidate& gap : gaps) {
+    BodyMapPose* layer = &gap_layers[stored];
+    const Fragment& upper = sorted[gap.upper];
+    const Fragment& lower = sorted[gap.upper + 1];
+    const double lower_depth = FragmentDepth(input, 1, lower.triangle, raster_i, raster_j);
+    WriteDepth(layer, 0, entry, std::clamp(static_cast<float>(upper.depth), 0.f, max_valid_depth));
+    WriteDepth(layer, 1, entry, std::clamp(static_cast<float>(lower_depth), 0.f, max_valid_depth));
+    bool nested = true;
+    for (int decoder = 0; decoder < 2; ++decoder) {
+      depths[decoder].upper = DecodedDepth(*layer, 0, entry, decoder == 1);
+      depths[decoder].lower = DecodedDepth(*layer, 1, entry, decoder == 1);
+      nested = nested && StrictlyNested(depths[decoder], pose.front_z, pose.depth_range);
+    }
+    if (!nested) {  // restore the background; a later gap may take this layer
+      WriteBackgroundDepth(layer, 0, entry);
+      WriteBackgroundDepth(layer, 1, entry);
+      ++counts->dropped_gaps;
+      continue;
+    }
+    float normal[3];
+    FragmentNormal(input, upper.triangle, raster_i, raster_j, -1.0, normal);
+    WriteNormal(layer, 0, entry, {normal[0], normal[1], normal[2]});
+    FragmentNormal(input, lower.triangle, raster_i, raster_j, 1.0, normal);
+    WriteNormal(layer, 1, entry, {normal[0], normal[1], normal[2]});
+    for (int decoder = 0; decoder < 2; ++decoder) {
+      depths[decoder].floor = depths[decoder].lower;
+      depths[decoder].has_floor = true;
+    }
+    ++stored;
+  }
+  return stored;
+}
+
 }  // namespace
 
 Status BakeGapLayers(const MapRasterInput& input, std::span<const uint8_t> valid, uint32_t crop_i0,
@@ -204,39 +245,8 @@ Status BakeGapLayers(const MapRasterInput& input, std::span<const uint8_t> valid
       }
       const size_t entry = pose->gap_texels.size();  // this texel's entry in every gap layer
       for (size_t k = 0; k < max_gaps; ++k) AppendBackground(&gap_layers[k]);
-      size_t stored = 0;  // gaps stored at this texel: the next one goes to gap_layers[stored]
-      for (const GapCandidate& gap : gaps) {
-        BodyMapPose* layer = &gap_layers[stored];
-        const Fragment& upper = sorted[gap.upper];
-        const Fragment& lower = sorted[gap.upper + 1];
-        const double lower_depth = FragmentDepth(input, 1, lower.triangle, raster_i, raster_j);
-        WriteDepth(layer, 0, entry,
-                   std::clamp(static_cast<float>(upper.depth), 0.f, max_valid_depth));
-        WriteDepth(layer, 1, entry,
-                   std::clamp(static_cast<float>(lower_depth), 0.f, max_valid_depth));
-        bool nested = true;
-        for (int decoder = 0; decoder < 2; ++decoder) {
-          depths[decoder].upper = DecodedDepth(*layer, 0, entry, decoder == 1);
-          depths[decoder].lower = DecodedDepth(*layer, 1, entry, decoder == 1);
-          nested = nested && StrictlyNested(depths[decoder], pose->front_z, pose->depth_range);
-        }
-        if (!nested) {  // restore the background; a later gap may take this layer
-          WriteBackgroundDepth(layer, 0, entry);
-          WriteBackgroundDepth(layer, 1, entry);
-          ++counts.dropped_gaps;
-          continue;
-        }
-        float normal[3];
-        FragmentNormal(input, upper.triangle, raster_i, raster_j, -1.0, normal);
-        WriteNormal(layer, 0, entry, {normal[0], normal[1], normal[2]});
-        FragmentNormal(input, lower.triangle, raster_i, raster_j, 1.0, normal);
-        WriteNormal(layer, 1, entry, {normal[0], normal[1], normal[2]});
-        for (NestingDepths& d : depths) {
-          d.floor = d.lower;
-          d.has_floor = true;
-        }
-        ++stored;
-      }
+      const size_t stored = StoreTexelGaps(input, sorted, gaps, raster_i, raster_j, *pose,
+                                           max_valid_depth, entry, depths, gap_layers, &counts);
       if (stored == 0) {  // every gap was dropped: the texel is not listed
         for (size_t k = 0; k < max_gaps; ++k) PopEntry(&gap_layers[k]);
         continue;
