@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "cloth_fixtures.h"
 #include "drape/formats/body_map_data.h"
 #include "drape/formats/hull_collider_data.h"
 #include "drape/runtime/body_map_collider.h"
@@ -88,18 +89,7 @@ float MaxStretch(const Cloth& cloth, const ClothState& state) {
   return worst;
 }
 
-ClothDescription SheetDescription(uint32_t cells, float size, Float3 center) {
-  SheetShape shape;
-  shape.center = center;
-  shape.width = shape.height = size;
-  shape.columns = shape.rows = cells;
-  GarmentMesh mesh;
-  EXPECT_TRUE(MakeSheet(shape, &mesh).ok());
-  ClothDescription d;
-  d.positions = mesh.positions;
-  d.triangles = mesh.triangles;
-  return d;
-}
+using test::SheetDescription;
 
 // The physics tests run on one OpenMP thread: the small cloths here gain nothing from a second
 // one, and on a loaded 2-core CI machine spinning OpenMP barriers would dominate the run time.

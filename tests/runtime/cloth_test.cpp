@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cloth_fixtures.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/garments.h"
 #include "drape/runtime/math.h"
@@ -14,18 +15,7 @@
 namespace drape {
 namespace {
 
-ClothDescription SheetDescription(uint32_t cells, float size, Float3 center) {
-  SheetShape shape;
-  shape.center = center;
-  shape.width = shape.height = size;
-  shape.columns = shape.rows = cells;
-  GarmentMesh mesh;
-  EXPECT_TRUE(MakeSheet(shape, &mesh).ok());
-  ClothDescription d;
-  d.positions = mesh.positions;
-  d.triangles = mesh.triangles;
-  return d;
-}
+using test::SheetDescription;
 
 // Two triangles sharing an edge: 5 stretch springs, 1 bend spring between the opposite corners,
 // masses a third of each triangle's area times density.
