@@ -12,14 +12,7 @@
 #include "hull/plane_kernels.h"
 
 #if defined(__SSE2__) && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#include <immintrin.h>
-
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+#include "common/lanes/avx2_region_begin.inl"
 
 #include "common/lanes/avx2_lanes.inl"
 
@@ -31,11 +24,7 @@ const PlaneKernels& Avx2PlaneKernels() { return PlaneLanes<EightLanes>::Table();
 
 }  // namespace drape::detail
 
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+#include "common/lanes/avx2_region_end.inl"
 
 #else  // no AVX2 on this target: BestInstructionSet() never reports it
 

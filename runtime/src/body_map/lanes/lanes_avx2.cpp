@@ -19,14 +19,7 @@
 #include "drape/runtime/body_map_collider.h"
 
 #if defined(__SSE2__) && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#include <immintrin.h>
-
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+#include "common/lanes/avx2_region_begin.inl"
 
 // The lane operations first: the lanes' templates find them where they are defined.
 #include "common/lanes/avx2_lanes.inl"
@@ -43,11 +36,7 @@ const BodyMapCollider::LaneKernels& BodyMapCollider::Avx2LaneKernels() {
 
 }  // namespace drape
 
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+#include "common/lanes/avx2_region_end.inl"
 
 #else  // no AVX2 on this target: BestInstructionSet() never reports it
 
