@@ -87,13 +87,12 @@ def body_map_queries(doc, gb):
             doc.add(f"| CollideBatch, {lanes_name}, {label} | "
                     f"{shapes('BM_CollideBatch', (m, lanes_count), threads=True)} |")
     lengths = (1, 4, 16, 64, 256)
+    cells = {label: " / ".join(ns(value(gb, p, "BM_SegmentLength", (n, s))) for n in lengths)
+             for label, s in (("nearest", 0), ("bilinear", 1))}
     doc.add("", "One `Query` per horizontal segment of a fixed length at a random depth in the "
-            "figure, N = 1024 (the walk's cost against its length), ns:", "",
-            "| sampling | " + " | ".join(f"{n} texel{'s' if n > 1 else ''}" for n in lengths)
-            + " |", "|---|" + "---|" * len(lengths))
-    for label, s in (("nearest", 0), ("bilinear", 1)):
-        doc.add(f"| {label} | " + " | ".join(ns(value(gb, p, "BM_SegmentLength", (n, s)))
-                                             for n in lengths) + " |")
+            "figure, N = 1024 (the walk's cost against its length), ns for segments of " +
+            " / ".join(str(n) for n in lengths) + f" texels: nearest {cells['nearest']}, "
+            f"bilinear {cells['bilinear']}.")
     doc.source(p)
 
 

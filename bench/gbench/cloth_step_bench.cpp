@@ -274,7 +274,7 @@ void BM_ClothStep(benchmark::State& state) {
   penetration.Report(state);
 }
 BENCHMARK(BM_ClothStep)
-    ->ArgNames({"threads", "substeps", "colliders"})
+    ->ArgNames({"omp_threads", "substeps", "colliders"})
     ->Args({1, 1, 1})
     ->Args({2, 1, 1})
     ->Args({1, 2, 1})
