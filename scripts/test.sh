@@ -4,7 +4,8 @@
 #  2. formats + runtime alone with -DDRAPE_BUILD_BAKE=OFF: builds, passes its tests, and its link
 #     lines name no assimp, CGAL or OSMesa;
 #  3. cmake --install of that build, and a tiny consumer that find_package(drape)s it;
-#  4. formats + runtime tests again under AddressSanitizer + UndefinedBehaviorSanitizer;
+#  4. formats + runtime tests again, and the bad-model corpus through drape-bake, under
+#     AddressSanitizer + UndefinedBehaviorSanitizer;
 #  5. each libFuzzer target over its seed corpus, reproducibly: a fixed seed and 100 000 inputs
 #     (DRAPE_FUZZ_RUNS; scripts/fuzz.sh alone runs a million, or explores with a random seed).
 set -uo pipefail
@@ -73,9 +74,10 @@ install_consumer() {
 }
 check "installed drape::runtime links into a consumer" install_consumer
 
-echo "== 4. formats + runtime under ASan + UBSan"
+echo "== 4. formats + runtime tests and the bad-model corpus under ASan + UBSan"
 if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
-  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 run_ctest build-sanitize
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    LSAN_OPTIONS=suppressions=$root/tests/tools/lsan_suppressions.txt run_ctest build-sanitize
 else
   check "sanitizer build" false
 fi

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
   std::string input, output, config_path, scene_path, report_path, preview_dir;
-  bool dump_config = false;
+  bool dump_config = false, list_formats = false;
   app.add_option("INPUT", input, "character file (anything assimp reads)");
   app.add_option("-o,--output", output, "the .drape file to write");
   app.add_option("--config", config_path, "JSON bake parameters (see --dump-config)");
@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   app.add_option("--report", report_path, "JSON report of the bake");
   app.add_option("--preview", preview_dir, "directory for preview pictures");
   app.add_flag("--dump-config", dump_config, "print every parameter with default, unit and range");
+  app.add_flag("--formats", list_formats, "print the file extensions the bake reads, one a line");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -42,6 +43,11 @@ int main(int argc, char** argv) {
   }
   if (dump_config) {
     std::printf("%s\n", drape::bake::BakeConfigReference().dump(2).c_str());
+    return 0;
+  }
+  if (list_formats) {
+    for (const std::string& extension : drape::bake::ReadableExtensions())
+      std::printf("%s\n", extension.c_str());
     return 0;
   }
   if (input.empty()) return Fail("no INPUT given (usage: drape-bake INPUT -o OUT.drape)");
@@ -92,5 +98,9 @@ int main(int argc, char** argv) {
     if (!report_path.empty()) std::remove(report_path.c_str());
     return Fail(s.message());
   }
+  // What was assumed or repaired, one line each (also the report's "warnings").
+  for (const auto& warning : result.report["warnings"])
+    std::fprintf(stderr, "drape-bake: warning: %s: %s\n", input.c_str(),
+                 warning.get<std::string>().c_str());
   return 0;
 }

@@ -110,6 +110,11 @@ Status EncodeAsset(const CharacterAsset& asset, std::vector<uint8_t>* bytes) {
   return Status::Ok();
 }
 
+bool LooksLikeAssetFile(std::span<const uint8_t> head) {
+  return head.size() >= kMagic.size() &&
+         std::memcmp(head.data(), kMagic.data(), kMagic.size()) == 0;
+}
+
 Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, CharacterAsset* asset) {
   *asset = CharacterAsset{};
   const size_t magic_bytes = std::min(bytes.size(), kMagic.size());

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "config/json_schema.h"
+#include "config/name_suggestions.h"
 #include "drape/bake/bake_config.h"
 
 namespace drape::bake {
@@ -45,7 +46,8 @@ TEST(BakeConfig, OutOfRangeAndUnknownKeysNameTheirPath) {
   s = ApplyBakeConfig({{"import", {{"no_such_key", 1}}}}, "c.json", &config);
   EXPECT_EQ(s.message(),
             "c.json: /import/no_such_key: unknown key: no_such_key is not a parameter of /import "
-            "(known here: unit_scale | up_axis | clip_sample_rate | rename_duplicate_joints)");
+            "(known here: unit_scale | up_axis | clip_sample_rate | rename_duplicate_joints | "
+            "memory_limit_mb | time_limit_s)");
   s = ApplyBakeConfig({{"hulls", 3}}, "c.json", &config);
   EXPECT_EQ(s.message(), "c.json: /hulls: must be an object, not a number");
   s = ApplyBakeConfig(nlohmann::json::array(), "c.json", &config);
@@ -153,6 +155,33 @@ TEST(BakeConfig, MapsLayersIsACountFromOneToFour) {
     EXPECT_NE(s.message().find("[1, 4]"), std::string::npos) << s.message();
     EXPECT_EQ(config.maps.layers, 3) << "a refused config changes nothing";
   }
+}
+
+TEST(NameSuggestions, IgnoreCaseAndThePrefixEveryNameShares) {
+  using detail::NearestNames;
+  // Game rigs prefix every joint: the prefix does not count, and neither does case.
+  const std::vector<std::string> mixamo = {
+      "mixamorig:Hips",    "mixamorig:Spine",       "mixamorig:Spine1", "mixamorig:Spine2",
+      "mixamorig:LeftArm", "mixamorig:LeftForeArm", "mixamorig:Head"};
+  EXPECT_EQ(NearestNames("spine", mixamo, 4),
+            (std::vector<std::string>{"mixamorig:Spine", "mixamorig:Spine1", "mixamorig:Spine2"}));
+  EXPECT_EQ(NearestNames("LeftArm", mixamo, 4), (std::vector<std::string>{"mixamorig:LeftArm"}));
+  EXPECT_EQ(NearestNames("mixamorig:leftarm", mixamo, 4),
+            (std::vector<std::string>{"mixamorig:LeftArm"}));
+  const std::vector<std::string> prefixed = {"B_Hip", "B_Spine", "B_Spine1", "B_Head", "B_L_Thigh"};
+  EXPECT_EQ(NearestNames("hips", prefixed, 4), (std::vector<std::string>{"B_Hip"}));
+  EXPECT_EQ(NearestNames("B_Spien", prefixed, 1), (std::vector<std::string>{"B_Spine"}));
+  // Nothing near: no suggestion rather than a random one.
+  EXPECT_TRUE(NearestNames("tail", prefixed, 4).empty());
+  EXPECT_TRUE(NearestNames("x", {}, 4).empty());
+}
+
+TEST(BakeConfig, AClipNamedInAConfigIsRefusedWhereItWasNamed) {
+  BakeConfig config;
+  EXPECT_EQ(config.maps_clip_origin, "");
+  ASSERT_TRUE(ParseBakeConfig(R"({"maps": {"clip": "walk"}})", "c.json", &config).ok());
+  EXPECT_EQ(config.maps_clip, "walk");
+  EXPECT_EQ(config.maps_clip_origin, "c.json: /maps/clip");
 }
 
 }  // namespace

@@ -78,6 +78,19 @@ echo '{"import": {"unit_scale": -1}}' >"$WORK/bad_config.json"
 NAMED="$WORK/bad_config.json" expect_error bad_config_value "$MANNEQUIN" "unit_scale.*must be in" --config "$WORK/bad_config.json"
 echo '{"import": {"no_such_key": 1}}' >"$WORK/unknown_key.json"
 NAMED="$WORK/unknown_key.json" expect_error bad_config_key "$MANNEQUIN" "no_such_key is not a parameter" --config "$WORK/unknown_key.json"
+echo '{"maps": {"clip": "wlak"}}' >"$WORK/bad_clip.json"
+NAMED="$WORK/bad_clip.json" expect_error bad_maps_clip "$MANNEQUIN" \
+  "bad_clip.json: /maps/clip: no clip named 'wlak' in '.*mannequin.gltf' \(clips: walk" --config "$WORK/bad_clip.json"
+# What assimp drops without a word is counted: an OBJ with a two-corner face and empty f lines
+# bakes, and says so on stderr and in the report.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 2\nf\nf 2 4 3\nf 1 4 2\nf  \n' >"$WORK/sloppy.obj"
+if "$BAKE" "$WORK/sloppy.obj" -o "$WORK/sloppy.drape" --report "$WORK/sloppy.json" 2>"$WORK/sloppy.stderr" &&
+  grep -q "warning: $WORK/sloppy.obj: 2 'f' lines without a corner skipped" "$WORK/sloppy.stderr" &&
+  grep -q "1 faces with one or two corners (points and lines) dropped" "$WORK/sloppy.json"; then
+  passed=$((passed + 1))
+else
+  fail "OBJ faces dropped without a warning: $(cat "$WORK/sloppy.stderr")"
+fi
 
 # --- Good input: bake, inspect, the report has the contract fields.
 if "$BAKE" "$MANNEQUIN" -o "$WORK/mannequin.drape" --report "$WORK/mannequin.json" 2>"$WORK/good.stderr"; then

@@ -118,6 +118,23 @@ else
   fail "unknown joint: $(cat "$WORK/joint.err")"
 fi
 
+# A clip the character lacks: one message naming /animation/clip and the clips, whether the
+# scene's maps are baked over the clip (refused by the bake) or only hulls pose it (refused once
+# the cached asset is loaded).
+for methods in '"hulls", "spheres"' '"maps", "hulls"'; do
+  write_scene "$WORK/bad_clip.json" 0.006 skirt hips
+  sed -i "s/\"clip\": \"walk\"/\"clip\": \"wlak\"/; s/\"methods\": \[[^]]*\]/\"methods\": [$methods]/" \
+    "$WORK/bad_clip.json"
+  rm -rf "$WORK/bad_clip_cache" && cp -r "$OUT" "$WORK/bad_clip_cache"
+  "$SIM" "$WORK/bad_clip.json" -o "$WORK/bad_clip_cache" --frames 2 --threads 1 >/dev/null 2>"$WORK/clip.err"
+  if [ $? -ne 0 ] && [ "$(wc -l <"$WORK/clip.err")" -eq 1 ] &&
+    grep -qF "$WORK/bad_clip.json: /animation/clip: no clip named 'wlak' in '$MANNEQUIN' (clips: walk" "$WORK/clip.err"; then
+    pass
+  else
+    fail "unknown clip with methods [$methods]: $(cat "$WORK/clip.err")"
+  fi
+done
+
 # --- 6. Bad command lines: a readable range, not the range of a double.
 "$SIM" "$WORK/scene.json" -o "$WORK/zero" --frames 0 >/dev/null 2>"$WORK/zero.err"
 rc=$?

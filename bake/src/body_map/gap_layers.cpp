@@ -125,15 +125,16 @@ void AppendBackground(BodyMapPose* pose) {
 
 // Removes the last entry AppendBackground() added.
 void PopEntry(BodyMapPose* pose) {
+  const auto drop_last = [](auto& values, size_t count) {
+    values.erase(values.end() - static_cast<std::ptrdiff_t>(std::min(count, values.size())),
+                 values.end());
+  };
   for (int view = 0; view < 2; ++view) {
-    if (!pose->depth_f32[view].empty()) pose->depth_f32[view].pop_back();
-    if (!pose->depth_u16[view].empty()) pose->depth_u16[view].pop_back();
-    if (!pose->normal_f32[view].empty())
-      pose->normal_f32[view].resize(pose->normal_f32[view].size() - 3);
-    if (!pose->normal_oct16[view].empty())
-      pose->normal_oct16[view].resize(pose->normal_oct16[view].size() - 2);
-    if (!pose->normal_rgb8[view].empty())
-      pose->normal_rgb8[view].resize(pose->normal_rgb8[view].size() - 3);
+    drop_last(pose->depth_f32[view], 1);
+    drop_last(pose->depth_u16[view], 1);
+    drop_last(pose->normal_f32[view], 3);
+    drop_last(pose->normal_oct16[view], 2);
+    drop_last(pose->normal_rgb8[view], 3);
   }
 }
 

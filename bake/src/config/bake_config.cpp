@@ -1,10 +1,9 @@
 #include "drape/bake/bake_config.h"
 
-#include "json_document.h"
-
 #include <fstream>
 
-#include "bake_config_schema.h"  // beside this file: see json_schema.h on the fuzz target
+#include "config/bake_config_schema.h"
+#include "config/json_document.h"
 
 namespace drape::bake {
 namespace {
@@ -26,7 +25,13 @@ const JsonSchema<BakeConfig>& ImportSection() {
                  [](BakeConfig& c) -> float& { return c.import.clip_sample_rate; })
           .Bool("rename_duplicate_joints",
                 "repair duplicate or empty joint names with suffixes instead of failing",
-                [](BakeConfig& c) -> bool& { return c.import.rename_duplicate_joints; });
+                [](BakeConfig& c) -> bool& { return c.import.rename_duplicate_joints; })
+          .Unsigned<uint32_t>("memory_limit_mb", "MiB", 64, 1048576,
+                              "memory the model reader may add; a file that needs more is refused",
+                              [](BakeConfig& c) -> uint32_t& { return c.import.memory_limit_mb; })
+          .Float("time_limit_s", "s", OpenBelow(0, 86400),
+                 "time the model reader may take; a file that takes longer is refused",
+                 [](BakeConfig& c) -> float& { return c.import.time_limit_s; });
   return schema;
 }
 
@@ -201,6 +206,7 @@ Status ApplyBakeConfig(const json& config, const std::string& source, BakeConfig
   const JsonDocument document{source, ""};
   BakeConfig result = *out;
   if (Status s = BakeConfigSchema().Read(JsonAt(config, "", document), &result); !s.ok()) return s;
+  if (result.maps_clip != out->maps_clip) result.maps_clip_origin = source + ": /maps/clip";
   *out = result;
   return Status::Ok();
 }
@@ -217,7 +223,10 @@ Status ParseBakeConfig(std::string_view text, const std::string& source, BakeCon
   return ApplyBakeConfig(parsed, source, config);
 }
 
-json BakeConfigReference() { return BakeConfigSchema().Reference(BakeConfig{}); }
+json BakeConfigReference() {
+  static const BakeConfig defaults;
+  return BakeConfigSchema().Reference(defaults);
+}
 
 json BakeConfigToJson(const BakeConfig& config) { return BakeConfigSchema().ToJson(config); }
 

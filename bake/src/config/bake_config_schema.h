@@ -3,8 +3,8 @@
 // ApplyBakeConfig and by a scene's /bake; printed by drape-bake --dump-config and in the scenes
 // reference.
 
+#include "config/json_schema.h"
 #include "drape/bake/bake_config.h"
-#include "json_schema.h"  // beside this file: see json_schema.h on the fuzz target
 
 namespace drape::bake {
 

@@ -1,4 +1,4 @@
-#include "json_document.h"
+#include "config/json_document.h"
 
 #include <filesystem>
 #include <fstream>

@@ -1,12 +1,12 @@
-// Included by its own name: the bake-config fuzz target compiles this file without the bake's
-// src/ on its include path.
-#include "json_schema.h"
+#include "config/json_schema.h"
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <utility>
+
+#include "config/name_suggestions.h"
 
 namespace drape::bake {
 
@@ -20,22 +20,6 @@ const json& Null() {
 }
 
 std::string Quote(const std::string& s) { return "'" + s + "'"; }
-
-// Levenshtein distance, for "did you mean".
-size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = above;
-    }
-  }
-  return row[b.size()];
-}
 
 // The markdown text of a default value: numbers shortest, strings in backticks, arrays in
 // brackets, absent as "none".
@@ -264,16 +248,8 @@ std::string JoinChoices(const std::vector<std::string>& names) {
 
 std::string UnknownKeyReason(const std::string& key, const std::string& parent,
                              const std::vector<std::string>& known) {
-  // The nearest known key within a third of the key's length (at least one edit) is suggested.
-  std::string suggestion;
-  size_t best = std::max<size_t>(1, key.size() / 3) + 1;
-  for (const std::string& name : known) {
-    const size_t distance = EditDistance(key, name);
-    if (distance < best) {
-      best = distance;
-      suggestion = name;
-    }
-  }
+  const std::vector<std::string> nearest = detail::NearestNames(key, known, 1);
+  const std::string suggestion = nearest.empty() ? std::string() : nearest.front();
   return "unknown key: " + key + " is not a parameter of " +
          (parent.empty() ? std::string("the top level") : parent) + " (" +
          (suggestion.empty() ? "" : "did you mean " + suggestion + "? ") +

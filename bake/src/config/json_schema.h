@@ -6,8 +6,6 @@
 // wrong type or out of its range, a missing required field, then runs the object's cross-field
 // rules; every refusal is one line, "<file>: <JSON path>: <reason>". The same tables print the
 // references (drape-bake --dump-config, docs/SCENES.md), so a reference cannot drift from the code.
-// This header includes only public headers: the bake-config fuzz target compiles it without the
-// bake's src/ on its include path.
 
 #include <cstdint>
 #include <functional>

@@ -1,11 +1,15 @@
 #include "drape/bake/importer.h"
 
+#include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 
 #include "import/asset_frame.h"
+#include "import/child_process.h"
 #include "import/clip_resampler.h"
+#include "import/header_prescan.h"
 #include "import/import_messages.h"
 #include "import/mesh_import.h"
 #include "import/skeleton_import.h"
@@ -33,6 +37,11 @@ Status CheckImportInputs(const std::string& path, const ImportOptions& options) 
   if (!(options.unit_scale >= 0.0 && std::isfinite(options.unit_scale))) {
     return SourceError(path, StatusCode::kInvalidArgument, "unit_scale must be >= 0 (0 = detect)");
   }
+  if (options.memory_limit_mb < 64 || options.memory_limit_mb > 1048576)
+    return SourceError(path, StatusCode::kInvalidArgument,
+                       "memory_limit_mb must be in [64, 1048576]");
+  if (!(options.time_limit_s > 0.f && options.time_limit_s <= 86400.f))
+    return SourceError(path, StatusCode::kInvalidArgument, "time_limit_s must be in (0, 86400] s");
   return Status::Ok();
 }
 
@@ -53,16 +62,12 @@ void RecordSourceInfo(const std::string& path, const detail::AssetFrame& frame,
                                                               frame.up_source);
 }
 
-}  // namespace
-
-Status ImportCharacter(const std::string& path, const ImportOptions& options,
-                       Character* character) {
-  *character = Character{};
-  if (Status s = CheckImportInputs(path, options); !s.ok()) return s;
-
+// The import's stages, in this process.
+Status ImportStages(const std::string& path, const ImportOptions& options, Character* character) {
   Assimp::Importer importer;  // owns the scene the stages read
   detail::SourceScene source;
-  if (Status s = detail::ReadSourceScene(path, &importer, &source); !s.ok()) return s;
+  if (Status s = detail::ReadSourceScene(path, &importer, &source, &character->warnings); !s.ok())
+    return s;
 
   detail::JointNodes joints;
   if (Status s = detail::SelectJointNodes(path, source, &joints); !s.ok()) return s;
@@ -95,6 +100,50 @@ Status ImportCharacter(const std::string& path, const ImportOptions& options,
 
   RecordSourceInfo(path, frame, character);
   return Status::Ok();
+}
+
+}  // namespace
+
+Status ImportCharacter(const std::string& path, const ImportOptions& options,
+                       Character* character) {
+  *character = Character{};
+  if (Status s = CheckImportInputs(path, options); !s.ok()) return s;
+  std::vector<std::string> prescan_warnings;
+  if (Status s = detail::PrescanModelFile(path, &prescan_warnings); !s.ok()) return s;
+  // A child process reads the file first: what would crash, hang or exhaust this process there
+  // becomes an error here. Only a file it read cleanly is read again in this process.
+  const detail::ChildLimits limits{static_cast<uint64_t>(options.memory_limit_mb) << 20,
+                                   static_cast<double>(options.time_limit_s)};
+  if (Status s = detail::RunInChildProcess(path, limits,
+                                           [&] {
+                                             Character probe;
+                                             return ImportStages(path, options, &probe);
+                                           });
+      !s.ok()) {
+    return s;
+  }
+  if (Status s = ImportStages(path, options, character); !s.ok()) return s;
+  character->warnings.insert(character->warnings.end(), prescan_warnings.begin(),
+                             prescan_warnings.end());
+  return Status::Ok();
+}
+
+std::vector<std::string> ReadableExtensions() {
+  std::string list;  // "*.3d;*.3ds;..."
+  Assimp::Importer().GetExtensionList(list);
+  std::vector<std::string> extensions;
+  for (size_t at = 0; at < list.size();) {
+    size_t end = list.find(';', at);
+    if (end == std::string::npos) end = list.size();
+    std::string pattern = list.substr(at, end - at);
+    if (pattern.rfind("*.", 0) == 0) pattern.erase(0, 1);
+    for (char& c : pattern) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (!pattern.empty()) extensions.push_back(pattern);
+    at = end + 1;
+  }
+  std::sort(extensions.begin(), extensions.end());
+  extensions.erase(std::unique(extensions.begin(), extensions.end()), extensions.end());
+  return extensions;
 }
 
 }  // namespace drape::bake

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "import/import_messages.h"
+#include "import/scene_repair.h"
 
 namespace drape::bake::detail {
 namespace {
@@ -113,20 +114,43 @@ Status ListMeshInstances(const std::string& path, SourceScene* source) {
   return Status::Ok();
 }
 
+// assimp's message, on one line.
+std::string ImporterError(const Assimp::Importer& importer) {
+  std::string why = importer.GetErrorString();
+  std::replace(why.begin(), why.end(), '\n', ' ');
+  return why;
+}
+
 }  // namespace
 
-Status ReadSourceScene(const std::string& path, Assimp::Importer* importer, SourceScene* source) {
+Status ReadSourceScene(const std::string& path, Assimp::Importer* importer, SourceScene* source,
+                       std::vector<std::string>* warnings) {
   importer->SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
   importer->SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene =
-      importer->ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                   aiProcess_SortByPType | aiProcess_ValidateDataStructure);
-  if (scene == nullptr) {
-    std::string why = importer->GetErrorString();
-    std::replace(why.begin(), why.end(), '\n', ' ');
+  // Read as the loader has it, repair what a viewer would forgive, then validate and
+  // post-process: what the repair left is refused with assimp's own message.
+  const aiScene* loaded = importer->ReadFile(path, 0);
+  if (loaded == nullptr) {
+    const std::string why = ImporterError(*importer);
+    // assimp asks every reader whose extension or signature matches; none took the file.
+    if (why.rfind("No suitable reader found", 0) == 0) {
+      return SourceError(path, StatusCode::kCorrupt,
+                         "unsupported or corrupt model: no reader accepts it (the file is "
+                         "corrupt, or not the format its extension names; drape-bake --formats "
+                         "lists what it reads)");
+    }
     return SourceError(path, StatusCode::kCorrupt, "unsupported or corrupt model: " + why);
   }
+  if (Status s = RepairLoadedScene(path, const_cast<aiScene*>(loaded), warnings); !s.ok()) return s;
+  const aiScene* scene =
+      importer->ApplyPostProcessing(aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                    aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+  if (scene == nullptr) {
+    return SourceError(path, StatusCode::kCorrupt,
+                       "unsupported or corrupt model: " + ImporterError(*importer));
+  }
+  DropStaleWeights(const_cast<aiScene*>(scene), warnings);
   if (scene->mRootNode == nullptr)
     return SourceError(path, StatusCode::kCorrupt, "the scene has no node hierarchy");
   if (scene->mNumMeshes == 0)

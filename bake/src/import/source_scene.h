@@ -32,10 +32,13 @@ struct SourceScene {
   std::vector<std::pair<int, unsigned>> mesh_instances;
 };
 
-// Reads `path` with assimp (triangulated, identical vertices joined, points and lines dropped),
-// flattens its nodes and lists the mesh instances. Refuses a scene without nodes, meshes, mesh
-// instances or triangles, and a corrupt hierarchy. `importer` owns the scene afterwards.
-Status ReadSourceScene(const std::string& path, Assimp::Importer* importer, SourceScene* source);
+// Reads `path` with assimp, repairs what a loader may leave that validation would refuse (see
+// scene_repair.h; one line per repair appended to `warnings`), validates, then triangulates,
+// joins identical vertices and drops points and lines; flattens the nodes and lists the mesh
+// instances. Refuses a scene without nodes, meshes, mesh instances or triangles, and a corrupt
+// hierarchy. `importer` owns the scene afterwards.
+Status ReadSourceScene(const std::string& path, Assimp::Importer* importer, SourceScene* source,
+                       std::vector<std::string>* warnings);
 
 // A number of the scene's metadata (FBX: UpAxis, UpAxisSign, UnitScaleFactor).
 bool MetadataNumber(const aiScene* scene, const char* key, double* value);

@@ -8,7 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <span>
 
+#include "config/clip_lookup.h"
 #include "drape/bake/body_map_baker.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
@@ -63,32 +65,32 @@ struct MapPoseRequest {
   float time = 0.f;
 };
 
-Status MapPoseRequests(const BakeConfig& config, const Character& character,
-                       std::vector<MapPoseRequest>* out) {
+// The poses the maps are baked at; refuses a clip the character lacks, naming where the clip
+// was named and listing the character's clips.
+Status MapPoseRequests(const std::string& input, const BakeConfig& config,
+                       const Character& character, std::vector<MapPoseRequest>* out) {
   out->clear();
   if (config.maps_clip.empty()) {
     out->push_back({});
     return Status::Ok();
   }
-  for (size_t c = 0; c < character.clips.size(); ++c) {
-    const ClipData& clip = character.clips[c];
-    if (clip.name != config.maps_clip) continue;
-    const float rate = config.maps_clip_rate > 0.f ? config.maps_clip_rate : clip.sample_rate;
-    const uint32_t count = static_cast<uint32_t>(std::ceil(clip.duration * rate - 1e-3f)) + 1;
-    for (uint32_t k = 0; k < count; ++k) {
-      out->push_back(
-          {static_cast<int32_t>(c), std::min(static_cast<float>(k) / rate, clip.duration)});
-    }
-    return Status::Ok();
-  }
-  return Status(StatusCode::kInvalidArgument,
-                "maps.clip '" + config.maps_clip + "' is not a clip of this character");
+  int32_t c = -1;
+  const std::string origin =
+      config.maps_clip_origin.empty() ? std::string("/maps/clip") : config.maps_clip_origin;
+  if (Status s = detail::FindClipNamed(character.clips, config.maps_clip, origin, input, &c);
+      !s.ok())
+    return s;
+  const ClipData& clip = character.clips[static_cast<size_t>(c)];
+  const float rate = config.maps_clip_rate > 0.f ? config.maps_clip_rate : clip.sample_rate;
+  const uint32_t count = static_cast<uint32_t>(std::ceil(clip.duration * rate - 1e-3f)) + 1;
+  for (uint32_t k = 0; k < count; ++k)
+    out->push_back({c, std::min(static_cast<float>(k) / rate, clip.duration)});
+  return Status::Ok();
 }
 
-Status BakeMaps(const BakeConfig& config, const Regions& regions, const Character& character,
-                const std::string& preview_dir, CharacterAsset* asset, json* report) {
-  std::vector<MapPoseRequest> requests;
-  if (Status s = MapPoseRequests(config, character, &requests); !s.ok()) return s;
+Status BakeMaps(const BakeConfig& config, std::span<const MapPoseRequest> requests,
+                const Regions& regions, const Character& character, const std::string& preview_dir,
+                CharacterAsset* asset, json* report) {
   SkeletonPose skeleton_pose;
   if (Status s = skeleton_pose.Init(character.skeleton); !s.ok()) return s;
   std::vector<Float3> posed(character.mesh.vertex_count());
@@ -454,6 +456,10 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   Character character;
   if (Status s = ImportCharacter(input, config.import, &character); !s.ok()) return s;
   timings["import_ms"] = MillisecondsSince(start);
+  std::vector<MapPoseRequest> map_requests;
+  if (config.maps_enabled) {
+    if (Status s = MapPoseRequests(input, config, character, &map_requests); !s.ok()) return s;
+  }
   CharacterAsset& asset = result->asset;
   StartAsset(character, &asset, &report);
 
@@ -468,7 +474,8 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   if (config.maps_enabled) {
     start = Clock::now();
     json maps = {{"renderer", RendererName(config.maps.renderer)}, {"poses", json::array()}};
-    if (Status s = BakeMaps(config, regions, character, preview_dir, &asset, &maps); !s.ok())
+    if (Status s = BakeMaps(config, map_requests, regions, character, preview_dir, &asset, &maps);
+        !s.ok())
       return failed(s);
     report["body_maps"] = maps;
     timings["maps_ms"] = MillisecondsSince(start);

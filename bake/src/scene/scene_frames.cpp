@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "config/clip_lookup.h"
 #include "drape/bake/scene.h"
 #include "scene/scene_messages.h"
 
@@ -34,16 +35,8 @@ Status ResolveSceneClip(const CharacterAsset& asset, Scene* scene, int32_t* clip
     if (scene->frame_count == 0) scene->frame_count = FrameCountFor(1.f, scene->dt);
     return Status::Ok();
   }
-  std::vector<std::string> names;
-  for (size_t c = 0; c < asset.clips.size(); ++c) {
-    names.push_back(asset.clips[c].name);
-    if (asset.clips[c].name == scene->animation.clip) *clip = static_cast<int32_t>(c);
-  }
-  if (*clip < 0) {
-    return Invalid(scene->source + ": /animation/clip: no clip named " +
-                   Quote(scene->animation.clip) + " in " + Quote(scene->character) +
-                   " (clips: " + (names.empty() ? "none" : JoinNames(names)) + ")");
-  }
+  DRAPE_RETURN_IF_ERROR(FindClipNamed(asset.clips, scene->animation.clip,
+                                      scene->source + ": /animation/clip", scene->character, clip));
   if (scene->frame_count == 0) {
     const float duration = asset.clips[static_cast<size_t>(*clip)].duration;
     scene->frame_count = FrameCountFor(duration > 0.f ? duration : scene->dt, scene->dt);

@@ -1,13 +1,13 @@
 #include "scene/scene_garments.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <queue>
 #include <utility>
 
+#include "config/name_suggestions.h"
 #include "drape/bake/scene.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
@@ -122,17 +122,13 @@ Status JointFrames(const std::string& prefix, const SceneGarment& g, const Skele
   return Status::Ok();
 }
 
-// The joint named `name`; the refusal at `path` suggests the joints sharing the name's first
-// letter (a few names help more than seventy), else says how many joints there are.
+// The joint named `name`; the refusal at `path` suggests the nearest joint names (case and the
+// prefix all joints share, such as "mixamorig:", ignored), else says how many joints there are.
 Status FindNamedJoint(const std::string& prefix, const SkeletonData& skeleton,
                       const std::string& name, const std::string& path, int32_t* j) {
   *j = FindJoint(skeleton, name);
   if (*j >= 0) return Status::Ok();
-  std::vector<std::string> similar;
-  for (const std::string& n : skeleton.joint_names)
-    if (!n.empty() && !name.empty() && std::tolower(n[0]) == std::tolower(name[0]))
-      similar.push_back(n);
-  if (similar.empty() || similar.size() > 12) similar.clear();
+  const std::vector<std::string> similar = NearestNames(name, skeleton.joint_names, 4);
   return Invalid(prefix + path + ": no joint named " + Quote(name) +
                  (similar.empty() ? " (" + std::to_string(skeleton.joint_count()) + " joints)"
                                   : " (did you mean " + JoinNames(similar) + "?)"));

@@ -66,6 +66,7 @@ Status ApplySceneToBakeConfig(const Scene& scene, BakeConfig* config) {
   result.spheres_enabled = scene.use_spheres;
   // Maps of the poses the scene plays: its clip (at maps.clip_rate), or the rest pose.
   result.maps_clip = scene.use_maps ? scene.animation.clip : std::string();
+  result.maps_clip_origin = scene.source + ": /animation/clip";
   *config = result;
   return Status::Ok();
 }

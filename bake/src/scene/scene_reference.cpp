@@ -56,7 +56,7 @@ else a line per 10 %), log lines to stdout. On any error it prints one line on s
 file and the reason, for a scene field its JSON path, and exits with 1:
 
 ```
-drape-sim: error: scene.json: /garments/0/attach/joint: no joint named 'hipz' (did you mean hips | head | hip_l | hip_r?)
+drape-sim: error: scene.json: /garments/0/attach/joint: no joint named 'hipz' (did you mean hips | hip_l | hip_r?)
 ```
 
 `drape-bake CHARACTER -o OUT.drape --scene SCENE.json` bakes what a scene needs in the same way:

@@ -340,7 +340,8 @@ const JsonSchema<Scene>& SceneSchema() {
               },
               nullptr,
               [](const Scene&, const std::string& path, std::string* out) {
-                BakeConfigSchema().WriteSections(BakeConfig{}, path, "`" + path + "`", out);
+                static const BakeConfig defaults;
+                BakeConfigSchema().WriteSections(defaults, path, "`" + path + "`", out);
               })
           .Default("{}");
   return schema;

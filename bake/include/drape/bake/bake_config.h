@@ -35,6 +35,9 @@ struct BakeConfig {
   }();
   std::string maps_clip;  // empty: the rest pose; else every time of this clip at maps_clip_rate
   float maps_clip_rate = 0.f;  // Hz, >= 0; 0 = each of the clip's resampled frames
+  // Where maps_clip was named ("config.json: /maps/clip", a scene's "/animation/clip"; empty:
+  // "/maps/clip"): the refusal of a clip the character lacks names it. Not a config key.
+  std::string maps_clip_origin;
 
   bool hulls_enabled = true;      // paper B: a convex collider per bone
   float rigid_threshold = 0.99f;  // a vertex is rigid to its heaviest bone at this weight, (0.5, 1]

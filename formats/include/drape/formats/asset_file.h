@@ -29,6 +29,9 @@ Status EncodeAsset(const CharacterAsset& asset, std::vector<uint8_t>* bytes);
 // path). On failure `asset` is left empty and the message says which check failed and why.
 Status DecodeAsset(std::span<const uint8_t> bytes, const std::string& name, CharacterAsset* asset);
 
+// Whether `head`, the first bytes of a file, starts as a .drape file does.
+bool LooksLikeAssetFile(std::span<const uint8_t> head);
+
 // Writes to "path.tmp-<pid>" and renames, so a failed write leaves no partial file at `path`.
 Status WriteAssetFile(const std::string& path, const CharacterAsset& asset);
 // The same for any bytes (reports, meshes, keys): all or nothing at `path`.
