@@ -1,5 +1,5 @@
-// The exact reference's cost (bench/reference/include/drape/bench/mesh_reference.h) on the
-// meshes its tests check it on (tests/bench/mesh_reference_test.cpp): mesh 0 is an icosphere
+// The exact reference's cost (bake/include/drape/bake/mesh_reference.h) on the
+// meshes its tests check it on (tests/bake/mesh_reference_test.cpp): mesh 0 is an icosphere
 // (5120 triangles; 1280 for BM_Distance), 1 the built-in mannequin's rest pose (7584), 2
 // CesiumMan's (4672, skipped when ../shared is absent). Points: half uniform in the mesh's box
 // inflated by 10 %, half within 1 cm of the surface (5 mm on the small icosphere), fixed seeds.
@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "drape/bake/mesh_queries.h"
-#include "drape/bench/mesh_reference.h"
+#include "drape/bake/mesh_reference.h"
 #include "reference_meshes.h"
 #include "test_support.h"
 
@@ -36,8 +36,8 @@ namespace drape {
 namespace {
 
 using bake::ExactMesh;
-using bench::MeshReference;
-using bench::WindingNumberOptions;
+using bake::MeshReference;
+using bake::WindingNumberOptions;
 using test::BoxPoints;
 using test::LoadRestPose;
 using test::MakeIcosphere;

@@ -8,7 +8,7 @@
 
 #include "bullet_cloth_peer.h"
 #include "drape/bake/bake_pipeline.h"
-#include "drape/bench/mesh_reference.h"
+#include "drape/bake/mesh_reference.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/garments.h"
@@ -26,7 +26,7 @@ using Clock = std::chrono::steady_clock;
 
 // Penetration of every particle into the exact posed body, appended to *depths (metres, 0 when
 // outside); returns the particles inside.
-size_t MeasurePenetration(const MeshReference& body, std::span<const Float3> particles,
+size_t MeasurePenetration(const bake::MeshReference& body, std::span<const Float3> particles,
                           std::vector<double>* depths) {
   const size_t first = depths->size();
   depths->resize(first + particles.size());
@@ -161,7 +161,7 @@ std::vector<ClothComparisonRow> CompareClothSolvers(const std::string& path,
         row.ms_per_frame_max = std::max(row.ms_per_frame_max, ms);
         row.finite = row.finite && AllFinite(state.positions);
         if (!SkinMesh(asset.mesh, skinning[f + 1], posed).ok()) row.error = "skinning failed";
-        const MeshReference body(posed, asset.mesh.triangles);
+        const bake::MeshReference body(posed, asset.mesh.triangles);
         inside += MeasurePenetration(body, state.positions, &depths);
         ++row.frames;
       }
@@ -232,7 +232,7 @@ std::vector<ClothComparisonRow> CompareClothSolvers(const std::string& path,
         bullet.CopyPositions(positions);
         row.finite = row.finite && AllFinite(positions);
         if (!SkinMesh(asset.mesh, skinning[f + 1], posed).ok()) row.error = "skinning failed";
-        const MeshReference body(posed, asset.mesh.triangles);
+        const bake::MeshReference body(posed, asset.mesh.triangles);
         inside += MeasurePenetration(body, positions, &depths);
         ++row.frames;
       }

@@ -63,7 +63,8 @@ double AngleDegrees(Float3 a, const double b[3]) {
 
 }  // namespace
 
-std::vector<ReferenceAnswer> AnswerQueries(const MeshReference& reference, const QuerySet& set) {
+std::vector<ReferenceAnswer> AnswerQueries(const bake::MeshReference& reference,
+                                           const QuerySet& set) {
   std::vector<ReferenceAnswer> answers(set.size());
   const long count = static_cast<long>(set.size());
 #pragma omp parallel for schedule(dynamic, 64)
@@ -94,7 +95,7 @@ std::vector<ReferenceAnswer> AnswerQueries(const MeshReference& reference, const
 }
 
 Metrics Evaluate(const Method& method, const QuerySet& set,
-                 std::span<const ReferenceAnswer> answers, const MeshReference& reference,
+                 std::span<const ReferenceAnswer> answers, const bake::MeshReference& reference,
                  const EvaluationOptions& options) {
   Metrics m;
   m.queries = set.size();

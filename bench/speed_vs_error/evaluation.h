@@ -18,7 +18,7 @@
 #include <span>
 #include <vector>
 
-#include "drape/bench/mesh_reference.h"
+#include "drape/bake/mesh_reference.h"
 #include "methods.h"
 #include "query_sets.h"
 
@@ -30,7 +30,8 @@ struct ReferenceAnswer {
   bool contact_expected = false;
 };
 
-std::vector<ReferenceAnswer> AnswerQueries(const MeshReference& reference, const QuerySet& set);
+std::vector<ReferenceAnswer> AnswerQueries(const bake::MeshReference& reference,
+                                           const QuerySet& set);
 
 struct Metrics {
   size_t queries = 0;
@@ -58,7 +59,7 @@ struct EvaluationOptions {
 };
 
 Metrics Evaluate(const Method& method, const QuerySet& set,
-                 std::span<const ReferenceAnswer> answers, const MeshReference& reference,
+                 std::span<const ReferenceAnswer> answers, const bake::MeshReference& reference,
                  const EvaluationOptions& options);
 
 }  // namespace drape::bench

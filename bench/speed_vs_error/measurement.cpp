@@ -88,7 +88,7 @@ void Measurement::RunCharacter(const CharacterSpec& spec) {
               note.empty() ? "" : ", ", note.c_str());
   if (!note.empty()) notes_.push_back(spec.label + ": " + note);
 
-  const MeshReference reference(positions, triangles);
+  const bake::MeshReference reference(positions, triangles);
   Context context = MakeContext(spec, positions, triangles, reference);
 
   if (options_.dump_maps) DumpMotions(options_.out_dir, spec, context.sets.back());
@@ -232,7 +232,7 @@ void Measurement::RunPosed(const CharacterSpec& spec, const bake::Character& cha
                 clip.name.empty() ? "unnamed clip" : clip.name.c_str(), time);
   posed.label += label;
   std::printf("%s\n", posed.label.c_str());
-  const MeshReference reference(positions, triangles);
+  const bake::MeshReference reference(positions, triangles);
   Context context = MakeContext(posed, positions, triangles, reference);
   // The quick sweep's nearest settings, and N = 1024 with and without air gaps: posed bodies
   // are where parts overlap along the view axis.
@@ -299,7 +299,7 @@ bool Measurement::Check() const { return CheckAccuracyClaims(rows_, set_violatio
 Measurement::Context Measurement::MakeContext(const CharacterSpec& spec,
                                               const std::vector<Float3>& positions,
                                               const std::vector<uint32_t>& triangles,
-                                              const MeshReference& reference) {
+                                              const bake::MeshReference& reference) {
   Context c;
   c.spec = spec;
   c.triangles = triangles.size() / 3;

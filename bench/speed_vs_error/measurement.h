@@ -10,8 +10,8 @@
 
 #include "characters.h"
 #include "drape/bake/importer.h"
+#include "drape/bake/mesh_reference.h"
 #include "drape/bake/regions.h"
-#include "drape/bench/mesh_reference.h"
 #include "drape/formats/character_asset.h"
 #include "evaluation.h"
 #include "methods.h"
@@ -38,7 +38,7 @@ class Measurement {
   struct Context {
     CharacterSpec spec;
     size_t triangles = 0;
-    const MeshReference* reference = nullptr;
+    const bake::MeshReference* reference = nullptr;
     std::vector<QuerySet> sets;  // the five sets, then "all"
     std::vector<std::vector<ReferenceAnswer>> answers;
     QuerySet peer_subset;  // every k-th motion of "all"
@@ -48,7 +48,7 @@ class Measurement {
   using HullAssets = std::vector<std::pair<std::string, CharacterAsset>>;
 
   Context MakeContext(const CharacterSpec& spec, const std::vector<Float3>& positions,
-                      const std::vector<uint32_t>& triangles, const MeshReference& reference);
+                      const std::vector<uint32_t>& triangles, const bake::MeshReference& reference);
   Row MakeRow(const Context& c, const Method& m, const std::string& set, const Metrics& metrics);
   void Measure(const Context& c, const Method& method);
   void MeasurePeer(const Context& c, const Method& method);

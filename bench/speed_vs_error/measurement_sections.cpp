@@ -57,7 +57,7 @@ void Measurement::ResolutionIndependence(const CharacterSpec& spec, const Contex
         "exact mesh ns |\n|---:|---:|---:|---:|---:|\n";
   for (int level = 0; level < 3; ++level) {
     if (level > 0) Subdivide(&positions, &triangles);
-    const MeshReference reference(positions, triangles);
+    const bake::MeshReference reference(positions, triangles);
     bake::BodyMapOptions o;
     o.resolution = 1024;
     BodyMapPose pose;

@@ -206,7 +206,7 @@ void CollideOneByOne(const Method& method, std::span<const Float3> previous,
 
 class ExactMeshPeer final : public Method {
  public:
-  explicit ExactMeshPeer(const MeshReference& reference) : reference_(reference) {}
+  explicit ExactMeshPeer(const bake::MeshReference& reference) : reference_(reference) {}
   void Collide(std::span<const Float3> previous, std::span<Float3> positions,
                std::span<Float3> velocities, std::span<uint8_t> flags) const override {
     CollideOneByOne(*this, previous, positions, velocities, flags);
@@ -218,7 +218,7 @@ class ExactMeshPeer final : public Method {
     ToDouble(p1, b);
     c.inside_end = reference_.Inside(b);
     if (!reference_.Inside(a)) {
-      const SurfaceHit hit = reference_.FirstCrossing(a, b);
+      const bake::SurfaceHit hit = reference_.FirstCrossing(a, b);
       if (hit.hit) {
         c.contact = true;
         c.t = static_cast<float>(hit.t);
@@ -240,7 +240,7 @@ class ExactMeshPeer final : public Method {
   }
 
  private:
-  const MeshReference& reference_;
+  const bake::MeshReference& reference_;
 };
 
 class FclPeer final : public Method {
@@ -316,7 +316,7 @@ std::unique_ptr<Method> MakeCombinedMethod(std::unique_ptr<Method> maps,
   return method;
 }
 
-std::unique_ptr<Method> MakeExactMeshPeer(const MeshReference& reference) {
+std::unique_ptr<Method> MakeExactMeshPeer(const bake::MeshReference& reference) {
   auto method = std::make_unique<ExactMeshPeer>(reference);
   method->family = "peer";
   method->setting = "exact mesh (winding number + CGAL AABB tree)";

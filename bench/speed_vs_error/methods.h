@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "drape/bench/mesh_reference.h"
+#include "drape/bake/mesh_reference.h"
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
@@ -79,7 +79,7 @@ std::unique_ptr<Method> MakeCombinedMethod(std::unique_ptr<Method> maps,
 
 // The exact mesh query itself: winding number at both ends, the first crossing of the segment
 // by CGAL's AABB tree, the closest point for a particle that ends inside.
-std::unique_ptr<Method> MakeExactMeshPeer(const MeshReference& reference);
+std::unique_ptr<Method> MakeExactMeshPeer(const bake::MeshReference& reference);
 
 // FCL's BVH point distance (the successor of RAPID, which paper A compares against): one
 // distance query per particle; contact when closer than the separation. Unsigned distance does

@@ -110,7 +110,7 @@ void TiltedDirection(const double axis[3], double max_angle, std::mt19937_64& rn
 
 std::vector<QuerySet> MakeQuerySets(std::span<const Float3> positions,
                                     std::span<const uint32_t> triangles,
-                                    const MeshReference& reference,
+                                    const bake::MeshReference& reference,
                                     const QuerySetOptions& options) {
   std::vector<QuerySet> sets(5);
   sets[0].name = "uniform";

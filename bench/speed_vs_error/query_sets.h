@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "drape/bench/mesh_reference.h"
+#include "drape/bake/mesh_reference.h"
 #include "drape/formats/types.h"
 
 namespace drape::bench {
@@ -50,7 +50,8 @@ struct QuerySetOptions {
 // Sets that cannot be filled (a mesh with no thin part) hold what was found, possibly nothing.
 std::vector<QuerySet> MakeQuerySets(std::span<const Float3> positions,
                                     std::span<const uint32_t> triangles,
-                                    const MeshReference& reference, const QuerySetOptions& options);
+                                    const bake::MeshReference& reference,
+                                    const QuerySetOptions& options);
 
 // All sets concatenated in order, named "all".
 QuerySet ConcatenateQuerySets(std::span<const QuerySet> sets);

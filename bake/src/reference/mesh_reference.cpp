@@ -1,4 +1,4 @@
-#include "drape/bench/mesh_reference.h"
+#include "drape/bake/mesh_reference.h"
 
 // All CGAL code of the reference queries lives in this one translation unit. Kernel: EPICK. Its
 // exact predicates make the segment queries watertight: whether a segment meets a triangle (and
@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-namespace drape::bench {
+namespace drape::bake {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
@@ -534,4 +534,4 @@ size_t MeshReference::memory_bytes() const {
   return tree_bytes + bvh_bytes + m.indices.size() * sizeof(uint32_t);
 }
 
-}  // namespace drape::bench
+}  // namespace drape::bake

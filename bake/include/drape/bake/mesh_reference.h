@@ -1,6 +1,7 @@
 #pragma once
-// The exact reference a collider is measured against (DESIGN.md "Speed against error"): the posed
-// original mesh, queried in double.
+// The exact reference a collider is measured against: the original mesh, queried in double. The
+// bake measures its proxies' fit with it (fit/collider_fit.h); the benchmarks measure every
+// collision method against the posed mesh (DESIGN.md "Speed against error").
 //
 // - Inside/outside is the generalised winding number (character meshes are open and
 //   self-overlapping, so a parity ray test is wrong on them), evaluated hierarchically after
@@ -31,7 +32,7 @@
 
 #include "drape/formats/types.h"
 
-namespace drape::bench {
+namespace drape::bake {
 
 inline constexpr uint32_t kNoTriangle = 0xFFFFFFFFu;  // "no triangle" in query results
 
@@ -47,9 +48,9 @@ struct WindingNumberOptions {
   // A BVH node is summarised by its expansion when |q - centre| > beta * radius. Larger is more
   // accurate and slower; [Limit: > 1] (values <= 1 are raised to 1.0001; non-finite gives the
   // default). Measured max |fast - brute| at expansion order 2, leaf size 4, on 1000 points in the
-  // inflated bounding box and 1000 within 1 cm of the surface (bench/gbench/mesh_reference_bench.cpp,
-  // BM_WindingSetting) of an icosphere (5120 triangles), the mannequin (7584) and CesiumMan
-  // (4672), and the time per query relative to beta = 2:
+  // inflated bounding box and 1000 within 1 cm of the surface
+  // (bench/gbench/mesh_reference_bench.cpp, BM_WindingSetting) of an icosphere (5120 triangles),
+  // the mannequin (7584) and CesiumMan (4672), and the time per query relative to beta = 2:
   //   beta 2: 4.6e-3 .. 6.4e-3 (1x); beta 3: 0.8e-3 .. 1.1e-3 (1.9x); beta 4: 2.1e-4 .. 3.5e-4 (3x)
   // Default 4: the reference stays 3x under 1e-3. Beta 2 (Barill et al.'s choice) suits speed;
   // neither flips Inside() on any point whose exact winding number is farther than 0.1 from 0.5.
@@ -114,4 +115,4 @@ class MeshReference {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace drape::bench
+}  // namespace drape::bake

@@ -4,7 +4,7 @@
 // triangle; degenerate input. The cost of each query and of each winding-number setting is
 // bench/gbench/mesh_reference_bench.cpp's.
 
-#include "drape/bench/mesh_reference.h"
+#include "drape/bake/mesh_reference.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
@@ -30,9 +30,9 @@ namespace drape {
 namespace {
 
 using bake::ExactMesh;
-using bench::MeshReference;
-using bench::SurfaceHit;
-using bench::WindingNumberOptions;
+using bake::MeshReference;
+using bake::SurfaceHit;
+using bake::WindingNumberOptions;
 
 using test::BoxPoints;
 using test::Corner;
@@ -271,7 +271,7 @@ void CheckDistances(const Mesh& mesh, const std::vector<V3>& points) {
     const double reference = brute.Distance(Ptr(p));
     const double distance = fast.Distance(Ptr(p));
     double point[3], normal[3];
-    uint32_t triangle = bench::kNoTriangle;
+    uint32_t triangle = bake::kNoTriangle;
     const double closest = fast.ClosestPoint(Ptr(p), point, &triangle, normal);
     EXPECT_NEAR(distance, reference, 1e-9);
     EXPECT_NEAR(closest, reference, 1e-9);
@@ -338,7 +338,7 @@ TEST(MeshReference, FirstCrossingMatchesMollerTrumbore) {
     for (size_t k = 0; k < ts.size(); ++k) EXPECT_NEAR(ts[k], expected[k].first, 1e-9);
     if (!hit.hit) {
       ++misses;
-      EXPECT_EQ(hit.triangle, bench::kNoTriangle);
+      EXPECT_EQ(hit.triangle, bake::kNoTriangle);
       continue;
     }
     EXPECT_NEAR(hit.t, expected.front().first, 1e-9) << "segment " << i;
@@ -422,7 +422,7 @@ TEST(MeshReference, EmptyMeshAnswersWithoutCrashing) {
   double point[3], normal[3] = {1, 1, 1};
   uint32_t triangle = 0;
   EXPECT_EQ(empty.ClosestPoint(q, point, &triangle, normal), INFINITY);
-  EXPECT_EQ(triangle, bench::kNoTriangle);
+  EXPECT_EQ(triangle, bake::kNoTriangle);
   EXPECT_EQ(normal[0], 0.0);
   EXPECT_FALSE(empty.FirstCrossing(q, p1).hit);
   std::vector<double> ts = {3.0};
