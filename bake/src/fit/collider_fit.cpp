@@ -1,0 +1,271 @@
+#include "fit/collider_fit.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "drape/bake/mesh_queries.h"
+#include "drape/bake/mesh_reference.h"
+#include "drape/runtime/math.h"
+#include "fit/surface_samples.h"
+
+namespace drape::bake {
+namespace {
+
+// Seeds of the sample streams; hull h draws from kHullSeed + h.
+constexpr uint64_t kHullSeed = 0x68756C6C00000000ull;
+constexpr uint64_t kBodySeed = 0x626F647900000000ull;
+
+// A hull at rest in the asset frame, in double. `placed` is false when its joint has no
+// skinning matrix: it then has no geometry and no samples.
+struct PlacedHull {
+  bool placed = false;
+  std::vector<double> vertices;  // 3 per vertex, metres
+  std::vector<uint32_t> triangles;
+  std::vector<double> planes;  // 4 per triangle: unit outward normal n, offset d (n.p = d on it)
+  double lo[3] = {INFINITY, INFINITY, INFINITY};
+  double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+};
+
+struct PlacedSphere {
+  bool placed = false;
+  double centre[3] = {0, 0, 0};
+  double radius = 0.0;
+};
+
+bool HasJoint(int32_t joint, size_t joint_count) {
+  return joint >= 0 && static_cast<size_t>(joint) < joint_count;
+}
+
+// The hull where the runtime puts it at the rest pose: skinning(joint) * bind_frame, in float
+// as the runtime computes it, then widened to double.
+PlacedHull PlaceHull(const HullColliderData& hull, std::span<const Mat34> rest_skinning) {
+  PlacedHull placed;
+  if (!HasJoint(hull.joint, rest_skinning.size())) return placed;
+  placed.placed = true;
+  const Mat34 world = Multiply(rest_skinning[hull.joint], hull.bind_frame);
+  for (const Float3& v : hull.vertices) {
+    const Float3 p = TransformPoint(world, v);
+    const double q[3] = {p.x, p.y, p.z};
+    for (int k = 0; k < 3; ++k) {
+      placed.vertices.push_back(q[k]);
+      placed.lo[k] = std::min(placed.lo[k], q[k]);
+      placed.hi[k] = std::max(placed.hi[k], q[k]);
+    }
+  }
+  const size_t vertex_count = hull.vertices.size();
+  for (size_t t = 0; t + 2 < hull.triangles.size(); t += 3) {
+    const uint32_t* corner = &hull.triangles[t];
+    if (corner[0] >= vertex_count || corner[1] >= vertex_count || corner[2] >= vertex_count)
+      continue;
+    placed.triangles.insert(placed.triangles.end(), corner, corner + 3);
+    const double* a = &placed.vertices[3 * size_t{corner[0]}];
+    const double* b = &placed.vertices[3 * size_t{corner[1]}];
+    const double* c = &placed.vertices[3 * size_t{corner[2]}];
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                   e1[0] * e2[1] - e1[1] * e2[0]};
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    // A zero-area triangle bounds nothing: its plane (0, 0) never rejects a point.
+    for (double& x : n) x = length > 0.0 ? x / length : 0.0;
+    placed.planes.insert(placed.planes.end(),
+                         {n[0], n[1], n[2], n[0] * a[0] + n[1] * a[1] + n[2] * a[2]});
+  }
+  return placed;
+}
+
+PlacedSphere PlaceSphere(const JointSphereData& sphere, std::span<const Mat34> rest_skinning) {
+  PlacedSphere placed;
+  if (!HasJoint(sphere.joint, rest_skinning.size())) return placed;
+  const Float3 c = TransformPoint(rest_skinning[sphere.joint], sphere.center);
+  placed.placed = true;
+  placed.centre[0] = c.x, placed.centre[1] = c.y, placed.centre[2] = c.z;
+  placed.radius = sphere.radius;
+  return placed;
+}
+
+// How far p lies outside the hull, metres: 0 inside (behind every plane), else the distance to
+// its surface. Beyond `limit` the answer may be any value above `limit` (the largest plane
+// distance, a lower bound of the true one), which is all the coverage needs.
+double HullOutsideDistance(const PlacedHull& hull, const double p[3], double limit) {
+  double worst_plane = -INFINITY;
+  for (size_t i = 0; i < hull.planes.size(); i += 4) {
+    const double* plane = &hull.planes[i];
+    worst_plane =
+        std::max(worst_plane, plane[0] * p[0] + plane[1] * p[1] + plane[2] * p[2] - plane[3]);
+  }
+  if (worst_plane <= 0.0) return 0.0;
+  if (worst_plane > limit) return worst_plane;
+  double nearest = INFINITY;
+  for (size_t t = 0; t < hull.triangles.size(); t += 3) {
+    nearest =
+        std::min(nearest, PointTriangleDistance(p, &hull.vertices[3 * size_t{hull.triangles[t]}],
+                                                &hull.vertices[3 * size_t{hull.triangles[t + 1]}],
+                                                &hull.vertices[3 * size_t{hull.triangles[t + 2]}]));
+  }
+  return nearest;
+}
+
+// Whether a point on the body is inside some collider or within its delta + tolerance of it.
+bool Covered(const double p[3], std::span<const PlacedHull> hulls,
+             std::span<const PlacedSphere> spheres, const ColliderFitOptions& options) {
+  const double sphere_limit = options.sphere_delta + options.coverage_tolerance;
+  for (const PlacedSphere& s : spheres) {
+    if (!s.placed) continue;
+    const double d[3] = {p[0] - s.centre[0], p[1] - s.centre[1], p[2] - s.centre[2]};
+    if (std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - s.radius <= sphere_limit) return true;
+  }
+  const double hull_limit = options.hull_delta + options.coverage_tolerance;
+  for (const PlacedHull& h : hulls) {
+    if (!h.placed) continue;
+    bool near_box = true;  // within hull_limit of the bounding box on every axis
+    for (int k = 0; k < 3; ++k) {
+      near_box = near_box && p[k] >= h.lo[k] - hull_limit && p[k] <= h.hi[k] + hull_limit;
+    }
+    if (near_box && HullOutsideDistance(h, p, hull_limit) <= hull_limit) return true;
+  }
+  return false;
+}
+
+// The nearest-rank 99th percentile of the values (sorted in place).
+double Percentile99(std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const size_t rank = static_cast<size_t>(std::ceil(0.99 * static_cast<double>(values.size())));
+  return values[std::max<size_t>(rank, 1) - 1];
+}
+
+// Every collider's bloat samples, flattened: collider c owns points [begin[c], end[c]), of which
+// [begin[c], area_end[c]) are spread over its area (the rest are a hull's vertices).
+struct BloatSamples {
+  std::vector<double> points;  // 3 per sample, metres
+  std::vector<double> delta;   // per sample: its collider's delta, metres
+  std::vector<size_t> begin, area_end, end;
+
+  size_t count() const { return points.size() / 3; }
+  void Close(double collider_delta) {
+    end.push_back(count());
+    delta.resize(count(), collider_delta);
+  }
+};
+
+BloatSamples CollectBloatSamples(std::span<const PlacedHull> hulls,
+                                 std::span<const PlacedSphere> spheres,
+                                 const ColliderFitOptions& options) {
+  BloatSamples s;
+  for (size_t h = 0; h < hulls.size(); ++h) {
+    s.begin.push_back(s.count());
+    if (hulls[h].placed) {
+      SampleTriangles(hulls[h].vertices, hulls[h].triangles, options.hull_samples, kHullSeed + h,
+                      &s.points);
+    }
+    s.area_end.push_back(s.count());
+    // The corners stick out farthest: the maximum includes them.
+    s.points.insert(s.points.end(), hulls[h].vertices.begin(), hulls[h].vertices.end());
+    s.Close(options.hull_delta);
+  }
+  for (const PlacedSphere& sphere : spheres) {
+    s.begin.push_back(s.count());
+    if (sphere.placed)
+      SampleSphere(sphere.centre, sphere.radius, options.sphere_samples, &s.points);
+    s.area_end.push_back(s.count());
+    s.Close(options.sphere_delta);
+  }
+  return s;
+}
+
+// Bloat of every sample, metres: how far outside the body beyond its collider's delta, >= 0.
+// One sample per iteration into its own slot: the same values at any thread count.
+std::vector<double> BloatOf(const BloatSamples& samples, const MeshReference& body) {
+  std::vector<double> bloat(samples.count());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int64_t i = 0; i < static_cast<int64_t>(bloat.size()); ++i) {
+    const double* q = &samples.points[3 * static_cast<size_t>(i)];
+    const double outside = body.WindingNumber(q) > 0.5 ? 0.0 : body.Distance(q);
+    bloat[i] = std::max(0.0, outside - samples.delta[i]);
+  }
+  return bloat;
+}
+
+ColliderBloat Summarise(const std::vector<double>& bloat, size_t begin, size_t area_end,
+                        size_t end) {
+  ColliderBloat b;
+  b.samples = static_cast<uint32_t>(end - begin);
+  std::vector<double> area(bloat.begin() + begin, bloat.begin() + area_end);
+  b.p99_mm = 1000.0 * Percentile99(area);
+  for (size_t i = begin; i < end; ++i) b.max_mm = std::max(b.max_mm, 1000.0 * bloat[i]);
+  return b;
+}
+
+// The fraction of area-weighted body samples that some collider covers.
+double Coverage(std::span<const double> body_points, std::span<const PlacedHull> hulls,
+                std::span<const PlacedSphere> spheres, const ColliderFitOptions& options) {
+  const size_t count = body_points.size() / 3;
+  if (count == 0) return 0.0;
+  std::vector<uint8_t> covered(count);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (int64_t i = 0; i < static_cast<int64_t>(count); ++i) {
+    covered[i] = Covered(&body_points[3 * static_cast<size_t>(i)], hulls, spheres, options);
+  }
+  size_t inside = 0;
+  for (uint8_t c : covered) inside += c;
+  return static_cast<double>(inside) / static_cast<double>(count);
+}
+
+// Area-weighted points on the body (its triangles whose corners exist), 3 doubles each.
+std::vector<double> BodySamples(std::span<const Float3> positions,
+                                std::span<const uint32_t> triangles, uint32_t count) {
+  std::vector<double> corners;
+  corners.reserve(3 * positions.size());
+  for (const Float3& p : positions) corners.insert(corners.end(), {p.x, p.y, p.z});
+  std::vector<uint32_t> valid;
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    if (triangles[t] < positions.size() && triangles[t + 1] < positions.size() &&
+        triangles[t + 2] < positions.size()) {
+      valid.insert(valid.end(), &triangles[t], &triangles[t] + 3);
+    }
+  }
+  std::vector<double> points;
+  SampleTriangles(corners, valid, count, kBodySeed, &points);
+  return points;
+}
+
+}  // namespace
+
+ColliderFit MeasureColliderFit(std::span<const Float3> rest_positions,
+                               std::span<const uint32_t> triangles,
+                               std::span<const HullColliderData> hulls,
+                               std::span<const JointSphereData> spheres,
+                               std::span<const Mat34> rest_skinning,
+                               const ColliderFitOptions& options) {
+  std::vector<PlacedHull> placed_hulls;
+  for (const HullColliderData& hull : hulls) placed_hulls.push_back(PlaceHull(hull, rest_skinning));
+  std::vector<PlacedSphere> placed_spheres;
+  for (const JointSphereData& s : spheres) placed_spheres.push_back(PlaceSphere(s, rest_skinning));
+
+  WindingNumberOptions winding;
+  winding.beta = options.winding_beta;
+  const MeshReference body(rest_positions, triangles, winding);
+  const BloatSamples samples = CollectBloatSamples(placed_hulls, placed_spheres, options);
+  const std::vector<double> bloat = BloatOf(samples, body);
+
+  ColliderFit fit;
+  std::vector<double> area_bloat;  // every collider's area-weighted samples, for the p99
+  for (size_t c = 0; c < samples.begin.size(); ++c) {
+    const ColliderBloat b = Summarise(bloat, samples.begin[c], samples.area_end[c], samples.end[c]);
+    (c < hulls.size() ? fit.hulls : fit.spheres).push_back(b);
+    area_bloat.insert(area_bloat.end(), bloat.begin() + samples.begin[c],
+                      bloat.begin() + samples.area_end[c]);
+    fit.bloat_max_mm = std::max(fit.bloat_max_mm, b.max_mm);
+  }
+  fit.bloat_p99_mm = 1000.0 * Percentile99(area_bloat);
+  fit.collider_samples = static_cast<uint32_t>(samples.count());
+
+  const std::vector<double> body_points =
+      BodySamples(rest_positions, triangles, options.body_samples);
+  fit.body_samples = static_cast<uint32_t>(body_points.size() / 3);
+  fit.coverage = Coverage(body_points, placed_hulls, placed_spheres, options);
+  return fit;
+}
+
+}  // namespace drape::bake
