@@ -47,10 +47,28 @@ void AddSphere(Soup* soup, Float3 center, float radius, int32_t who) {
   }
 }
 
-// Per-owner colour: a hue wheel for hulls, white for spheres, grey for the body.
-void OwnerColour(int32_t owner, int32_t hull_count, float rgb[3]) {
+// Green at no bloat, yellow at half of red_mm, red at red_mm and beyond.
+void BloatColour(double mm, double red_mm, float rgb[3]) {
+  constexpr float kGreen[3] = {0.2f, 0.8f, 0.25f};
+  constexpr float kYellow[3] = {0.95f, 0.85f, 0.1f};
+  constexpr float kRed[3] = {0.95f, 0.12f, 0.1f};
+  const float t =
+      red_mm > 0.0 ? static_cast<float>(std::clamp(mm / red_mm, 0.0, 1.0)) : (mm > 0.0 ? 1.f : 0.f);
+  const float* from = t <= 0.5f ? kGreen : kYellow;
+  const float* to = t <= 0.5f ? kYellow : kRed;
+  const float f = t <= 0.5f ? 2.f * t : 2.f * t - 1.f;
+  for (int k = 0; k < 3; ++k) rgb[k] = from[k] + (to[k] - from[k]) * f;
+}
+
+// Per-owner colour: grey for the body; by bloat when given; else a hue wheel for hulls and
+// white for spheres.
+void OwnerColour(int32_t owner, int32_t hull_count, const PreviewBloat* bloat, float rgb[3]) {
   if (owner < 0) {
     rgb[0] = rgb[1] = rgb[2] = 0.75f;
+  } else if (bloat != nullptr) {
+    const std::vector<double>& mm = owner < hull_count ? bloat->hull_mm : bloat->sphere_mm;
+    const size_t index = static_cast<size_t>(owner < hull_count ? owner : owner - hull_count);
+    BloatColour(index < mm.size() ? mm[index] : 0.0, bloat->red_mm, rgb);
   } else if (owner >= hull_count) {
     rgb[0] = rgb[1] = rgb[2] = 1.f;
   } else {
@@ -62,9 +80,11 @@ void OwnerColour(int32_t owner, int32_t hull_count, float rgb[3]) {
   }
 }
 
-// Renders the soup looking along -axis (axis 2: front view along -z; axis 0: side view along -x).
-Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, int axis,
-                  uint32_t height, const std::string& path) {
+// Renders the soups looking along -axis (axis 2: front view along -z; axis 0: side view along -x):
+// the body, the joint spheres translucent over it, the hulls over both (a hull inside a sphere
+// stays visible).
+Status RenderView(const Soup& body, const Soup& hulls, const Soup& spheres, int32_t hull_count,
+                  const PreviewBloat* bloat, int axis, uint32_t height, const std::string& path) {
   // The picture plane: (u, v) = (x, y) for the front view, (-z, y) for the side view.
   auto project = [axis](const double* p, double* u, double* v, double* depth) {
     *u = axis == 2 ? p[0] : -p[2];
@@ -72,7 +92,7 @@ Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, i
     *depth = axis == 2 ? -p[2] : -p[0];
   };
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (const Soup* soup : {&body, &colliders}) {
+  for (const Soup* soup : {&body, &hulls, &spheres}) {
     for (size_t i = 0; i < soup->positions.size(); i += 3) {
       double c[3];
       project(&soup->positions[i], &c[0], &c[1], &c[2]);
@@ -113,9 +133,10 @@ Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, i
     input.triangles = soup.triangles;
     RasterizeViewCpu(input, 0, &layer->image, &layer->face);
   };
-  Layer body_layer, collider_layer;
+  Layer body_layer, hull_layer, sphere_layer;
   render(body, &body_layer);
-  if (!colliders.triangles.empty()) render(colliders, &collider_layer);
+  if (!hulls.triangles.empty()) render(hulls, &hull_layer);
+  if (!spheres.triangles.empty()) render(spheres, &sphere_layer);
 
   const float light[3] = {0.35f, 0.45f, axis == 2 ? 0.82f : 0.f};
   const float side_light[3] = {axis == 0 ? 0.82f : 0.f, 0.45f, 0.35f};
@@ -128,15 +149,12 @@ Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, i
       const float* n = &layer.image.normal[3 * i];
       const float lambert = 0.35f + 0.65f * std::fabs(n[0] * l[0] + n[1] * l[1] + n[2] * l[2]);
       float colour[3];
-      OwnerColour(soup.owner[layer.face[i]], hull_count, colour);
+      OwnerColour(soup.owner[layer.face[i]], hull_count, bloat, colour);
       for (int k = 0; k < 3; ++k) rgb[k] = (1.f - alpha) * rgb[k] + alpha * colour[k] * lambert;
     };
     shade(body_layer, body, 1.f);
-    const bool collider_here = !collider_layer.image.valid.empty() && collider_layer.image.valid[i];
-    if (collider_here) {
-      const int32_t owner = colliders.owner[collider_layer.face[i]];
-      shade(collider_layer, colliders, owner >= hull_count ? 0.3f : 0.7f);
-    }
+    shade(sphere_layer, spheres, 0.3f);
+    shade(hull_layer, hulls, 0.7f);
     for (int k = 0; k < 3; ++k)
       pixels[3 * i + k] = static_cast<uint8_t>(std::clamp(rgb[k], 0.f, 1.f) * 255.f);
   }
@@ -147,8 +165,8 @@ Status RenderView(const Soup& body, const Soup& colliders, int32_t hull_count, i
 
 Status WriteColliderPreview(const CharacterAsset& asset, std::span<const Float3> rest_positions,
                             std::span<const Mat34> rest_skinning, const std::string& directory,
-                            uint32_t height) {
-  Soup body, colliders;
+                            uint32_t height, const PreviewBloat* bloat) {
+  Soup body, hulls, spheres;
   const auto& tris = asset.mesh.triangles;
   for (size_t t = 0; t + 2 < tris.size(); t += 3) {
     body.Add(rest_positions[tris[t]], rest_positions[tris[t + 1]], rest_positions[tris[t + 2]], -1);
@@ -158,22 +176,23 @@ Status WriteColliderPreview(const CharacterAsset& asset, std::span<const Float3>
     const HullColliderData& hull = asset.hulls[h];
     const Mat34 world = Multiply(rest_skinning[hull.joint], hull.bind_frame);
     for (size_t t = 0; t + 2 < hull.triangles.size(); t += 3) {
-      colliders.Add(TransformPoint(world, hull.vertices[hull.triangles[t]]),
-                    TransformPoint(world, hull.vertices[hull.triangles[t + 1]]),
-                    TransformPoint(world, hull.vertices[hull.triangles[t + 2]]), h);
+      hulls.Add(TransformPoint(world, hull.vertices[hull.triangles[t]]),
+                TransformPoint(world, hull.vertices[hull.triangles[t + 1]]),
+                TransformPoint(world, hull.vertices[hull.triangles[t + 2]]), h);
     }
   }
   for (size_t s = 0; s < asset.joint_spheres.size(); ++s) {
     const JointSphereData& sphere = asset.joint_spheres[s];
-    AddSphere(&colliders, TransformPoint(rest_skinning[sphere.joint], sphere.center), sphere.radius,
+    AddSphere(&spheres, TransformPoint(rest_skinning[sphere.joint], sphere.center), sphere.radius,
               hull_count + static_cast<int32_t>(s));
   }
-  if (Status s =
-          RenderView(body, colliders, hull_count, 2, height, directory + "/colliders_front.png");
+  if (Status s = RenderView(body, hulls, spheres, hull_count, bloat, 2, height,
+                            directory + "/colliders_front.png");
       !s.ok()) {
     return s;
   }
-  return RenderView(body, colliders, hull_count, 0, height, directory + "/colliders_side.png");
+  return RenderView(body, hulls, spheres, hull_count, bloat, 0, height,
+                    directory + "/colliders_side.png");
 }
 
 }  // namespace drape::bake
