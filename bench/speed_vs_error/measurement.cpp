@@ -48,16 +48,17 @@ bool MeasuredPosed(const std::string& label) {
 std::string PerBoneTable(const nlohmann::json& report) {
   std::ostringstream md;
   md << "Default bake: per bone, the collider's triangles, its growth beyond the inflated hull "
-        "and its one-sided distance to the mesh (the farthest collider vertex from the "
-        "surface), from the bake report.\n\n| bone | triangles | planes | growth mm | "
-        "distance to mesh mm | bytes |\n|---|---:|---:|---:|---:|---:|\n";
+        "and its bloat (how far its surface reaches outside the body beyond delta: the 99th "
+        "percentile and the maximum over samples on it), from the bake report.\n\n| bone | "
+        "triangles | planes | growth mm | bloat p99 mm | bloat max mm | bytes |\n"
+        "|---|---:|---:|---:|---:|---:|---:|\n";
   if (!report.contains("hulls") || !report["hulls"].contains("colliders")) return "";
   for (const auto& c : report["hulls"]["colliders"]) {
     char line[256];
-    std::snprintf(line, sizeof(line), "| %s | %d | %d | %.1f | %.1f | %d |\n",
+    std::snprintf(line, sizeof(line), "| %s | %d | %d | %.1f | %.1f | %.1f | %d |\n",
                   c.value("bone", std::string("?")).c_str(), c.value("triangles_after", 0),
                   c.value("planes_after", 0), c.value("growth_mm", 0.0),
-                  c.value("distance_to_mesh_mm", 0.0), c.value("bytes", 0));
+                  c.value("bloat_p99_mm", 0.0), c.value("bloat_max_mm", 0.0), c.value("bytes", 0));
     md << line;
   }
   return md.str();

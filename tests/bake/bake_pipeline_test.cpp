@@ -37,8 +37,8 @@ struct CharacterCase {
   // Paper A looks along the body's front axis. For an upright character the air between parts
   // along that axis is small; for a quadruped the slab from the chest to the tail spans the air
   // under the belly and between the legs, which the discrete test counts as inside (the measured
-  // slab bias, docs/ALGORITHMS.md §6.5). Humanoids must reach 99.5 %; quadrupeds are held to what they give
-  // with paper A's slab, and to 99.5 % with air-gap layers (BodyMapPose::layers = 4).
+  // slab bias, docs/ALGORITHMS.md §6.5). Humanoids must reach 99.5 %; quadrupeds are held to what
+  // they give with paper A's slab, and to 99.5 % with air-gap layers (BodyMapPose::layers = 4).
   double min_agreement;
 };
 
@@ -265,9 +265,9 @@ TEST(BakePipeline, ReportCarriesTheContractFields) {
   BakeResult result;
   ASSERT_TRUE(BakeCharacter(test::MannequinPath(), BakeConfig{}, &result).ok());
   const auto& r = result.report;
-  for (const char* field :
-       {"input", "tool_version", "format_version", "unit_scale", "up_axis", "source_to_asset",
-        "joint_count", "clips", "warnings", "timings", "body_maps", "hulls", "joint_spheres"}) {
+  for (const char* field : {"input", "tool_version", "format_version", "unit_scale", "up_axis",
+                            "source_to_asset", "joint_count", "clips", "warnings", "timings",
+                            "body_maps", "hulls", "joint_spheres", "fit"}) {
     EXPECT_TRUE(r.contains(field)) << field;
   }
   ASSERT_EQ(r["source_to_asset"].size(), 4u);
@@ -276,12 +276,27 @@ TEST(BakePipeline, ReportCarriesTheContractFields) {
   for (const auto& c : r["hulls"]["colliders"]) {
     for (const char* field :
          {"bone", "kind", "rigid_vertices", "triangles_before", "triangles_after", "planes_before",
-          "planes_after", "growth_mm", "distance_to_mesh_mm", "bytes", "ms"}) {
+          "planes_after", "growth_mm", "bloat_p99_mm", "bloat_max_mm", "bytes", "ms"}) {
       EXPECT_TRUE(c.contains(field)) << field;
     }
     EXPECT_LE(c["growth_mm"].get<double>(), 1000.0 * BakeConfig{}.hull.max_growth + 1e-3);
     EXPECT_EQ(c["map_table"]["empty_cells"].get<int>(), 0);
+    EXPECT_LE(c["bloat_p99_mm"].get<double>(), c["bloat_max_mm"].get<double>());
   }
+  ASSERT_FALSE(r["joint_spheres"].empty());
+  for (const auto& s : r["joint_spheres"]) {
+    for (const char* field : {"joint", "parent", "radius_mm", "bloat_p99_mm", "bloat_max_mm"}) {
+      EXPECT_TRUE(s.contains(field)) << field;
+    }
+  }
+  for (const char* field :
+       {"coverage", "bloat_p99_mm", "bloat_max_mm", "body_samples", "collider_samples",
+        "hull_delta_mm", "sphere_delta_mm", "coverage_tolerance_mm", "max_bloat_mm"}) {
+    EXPECT_TRUE(r["fit"].contains(field)) << field;
+  }
+  EXPECT_GE(r["fit"]["coverage"].get<double>(), 0.99);  // the mannequin is covered
+  EXPECT_EQ(r["fit"]["max_bloat_mm"].get<double>(), 15.0);
+  EXPECT_TRUE(r["timings"].contains("fit_ms"));
   const auto& pose = r["body_maps"]["poses"][0];
   for (const char* field :
        {"resolution", "texel_size_mm", "coverage", "bytes", "render_ms_front", "renderer"}) {
@@ -420,6 +435,45 @@ TEST(BakePipeline, WarnsWhenFewVerticesShapeTheHulls) {
   EXPECT_LT(shaped.report["hulls"]["rigid_vertex_fraction"].get<double>(), 0.5);
   EXPECT_GT(shaped.report["hulls"]["hull_vertex_fraction"].get<double>(), 0.5);
   EXPECT_EQ(rigid_warnings(shaped.report), 0);
+}
+
+// hulls.max_bloat: one warning names every collider whose bloat max in the report exceeds it,
+// with its figure; at 1 m nothing is named, and the measure is the same.
+TEST(BakePipeline, WarnsAboutCollidersBulgingBeyondMaxBloat) {
+  const auto bulge_warnings = [](const nlohmann::json& report) {
+    std::vector<std::string> found;
+    for (const auto& w : report["warnings"]) {
+      if (w.get<std::string>().find("hulls.max_bloat") != std::string::npos)
+        found.push_back(w.get<std::string>());
+    }
+    return found;
+  };
+  BakeConfig config;
+  config.maps_enabled = false;
+  config.max_bloat = 0.001f;
+  BakeResult tight;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &tight).ok());
+  std::vector<std::string> expected;  // "hull 'chest' up to ", ...
+  for (const auto& c : tight.report["hulls"]["colliders"]) {
+    if (c["bloat_max_mm"].get<double>() > 1.0)
+      expected.push_back("hull '" + c["bone"].get<std::string>() + "' up to ");
+  }
+  for (const auto& c : tight.report["joint_spheres"]) {
+    if (c["bloat_max_mm"].get<double>() > 1.0)
+      expected.push_back("joint sphere '" + c["joint"].get<std::string>() + "' up to ");
+  }
+  ASSERT_FALSE(expected.empty());
+  const std::vector<std::string> found = bulge_warnings(tight.report);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].rfind(std::to_string(expected.size()) + " collider", 0), 0u) << found[0];
+  for (const std::string& name : expected)
+    EXPECT_NE(found[0].find(name), std::string::npos) << name;
+  config.max_bloat = 1.f;
+  BakeResult loose;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &loose).ok());
+  EXPECT_TRUE(bulge_warnings(loose.report).empty());
+  EXPECT_EQ(loose.report["fit"]["bloat_max_mm"], tight.report["fit"]["bloat_max_mm"])
+      << "the limit changes the warning, not the measure";
 }
 
 }  // namespace

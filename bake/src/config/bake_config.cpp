@@ -123,6 +123,10 @@ const JsonSchema<BakeConfig>& HullsSection() {
           .Float("max_growth", "m", Closed(0, 1),
                  "no collider vertex ends farther than this beyond the inflated hull",
                  [](BakeConfig& c) -> float& { return c.hull.max_growth; })
+          .Float("max_bloat", "m", OpenBelow(0, 1),
+                 "a warning names every hull and joint sphere whose surface reaches farther than "
+                 "this outside the body, beyond its delta (the report's \"fit\")",
+                 [](BakeConfig& c) -> float& { return c.max_bloat; })
           .Enum<ObbMode>(
               "obb",
               {{"covariance", ObbMode::kCovariance}, {"cgal_optimal", ObbMode::kCgalOptimal}},

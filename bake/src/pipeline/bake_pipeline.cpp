@@ -16,7 +16,6 @@
 #include "drape/bake/importer.h"
 #include "drape/bake/kirkpatrick_builder.h"
 #include "drape/bake/map_table_builder.h"
-#include "drape/bake/mesh_queries.h"
 #include "drape/bake/regions.h"
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
@@ -24,6 +23,8 @@
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
+#include "fit/collider_fit.h"
+#include "fit/fit_report.h"
 
 namespace drape::bake {
 namespace {
@@ -33,17 +34,6 @@ using nlohmann::json;
 
 double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-// One-sided distance from the collider surface (its vertices, in the asset frame) to the mesh:
-// how far the proxy stands off the body it approximates. Brute force; characters are small.
-double MaxDistanceToMesh(const std::vector<Float3>& points, const ExactMesh& mesh) {
-  double worst = 0;
-  for (const Float3& q : points) {
-    const double p[3] = {q.x, q.y, q.z};
-    worst = std::max(worst, mesh.Distance(p));
-  }
-  return worst;
 }
 
 size_t HullBytes(const HullColliderData& h) {
@@ -208,8 +198,7 @@ std::string LeaveToJointSphere(const SkeletonData& skeleton, uint32_t j, Regions
   return where;
 }
 
-json HullReport(const std::string& bone, const Regions& regions, uint32_t j, const BoneHull& b,
-                double stand_off) {
+json HullReport(const std::string& bone, const Regions& regions, uint32_t j, const BoneHull& b) {
   const HullStats& st = b.stats;
   const KirkpatrickStats& kirkpatrick = b.kirkpatrick;
   const MapTableStats& table = b.table;
@@ -223,7 +212,6 @@ json HullReport(const std::string& bone, const Regions& regions, uint32_t j, con
           {"planes_after", st.planes_after},
           {"budget_reached", st.budget_reached},
           {"growth_mm", st.growth_mm},
-          {"distance_to_mesh_mm", stand_off * 1000.0},
           {"kirkpatrick",
            {{"axis", kirkpatrick.axis_index},
             {"upper_nodes", kirkpatrick.upper.nodes},
@@ -256,7 +244,6 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
   const SkeletonData& skeleton = character.skeleton;
   const uint32_t joints = skeleton.joint_count();
   const std::vector<std::vector<Float3>> points = ColliderPoints(regions, joints);
-  const ExactMesh rest_mesh(regions.rest_positions, character.mesh.triangles);
   std::vector<BoneHull> built = BuildBoneHulls(config, points);
   json colliders = json::array();
   json left_out = json::array();
@@ -280,11 +267,7 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
       continue;
     }
     hull.bind_frame = Multiply(rest_to_bind, regions.collider_frames[j]);
-    std::vector<Float3> world;
-    for (const Float3& v : hull.vertices)
-      world.push_back(TransformPoint(regions.collider_frames[j], v));
-    const double stand_off = MaxDistanceToMesh(world, rest_mesh);
-    colliders.push_back(HullReport(bone, regions, j, built[j], stand_off));
+    colliders.push_back(HullReport(bone, regions, j, built[j]));
     asset->hulls.push_back(std::move(hull));
   }
   (*report)["colliders"] = colliders;
@@ -410,6 +393,47 @@ void BakeSpheres(const BakeConfig& config, const Regions& regions, Character& ch
   (*report)["joint_spheres"] = spheres;
 }
 
+// The proxies' fit to the rest-pose body (fit/collider_fit.h): each collider's bloat on its
+// report entry (report["hulls"]["colliders"] and report["joint_spheres"] list the colliders in
+// the asset's order), the whole in report["fit"], and the warnings of fit/fit_report.h.
+ColliderFit ReportFit(const BakeConfig& config, const Regions& regions, const CharacterAsset& asset,
+                      json* report, std::vector<std::string>* warnings) {
+  ColliderFitOptions options;
+  options.hull_delta = config.hull.delta;
+  options.sphere_delta = config.sphere_delta;
+  const ColliderFit fit =
+      MeasureColliderFit(regions.rest_positions, asset.mesh.triangles, asset.hulls,
+                         asset.joint_spheres, regions.rest_skinning, options);
+  std::vector<std::string> hull_names, sphere_names;
+  for (const HullColliderData& h : asset.hulls)
+    hull_names.push_back(asset.skeleton.joint_names[h.joint]);
+  for (const JointSphereData& s : asset.joint_spheres)
+    sphere_names.push_back(asset.skeleton.joint_names[s.joint]);
+  if (report->contains("hulls")) {
+    json& entries = (*report)["hulls"]["colliders"];
+    for (size_t h = 0; h < fit.hulls.size() && h < entries.size(); ++h)
+      AddBloatToReport(fit.hulls[h], &entries[h]);
+  }
+  if (report->contains("joint_spheres")) {
+    json& entries = (*report)["joint_spheres"];
+    for (size_t s = 0; s < fit.spheres.size() && s < entries.size(); ++s)
+      AddBloatToReport(fit.spheres[s], &entries[s]);
+  }
+  (*report)["fit"] = FitToJson(fit, options, config.max_bloat);
+  for (std::string& w : FitWarnings(fit, options, hull_names, sphere_names, config.max_bloat))
+    warnings->push_back(std::move(w));
+  return fit;
+}
+
+// The preview's colours: each collider's bloat max, red at hulls.max_bloat.
+PreviewBloat PreviewBloatOf(const ColliderFit& fit, float max_bloat) {
+  PreviewBloat bloat;
+  for (const ColliderBloat& b : fit.hulls) bloat.hull_mm.push_back(b.max_mm);
+  for (const ColliderBloat& b : fit.spheres) bloat.sphere_mm.push_back(b.max_mm);
+  bloat.red_mm = 1000.0 * max_bloat;
+  return bloat;
+}
+
 // What the scene's garment can reach; the rest is left out of the asset and the report says so.
 Status ApplySceneReach(const Scene& scene, CharacterAsset* asset, json* report) {
   SceneReach reach;
@@ -494,11 +518,17 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     BakeSpheres(config, regions, character, &asset, &report);
     timings["spheres_ms"] = MillisecondsSince(start);
   }
-  if (!preview_dir.empty() && (config.hulls_enabled || config.spheres_enabled)) {
-    if (Status s =
-            WriteColliderPreview(asset, regions.rest_positions, regions.rest_skinning, preview_dir);
-        !s.ok()) {
-      return failed(s);
+  if (config.hulls_enabled || config.spheres_enabled) {
+    start = Clock::now();
+    const ColliderFit fit = ReportFit(config, regions, asset, &report, &character.warnings);
+    timings["fit_ms"] = MillisecondsSince(start);
+    if (!preview_dir.empty()) {
+      const PreviewBloat bloat = PreviewBloatOf(fit, config.max_bloat);
+      if (Status s = WriteColliderPreview(asset, regions.rest_positions, regions.rest_skinning,
+                                          preview_dir, 800, &bloat);
+          !s.ok()) {
+        return failed(s);
+      }
     }
   }
   if (scene != nullptr) {

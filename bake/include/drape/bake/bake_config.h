@@ -47,6 +47,9 @@ struct BakeConfig {
   // rigid-only hulls, at the rest pose and posed (docs/ALGORITHMS.md §2.1).
   float shape_threshold = 0.51f;
   HullOptions hull;
+  // Metres, > 0: the report warns about every hull or joint sphere whose surface reaches farther
+  // than this outside the body beyond its delta (the fit, measured against the exact mesh).
+  float max_bloat = 0.015f;
   KirkpatrickOptions kirkpatrick;
   MapTableOptions map_table;
 
