@@ -1,7 +1,10 @@
 // drape-bake INPUT -o OUT.drape [--config FILE.json] [--scene SCENE.json] [--report REPORT.json]
-//            [--preview DIR]
+//            [--preview DIR] [--strict]
 // drape-bake --dump-config
 // On any error: one line on stderr naming the input and the reason, exit code 1, no output file.
+// Warnings (what was assumed or repaired, colliders that fit the body badly) go to stderr, one
+// line each, and into the report; with --strict any warning is an error: the line names the
+// input, how many warnings there were and the first, and nothing is written.
 
 #include <unistd.h>
 #include <CLI/CLI.hpp>
@@ -27,13 +30,14 @@ int main(int argc, char** argv) {
   CLI::App app{
       "drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
   std::string input, output, config_path, scene_path, report_path, preview_dir;
-  bool dump_config = false, list_formats = false;
+  bool dump_config = false, list_formats = false, strict = false;
   app.add_option("INPUT", input, "character file (anything assimp reads)");
   app.add_option("-o,--output", output, "the .drape file to write");
   app.add_option("--config", config_path, "JSON bake parameters (see --dump-config)");
   app.add_option("--scene", scene_path, "JSON scene: bake only what it needs");
   app.add_option("--report", report_path, "JSON report of the bake");
   app.add_option("--preview", preview_dir, "directory for preview pictures");
+  app.add_flag("--strict", strict, "fail the bake on any warning (for pipelines)");
   app.add_flag("--dump-config", dump_config, "print every parameter with default, unit and range");
   app.add_flag("--formats", list_formats, "print the file extensions the bake reads, one a line");
   try {
@@ -79,6 +83,12 @@ int main(int argc, char** argv) {
       !s.ok()) {
     return Fail(s.message());
   }
+  const nlohmann::json& warnings = result.report["warnings"];
+  if (strict && !warnings.empty()) {
+    return Fail(input + ": --strict: " + std::to_string(warnings.size()) +
+                (warnings.size() == 1 ? " warning: " : " warnings, the first: ") +
+                warnings[0].get<std::string>());
+  }
 
   std::vector<uint8_t> bytes;
   if (drape::Status s = drape::EncodeAsset(result.asset, &bytes); !s.ok())
@@ -99,7 +109,7 @@ int main(int argc, char** argv) {
     return Fail(s.message());
   }
   // What was assumed or repaired, one line each (also the report's "warnings").
-  for (const auto& warning : result.report["warnings"])
+  for (const auto& warning : warnings)
     std::fprintf(stderr, "drape-bake: warning: %s: %s\n", input.c_str(),
                  warning.get<std::string>().c_str());
   return 0;

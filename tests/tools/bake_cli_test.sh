@@ -81,6 +81,9 @@ NAMED="$WORK/unknown_key.json" expect_error bad_config_key "$MANNEQUIN" "no_such
 echo '{"maps": {"clip": "wlak"}}' >"$WORK/bad_clip.json"
 NAMED="$WORK/bad_clip.json" expect_error bad_maps_clip "$MANNEQUIN" \
   "bad_clip.json: /maps/clip: no clip named 'wlak' in '.*mannequin.gltf' \(clips: walk" --config "$WORK/bad_clip.json"
+# --strict: a bake with warnings fails like any error (the mannequin's report always has one: the
+# frame it was read in), naming the count and the first warning.
+expect_error strict "$MANNEQUIN" "--strict: [0-9]+ warnings?(, the first)?: [a-z]" --strict
 # What assimp drops without a word is counted: an OBJ with a two-corner face and empty f lines
 # bakes, and says so on stderr and in the report.
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 2\nf\nf 2 4 3\nf 1 4 2\nf  \n' >"$WORK/sloppy.obj"
@@ -141,7 +144,7 @@ OBJ
       fail "engine_sample on an asset without a clip: '$(cat "$WORK/engine.err")'"
     fi
   fi
-  for field in source_to_asset unit_scale up_axis joint_count clips warnings timings tool_version format_version; do
+  for field in source_to_asset unit_scale up_axis joint_count clips warnings timings tool_version format_version fit bloat_max_mm; do
     if grep -q "\"$field\"" "$WORK/mannequin.json"; then passed=$((passed + 1)); else fail "report lacks $field"; fi
   done
   # A corrupt .drape is refused by drape-inspect with the file named.
