@@ -1,5 +1,6 @@
 // One particle against every collider its segment may reach: Gauss-Seidel passes, deepest
-// contact first, with the contact planes of earlier responses re-imposed (docs/ALGORITHMS.md §8.6).
+// contact first, with the contact planes of earlier responses re-imposed, every response within
+// the particle's motion plus depth, and the best iterate kept (docs/ALGORITHMS.md §8.6).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -168,7 +169,59 @@ class ContactPlanes {
   uint32_t count_ = 0;
 };
 
+// Squared distance in double: the budget test must hold for coordinates up to float's range.
+double DistanceSquared(Float3 a, Float3 b) {
+  const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
+  return dx * dx + dy * dy + dz * dz;
+}
+
+// How bad an iterate is, from the contacts of the segment previous -> iterate: first the number
+// of colliders the segment passes through and ends outside (the particle tunnelled), then the
+// deepest the iterate lies inside one. Lower is better; ties go to the later iterate.
+struct IterateScore {
+  uint32_t crossings = 0;
+  float depth = 0.f;  // metres
+  bool operator<=(const IterateScore& o) const {
+    return depth < o.depth || (depth == o.depth && crossings <= o.crossings);
+  }
+};
+
 }  // namespace
+
+template <bool kActive>
+uint32_t HullColliderSet::ParticleContacts(Float3 p0, Float3 p1, float s0, float s1,
+                                           const uint32_t* first_candidates, uint32_t skip,
+                                           ContactFrames* out) const {
+  uint32_t count = 0;
+  if (first_candidates != nullptr) {
+    for (uint32_t mask = *first_candidates; mask != 0; mask &= mask - 1)
+      out->candidates[count++] = static_cast<uint32_t>(__builtin_ctz(mask));
+  } else {
+    count = BroadPhase(p0, p1, s0, s1, kActive, out->candidates);
+  }
+  out->count = count;
+  out->hits = 0;
+  for (uint32_t i = 0; i < count; ++i) {
+    if constexpr (kActive) {
+      out->frames[i] = &active_[out->candidates[i]];
+    } else {
+      ActiveFrames* f = new (out->storage + i * sizeof(ActiveFrames)) ActiveFrames;
+      ComputeFrames(out->candidates[i], s0, s1, f);
+      out->frames[i] = f;
+    }
+  }
+  ContactQuery* contacts = out->contacts();
+  for (uint32_t i = 0; i < count; ++i) {
+    // The collider resolved alone in the previous pass left the particle on or outside it.
+    if (out->candidates[i] == skip) {
+      new (&contacts[i]) ContactQuery();
+      continue;
+    }
+    new (&contacts[i]) ContactQuery(ColliderContact(out->candidates[i], *out->frames[i], p0, p1));
+    if (contacts[i].contact) out->order[out->hits++] = i;
+  }
+  return count;
+}
 
 template <bool kActive>
 void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, uint8_t* flags,
@@ -178,49 +231,55 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
   Float3 position = *p1, vel = *velocity;
   uint32_t last_single = UINT32_MAX;  // the one collider resolved in the previous pass, if so
   ContactPlanes planes;
+  // No response may leave the particle farther from where it started the step than its motion
+  // relative to the colliders plus the depth it ends at inside them (and the separation): set
+  // from the first pass's contacts. An entry response keeps the particle within its motion of
+  // p0 (projecting the end onto an entry plane shortens the segment), a push-out moves it by the
+  // depth; inside overlapping colliders the nearest exit of their union can be deeper than any
+  // one of them (HullColliderSet::kUnionDepthFactor). Contact planes of two colliders that meet
+  // far from the body would break it: that response is undone. A response beyond it (contact planes
+  // of two colliders meeting far from the body) is undone.
+  double budget_squared = 0.0;
+  // The best iterate so far (Gauss-Seidel passes can make a pinched particle worse).
+  Float3 best_position = position, best_velocity = vel;
+  uint8_t best_flags = result;
+  IterateScore best_score{UINT32_MAX, 0.f};
+  ContactFrames pass_contacts;
+  const auto score_of = [&](const ContactFrames& c) {
+    IterateScore score;
+    const ContactQuery* contacts = c.contacts();
+    for (uint32_t h = 0; h < c.hits; ++h) {
+      const ContactQuery& q = contacts[c.order[h]];
+      score.crossings += q.inside_end ? 0u : 1u;
+      score.depth = std::max(score.depth, q.depth);
+    }
+    return score;
+  };
+  const auto keep_if_best = [&](IterateScore score) {
+    if (score <= best_score) {
+      best_score = score;
+      best_position = position;
+      best_velocity = vel;
+      best_flags = result;
+    }
+  };
+  bool converged = false;
   for (uint32_t pass = 0; pass < options_.gauss_seidel_passes; ++pass) {
     // Candidates for the current segment: a response may have moved the particle towards a
     // collider the original segment did not reach.
-    uint32_t candidates[kMaxCandidates];
-    uint32_t count = 0;
-    if (pass == 0 && first_candidates != nullptr) {
-      for (uint32_t mask = *first_candidates; mask != 0; mask &= mask - 1)
-        candidates[count++] = static_cast<uint32_t>(__builtin_ctz(mask));
-    } else {
-      count = BroadPhase(p0, position, s0, s1, kActive, candidates);
-    }
-    if (count == 0) break;
+    const uint32_t count = ParticleContacts<kActive>(
+        p0, position, s0, s1, pass == 0 ? first_candidates : nullptr, last_single, &pass_contacts);
     // Only the collider just resolved: its response left the particle on or outside it.
-    if (pass > 0 && count == 1 && candidates[0] == last_single) break;
-    // Transforms: the cached ones, or (other fractions) computed into raw stack storage so the
-    // common path does not pay for constructing them.
-    const ActiveFrames* frames[kMaxCandidates];
-    alignas(
-        ActiveFrames) unsigned char storage[kActive ? 1 : kMaxCandidates * sizeof(ActiveFrames)];
-    for (uint32_t i = 0; i < count; ++i) {
-      if constexpr (kActive) {
-        frames[i] = &active_[candidates[i]];
-      } else {
-        ActiveFrames* f = new (storage + i * sizeof(ActiveFrames)) ActiveFrames;
-        ComputeFrames(candidates[i], s0, s1, f);
-        frames[i] = f;
-      }
+    const bool only_last = pass > 0 && count == 1 && pass_contacts.candidates[0] == last_single;
+    const uint32_t hits = only_last ? 0 : pass_contacts.hits;
+    keep_if_best(only_last ? IterateScore{} : score_of(pass_contacts));
+    if (hits == 0) {
+      converged = true;
+      break;
     }
-    // Raw storage again: only the first `count` are constructed.
-    alignas(ContactQuery) unsigned char contact_storage[kMaxCandidates * sizeof(ContactQuery)];
-    ContactQuery* contacts = reinterpret_cast<ContactQuery*>(contact_storage);
-    uint32_t order[kMaxCandidates];
-    uint32_t hits = 0;
-    for (uint32_t i = 0; i < count; ++i) {
-      // The collider resolved alone in the previous pass left the particle on or outside it.
-      if (candidates[i] == last_single) {
-        new (&contacts[i]) ContactQuery();
-        continue;
-      }
-      new (&contacts[i]) ContactQuery(ColliderContact(candidates[i], *frames[i], p0, position));
-      if (contacts[i].contact) order[hits++] = i;
-    }
-    if (hits == 0) break;
+    const ContactQuery* contacts = pass_contacts.contacts();
+    uint32_t* order = pass_contacts.order;
+    if (pass == 0) budget_squared = Budget(p0, position, pass_contacts, params.separation);
     // Deepest first; ties keep collider order (insertion sort is stable).
     for (uint32_t i = 1; i < hits; ++i) {
       const uint32_t key = order[i];
@@ -233,19 +292,64 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
     }
     for (uint32_t rank = 0; rank < hits; ++rank) {
       const uint32_t i = order[rank];
-      const ContactQuery c =
-          rank == 0 ? contacts[i] : ColliderContact(candidates[i], *frames[i], p0, position);
+      const ContactQuery c = rank == 0 ? contacts[i]
+                                       : ColliderContact(pass_contacts.candidates[i],
+                                                         *pass_contacts.frames[i], p0, position);
       if (!c.contact) continue;
+      const Float3 before_position = position, before_velocity = vel;
+      const ContactPlanes before_planes = planes;
       ApplyResponse(c, params, &position, &vel);
-      result |= static_cast<uint8_t>(kCollisionContact | c.flags);
+      const Float3 responded = position;
       planes.Add(c.normal, Dot(c.normal, c.point) + params.separation);
       if (planes.count() > 1) planes.Enforce(&position);
+      // Beyond the budget: this response alone (the contact planes meet too far away), else
+      // none (the passes go on from the last iterate within it).
+      if (DistanceSquared(position, p0) > budget_squared) position = responded;
+      if (DistanceSquared(position, p0) > budget_squared) {
+        position = before_position;
+        vel = before_velocity;
+        planes = before_planes;
+        continue;
+      }
+      result |= static_cast<uint8_t>(kCollisionContact | c.flags);
     }
-    last_single = hits == 1 ? candidates[order[0]] : UINT32_MAX;
+    last_single = hits == 1 ? pass_contacts.candidates[order[0]] : UINT32_MAX;
+  }
+  if (!converged) {
+    // Every pass was used: score the last iterate too, then keep the best.
+    ParticleContacts<kActive>(p0, position, s0, s1, nullptr, last_single, &pass_contacts);
+    keep_if_best(score_of(pass_contacts));
+    position = best_position;
+    vel = best_velocity;
+    result = best_flags;
   }
   *p1 = position;
   *velocity = vel;
   *flags = result;
+}
+
+double HullColliderSet::Budget(Float3 p0, Float3 p1, const ContactFrames& c, float separation) {
+  // Per collider hit, in its frame: an entry response leaves the particle within its motion
+  // relative to the collider (the chord) of where p0 sits on the collider at the end of the
+  // substep, which the collider carried away from p0 (a bone turning into a particle at rest
+  // pushes it as far as its surface travels). Responses to several moving colliders compose:
+  // their carries add up.
+  double chord = std::sqrt(DistanceSquared(p0, p1)), carry = 0.0, depth = 0.0;
+  const ContactQuery* contacts = c.contacts();
+  for (uint32_t h = 0; h < c.hits; ++h) {
+    const uint32_t i = c.order[h];
+    const Float3 a = TransformPoint(c.frames[i]->to_local_start, p0);
+    const Float3 b = TransformPoint(c.frames[i]->to_local_end, p1);
+    const Float3 carried = TransformPoint(c.frames[i]->to_world_end, a);
+    chord = std::max(chord, std::sqrt(DistanceSquared(a, b)));
+    carry += std::sqrt(DistanceSquared(carried, p0));
+    depth += contacts[i].depth;
+  }
+  // Rounding of the float response: relative to the coordinates' size.
+  const double scale =
+      std::max({std::fabs(double(p1.x)), std::fabs(double(p1.y)), std::fabs(double(p1.z)), 1.0});
+  const double budget = chord + carry + kUnionDepthFactor * depth + separation + 1e-6 * scale;
+  return budget * budget;
 }
 
 template void HullColliderSet::ResolveParticle<true>(Float3, Float3*, Float3*, uint8_t*,
@@ -254,5 +358,11 @@ template void HullColliderSet::ResolveParticle<true>(Float3, Float3*, Float3*, u
 template void HullColliderSet::ResolveParticle<false>(Float3, Float3*, Float3*, uint8_t*,
                                                       const ResponseParams&, float, float,
                                                       const uint32_t*) const;
+template uint32_t HullColliderSet::ParticleContacts<true>(Float3, Float3, float, float,
+                                                          const uint32_t*, uint32_t,
+                                                          ContactFrames*) const;
+template uint32_t HullColliderSet::ParticleContacts<false>(Float3, Float3, float, float,
+                                                           const uint32_t*, uint32_t,
+                                                           ContactFrames*) const;
 
 }  // namespace drape

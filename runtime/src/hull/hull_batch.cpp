@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 #include "drape/runtime/hull_collider_set.h"
 #include "hull/plane_kernels.h"
@@ -124,10 +125,8 @@ ContactQuery HullColliderSet::Query(Float3 p0, Float3 p1, uint8_t kinds) const {
   }
   bool inside = false;
   float depth = 0.f;
-  const uint32_t hull_total = static_cast<uint32_t>(hulls_.size());
   for (uint32_t k = 0; k < motions_.size(); ++k) {
-    const bool is_hull = k < hull_total;
-    if (!(kinds & (is_hull ? kColliderHulls : kColliderSpheres))) continue;
+    if (!HasKind(k, kinds)) continue;
     const ContactQuery c = ColliderContact(k, active_[k], p0, p1);
     inside = inside || c.inside_end;
     depth = std::max(depth, c.depth);
@@ -136,9 +135,67 @@ ContactQuery HullColliderSet::Query(Float3 p0, Float3 p1, uint8_t kinds) const {
         !best.contact || c.depth > best.depth || (c.depth == best.depth && c.t < best.t);
     if (better) best = c;
   }
+  // Inside overlapping colliders, the deepest one's exit may lie inside another (out through the
+  // far side of a large joint sphere, into the torso hull): take the nearest exit of their union.
+  if (best.contact && inside && InsideAny(ExitProbe(best), kinds)) {
+    UnionExit(p0, p1, kinds, &best);
+  }
   best.inside_end = inside;
   best.depth = depth;
   return best;
+}
+
+bool HullColliderSet::HasKind(uint32_t collider, uint8_t kinds) const {
+  const bool is_hull = collider < hulls_.size();
+  return (kinds & (is_hull ? kColliderHulls : kColliderSpheres)) != 0;
+}
+
+Float3 HullColliderSet::ExitProbe(const ContactQuery& c) {
+  // Just off the surface the response puts the particle on (ResponseParams' default separation).
+  return c.point + c.normal * 1e-4f;
+}
+
+bool HullColliderSet::InsideAny(Float3 x, uint8_t kinds) const {
+  for (uint32_t k = 0; k < motions_.size(); ++k) {
+    if (HasKind(k, kinds) && ColliderContact(k, active_[k], x, x).inside_end) return true;
+  }
+  return false;
+}
+
+void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuery* best) const {
+  // Candidates: the exit of every collider the end is inside, followed out of whatever other
+  // collider it lands in (at most three hops). The one nearest p1 that is outside all of them
+  // and within the particle's reach (its motion plus kUnionDepthFactor times the sum of its
+  // depths, from p0: the bound every response keeps) wins. None: the deepest contact stays.
+  double reach = std::sqrt(double(Dot(p1 - p0, p1 - p0)));
+  for (uint32_t k = 0; k < motions_.size(); ++k) {
+    if (HasKind(k, kinds))
+      reach += kUnionDepthFactor * ColliderContact(k, active_[k], p1, p1).depth;
+  }
+  double nearest = std::numeric_limits<double>::infinity();
+  for (uint32_t k = 0; k < motions_.size(); ++k) {
+    if (!HasKind(k, kinds)) continue;
+    ContactQuery c = ColliderContact(k, active_[k], p1, p1);
+    if (!c.inside_end) continue;
+    for (int hop = 0; hop < 4 && c.contact; ++hop) {
+      const double distance = std::sqrt(double(Dot(c.point - p1, c.point - p1)));
+      if (!(distance < nearest) || std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) {
+        break;
+      }
+      const Float3 probe = ExitProbe(c);
+      uint32_t holder = UINT32_MAX;
+      for (uint32_t m = 0; m < motions_.size() && holder == UINT32_MAX; ++m) {
+        if (HasKind(m, kinds) && ColliderContact(m, active_[m], probe, probe).inside_end)
+          holder = m;
+      }
+      if (holder == UINT32_MAX) {
+        nearest = distance;
+        *best = c;
+        break;
+      }
+      c = ColliderContact(holder, active_[holder], probe, probe);
+    }
+  }
 }
 
 }  // namespace drape

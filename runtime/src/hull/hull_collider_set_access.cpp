@@ -23,6 +23,14 @@ int32_t HullColliderSetAccess::LocateLocal(const HullColliderSet& set, uint32_t 
                                          ProjectHullUv(p, h.uv_origin, h.uv_u, h.uv_v), steps)];
 }
 
+double HullColliderSetAccess::DepthSum(const HullColliderSet& set, Float3 p) {
+  double sum = 0.0;
+  for (uint32_t k = 0; k < set.motions_.size(); ++k) {
+    sum += set.ColliderContact(k, set.active_[k], p, p).depth;
+  }
+  return sum;
+}
+
 ContactQuery HullColliderSetAccess::QueryHullLocal(const HullColliderSet& set, uint32_t hull,
                                                    Float3 a, Float3 b) {
   if (!IsFinite(a) || !IsFinite(b)) {

@@ -27,6 +27,9 @@ struct HullColliderSetAccess {
   }
   // The whole narrow phase of the collider-frame segment a -> b with the set's options.
   static ContactQuery QueryHullLocal(const HullColliderSet& set, uint32_t hull, Float3 a, Float3 b);
+  // The sum over all colliders of the depth of world point p inside them (selected substep): the
+  // bound a response inside overlapping colliders stays within, beside the motion.
+  static double DepthSum(const HullColliderSet& set, Float3 p);
   // The map-table response ray through p: false when it finds no listed triangle.
   static bool MapTableRayLocal(const HullColliderSet& set, uint32_t hull, Float3 p, Float3* point,
                                Float3* normal);

@@ -107,6 +107,13 @@ class HullColliderSet {
   // same bits, several times slower). A solver calls it once per substep.
   Status SelectSubstep(float s0, float s1);
 
+  // The response bound: no response leaves a particle farther from previous[i] than its motion
+  // relative to the colliders plus kUnionDepthFactor times the sum of the depths of the end in
+  // them (plus the separation). Inside two overlapping colliders the nearest exit of their union
+  // is their crease, within twice the sum of the depths when the faces meet at 60 degrees or
+  // more; in a narrower pinch the particle stays rather than be thrown along it.
+  static constexpr double kUnionDepthFactor = 2.0;
+
   // Collides particles moving previous[i] -> positions[i] over the fractions [substep_start,
   // substep_end] of the step and applies the response (collision_types.h) to positions[i] and
   // velocities[i] in place. flags[i] is always written (CollisionFlags); a non-finite input is
@@ -118,7 +125,10 @@ class HullColliderSet {
                       float substep_end = 1.f, uint32_t* contact_count = nullptr) const;
 
   // One segment p0 -> p1 over the selected substep, no response: among the colliders in `kinds`,
-  // the deepest contact, else the earliest entry; inside_end when p1 is inside any of them.
+  // the deepest contact, else the earliest entry; inside_end when p1 is inside any of them, depth
+  // the deepest. Inside overlapping colliders, the contact is the nearest exit of their union
+  // (within the motion plus the sum of the depths) when the deepest one's exit lies inside
+  // another.
   ContactQuery Query(Float3 p0, Float3 p1, uint8_t kinds = kColliderAll) const;
 
   // Posed at fraction s of the step: a hull's collider frame -> world (rigid), a sphere's centre.
@@ -202,6 +212,35 @@ class HullColliderSet {
   // At most this many colliders are resolved per particle (the lowest indices).
   static constexpr uint32_t kMaxCandidates = 32;
   uint32_t BroadPhase(Float3 p0, Float3 p1, float s0, float s1, bool active, uint32_t* out) const;
+  // One particle's candidates, their transforms and contacts, on the stack (raw storage: only
+  // the first `count` are constructed, so the common path does not pay for the rest).
+  struct ContactFrames {
+    uint32_t candidates[kMaxCandidates];
+    uint32_t order[kMaxCandidates];  // indices of the contacts that hit, `hits` of them
+    uint32_t count = 0, hits = 0;
+    const ActiveFrames* frames[kMaxCandidates];
+    alignas(ActiveFrames) unsigned char storage[kMaxCandidates * sizeof(ActiveFrames)];
+    alignas(ContactQuery) unsigned char contact_storage[kMaxCandidates * sizeof(ContactQuery)];
+    ContactQuery* contacts() { return reinterpret_cast<ContactQuery*>(contact_storage); }
+    const ContactQuery* contacts() const {
+      return reinterpret_cast<const ContactQuery*>(contact_storage);
+    }
+  };
+  // Candidates (the first-pass mask, or the broad phase of p0 -> p1) and their contacts; the
+  // collider `skip` counts as no contact. Returns the candidate count.
+  template <bool kActive>
+  uint32_t ParticleContacts(Float3 p0, Float3 p1, float s0, float s1,
+                            const uint32_t* first_candidates, uint32_t skip,
+                            ContactFrames* out) const;
+  // The squared distance from p0 a response may leave the particle at (kUnionDepthFactor).
+  static double Budget(Float3 p0, Float3 p1, const ContactFrames& contacts, float separation);
+  // Query's helpers: whether collider k is of a kind in `kinds`; the point just outside the
+  // surface a contact resolves to; whether x is inside any collider of `kinds`; the nearest exit
+  // of the union of the colliders p1 is inside (replaces *best when one is found).
+  bool HasKind(uint32_t collider, uint8_t kinds) const;
+  static Float3 ExitProbe(const ContactQuery& c);
+  bool InsideAny(Float3 x, uint8_t kinds) const;
+  void UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuery* best) const;
   // kActive: the fractions are the selected substep's. first_candidates: the first pass's broad
   // phase already done, as a bit mask (at most 32 colliders).
   template <bool kActive>
