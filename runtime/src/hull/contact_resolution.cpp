@@ -242,7 +242,6 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
   double budget_squared = 0.0;
   // The best iterate so far (Gauss-Seidel passes can make a pinched particle worse).
   Float3 best_position = position, best_velocity = vel;
-  uint8_t best_flags = result;
   IterateScore best_score{UINT32_MAX, 0.f};
   ContactFrames pass_contacts;
   const auto score_of = [&](const ContactFrames& c) {
@@ -260,7 +259,6 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
       best_score = score;
       best_position = position;
       best_velocity = vel;
-      best_flags = result;
     }
   };
   bool converged = false;
@@ -296,6 +294,8 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
                                        : ColliderContact(pass_contacts.candidates[i],
                                                          *pass_contacts.frames[i], p0, position);
       if (!c.contact) continue;
+      // Flags say what was found, whether or not the response below stays within the budget.
+      result |= static_cast<uint8_t>(kCollisionContact | c.flags);
       const Float3 before_position = position, before_velocity = vel;
       const ContactPlanes before_planes = planes;
       ApplyResponse(c, params, &position, &vel);
@@ -309,9 +309,7 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
         position = before_position;
         vel = before_velocity;
         planes = before_planes;
-        continue;
       }
-      result |= static_cast<uint8_t>(kCollisionContact | c.flags);
     }
     last_single = hits == 1 ? pass_contacts.candidates[order[0]] : UINT32_MAX;
   }
@@ -321,7 +319,6 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
     keep_if_best(score_of(pass_contacts));
     position = best_position;
     vel = best_velocity;
-    result = best_flags;
   }
   *p1 = position;
   *velocity = vel;
