@@ -138,7 +138,15 @@ std::vector<HullBake> HullBakes(const bake::ImportOptions& import, bool quick) {
     c.maps_enabled = false;
     return c;
   };
-  bakes.push_back({"default (100 tris, delta 5 mm, shape threshold 0.51)", base()});
+  bakes.push_back({"default (100 tris, delta 5 mm, convex pieces, surface spheres)", base()});
+  {
+    // The previous default: one hull per bone shaped at 0.51, paper B's spheres.
+    bake::BakeConfig c = base();
+    c.shape_threshold = 0.51f;
+    c.hull_max_pieces = 1;
+    c.sphere_cover = bake::SphereCover::kFlexible;
+    bakes.push_back({"one hull per bone, shape threshold 0.51, paper B's spheres", c});
+  }
   const std::vector<uint32_t> budgets =
       quick ? std::vector<uint32_t>{32} : std::vector<uint32_t>{16, 32, 64, 200, 400};
   for (uint32_t b : budgets) {
@@ -176,8 +184,8 @@ std::vector<HullBake> HullBakes(const bake::ImportOptions& import, bool quick) {
     c.rigid_threshold = tau;
     bakes.push_back({"rigid threshold " + std::to_string(tau).substr(0, 3), c});
   }
-  // The default lets flexible vertices shape the hull of their heaviest bone too (shape
-  // threshold 0.51); paper B shapes hulls from the rigid vertices only (1), 0.7 is in between.
+  // The default lets every triangle shape the hull of the bone that carries most of it (shape
+  // threshold 0); paper B shapes hulls from the rigid vertices only (1), 0.7 is in between.
   for (float shape : {0.7f, 1.f}) {
     bake::BakeConfig c = base();
     c.shape_threshold = shape;

@@ -35,7 +35,8 @@ TEST(BakeConfig, OutOfRangeAndUnknownKeysNameTheirPath) {
   s = ApplyBakeConfig({{"maps", {{"renderer", "vulkan"}}}}, "c.json", &config);
   EXPECT_EQ(s.message(), "c.json: /maps/renderer: 'vulkan' is not one of cpu | osmesa");
   s = ApplyBakeConfig({{"spheres", {{"cover", "all"}}}}, "c.json", &config);
-  EXPECT_EQ(s.message(), "c.json: /spheres/cover: 'all' is not one of flexible | left_by_hulls");
+  EXPECT_EQ(s.message(),
+            "c.json: /spheres/cover: 'all' is not one of flexible | left_by_hulls | surface");
   s = ApplyBakeConfig({{"maps", {{"enabled", "yes"}}}}, "c.json", &config);
   EXPECT_EQ(s.message(), "c.json: /maps/enabled: must be true or false, not a string");
   // An unknown key names the keys known where it stands, and the nearest of them.

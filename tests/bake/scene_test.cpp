@@ -405,13 +405,18 @@ TEST_F(SceneTest, SkirtReachKeepsHipsAndDropsHeadAndWrists) {
   ASSERT_EQ(reach.hulls.size(), asset().hulls.size());
   ASSERT_EQ(reach.spheres.size(), asset().joint_spheres.size());
 
+  // By joint name (a bone may have several convex pieces, each its own hull), and counted.
   std::set<std::string> reachable_hulls, dropped_hulls, dropped_spheres;
+  size_t reachable_hull_count = 0, dropped_hull_count = 0, dropped_sphere_count = 0;
   for (const ColliderReach& c : reach.hulls) {
     (c.reachable ? reachable_hulls : dropped_hulls).insert(c.joint_name);
+    ++(c.reachable ? reachable_hull_count : dropped_hull_count);
     EXPECT_EQ(c.reachable, c.clearance <= 0.f);
   }
-  for (const ColliderReach& c : reach.spheres)
+  for (const ColliderReach& c : reach.spheres) {
     if (!c.reachable) dropped_spheres.insert(c.joint_name);
+    dropped_sphere_count += c.reachable ? 0 : 1;
+  }
   for (const char* kept : {"hips", "hip_l", "hip_r", "spine"})
     EXPECT_TRUE(reachable_hulls.count(kept)) << kept << " should be reachable";
   for (const char* dropped : {"head", "wrist_l", "wrist_r", "ankle_l", "ankle_r"})
@@ -423,8 +428,8 @@ TEST_F(SceneTest, SkirtReachKeepsHipsAndDropsHeadAndWrists) {
   CharacterAsset pruned = asset();
   json left_out = json::array();
   PruneUnreachable(reach, &pruned, &left_out);
-  EXPECT_EQ(pruned.hulls.size(), reachable_hulls.size());
-  EXPECT_EQ(pruned.joint_spheres.size() + dropped_spheres.size(), asset().joint_spheres.size());
+  EXPECT_EQ(pruned.hulls.size(), reachable_hull_count);
+  EXPECT_EQ(pruned.joint_spheres.size() + dropped_sphere_count, asset().joint_spheres.size());
   size_t dropped_entries = 0;
   for (const json& entry : left_out) {
     if (entry["kind"] == "hull" || entry["kind"] == "joint_sphere") {
@@ -432,7 +437,7 @@ TEST_F(SceneTest, SkirtReachKeepsHipsAndDropsHeadAndWrists) {
       EXPECT_NE(entry["reason"].get<std::string>().find("cannot reach"), std::string::npos);
     }
   }
-  EXPECT_EQ(dropped_entries, dropped_hulls.size() + dropped_spheres.size());
+  EXPECT_EQ(dropped_entries, dropped_hull_count + dropped_sphere_count);
   // The whole looping clip is played: every map pose stays.
   EXPECT_EQ(pruned.body_maps.poses.size(), asset().body_maps.poses.size());
 }

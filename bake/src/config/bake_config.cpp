@@ -97,9 +97,10 @@ const JsonSchema<BakeConfig>& HullsSection() {
           .Float("rigid_threshold", "weight", OpenBelow(0.5, 1),
                  "a vertex is rigid to its heaviest bone when that weight reaches this",
                  [](BakeConfig& c) -> float& { return c.rigid_threshold; })
-          .Float("shape_threshold", "weight", OpenBelow(0.5, 1),
+          .Float("shape_threshold", "weight", Closed(0, 1),
                  "a flexible vertex also shapes its heaviest bone's hull (and stays in its joint "
-                 "sphere) when that weight reaches min(this, rigid_threshold); 1: rigid vertices "
+                 "sphere) when that weight reaches min(this, rigid_threshold); 0: every triangle "
+                 "shapes the hull of the bone that carries most of its weight; 1: rigid vertices "
                  "only, as in paper B",
                  [](BakeConfig& c) -> float& { return c.shape_threshold; })
           .Float("delta", "m", Closed(0, 0.1),
@@ -125,8 +126,15 @@ const JsonSchema<BakeConfig>& HullsSection() {
                  [](BakeConfig& c) -> float& { return c.hull.max_growth; })
           .Float("max_bloat", "m", OpenBelow(0, 1),
                  "a warning names every hull and joint sphere whose surface reaches farther than "
-                 "this outside the body, beyond its delta (the report's \"fit\")",
+                 "this outside the body, beyond its delta (the report's \"fit\"); a bone whose "
+                 "convex hull bulges farther is cut into convex pieces (max_pieces)",
                  [](BakeConfig& c) -> float& { return c.max_bloat; })
+          .Unsigned<uint32_t>("max_pieces", "count", 1, 64,
+                              "a bone's region is cut into at most this many convex pieces, each "
+                              "its own hull, while its hull bulges beyond max_bloat (a body with "
+                              "one region, e.g. no skeleton: 4 times this); 1: one hull per bone "
+                              "(paper B)",
+                              [](BakeConfig& c) -> uint32_t& { return c.hull_max_pieces; })
           .Enum<ObbMode>(
               "obb",
               {{"covariance", ObbMode::kCovariance}, {"cgal_optimal", ObbMode::kCgalOptimal}},
@@ -170,11 +178,18 @@ const JsonSchema<BakeConfig>& SpheresSection() {
                  [](BakeConfig& c) -> float& { return c.sphere_delta; })
           .Enum<SphereCover>(
               "cover",
-              {{"flexible", SphereCover::kFlexible}, {"left_by_hulls", SphereCover::kLeftByHulls}},
+              {{"flexible", SphereCover::kFlexible},
+               {"left_by_hulls", SphereCover::kLeftByHulls},
+               {"surface", SphereCover::kSurface}},
               "flexible: every flexible vertex of the joint (paper B); left_by_hulls: only the "
               "flexible corners of rest-pose triangles no single hull holds (smaller spheres on "
-              "smoothly weighted rigs; needs hulls.enabled)",
-              [](BakeConfig& c) -> SphereCover& { return c.sphere_cover; });
+              "smoothly weighted rigs; needs hulls.enabled); surface: as large as the body "
+              "around the joint centre allows (the centre's distance to the surface)",
+              [](BakeConfig& c) -> SphereCover& { return c.sphere_cover; })
+          .Float("min_radius", "m", Closed(0, 1),
+                 "cover surface: a joint whose centre is nearer the body surface than this (or "
+                 "outside the body) gets no sphere",
+                 [](BakeConfig& c) -> float& { return c.sphere_min_radius; });
   return schema;
 }
 

@@ -16,6 +16,7 @@
 #include "drape/bake/importer.h"
 #include "drape/bake/kirkpatrick_builder.h"
 #include "drape/bake/map_table_builder.h"
+#include "drape/bake/mesh_reference.h"
 #include "drape/bake/regions.h"
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
@@ -25,6 +26,8 @@
 #include "drape/runtime/skinning.h"
 #include "fit/collider_fit.h"
 #include "fit/fit_report.h"
+#include "regions/convex_pieces.h"
+#include "regions/surface_spheres.h"
 
 namespace drape::bake {
 namespace {
@@ -137,22 +140,71 @@ Status BakeMaps(const BakeConfig& config, std::span<const MapPoseRequest> reques
   return Status::Ok();
 }
 
-// Each bone's collider points in its collider frame: its rigid vertices, then its shaping ones.
-std::vector<std::vector<Float3>> ColliderPoints(const Regions& regions, uint32_t joints) {
-  std::vector<std::vector<Float3>> points(joints);
-  for (uint32_t j = 0; j < joints; ++j) {
-    const Mat34 to_collider = InverseRigid(regions.collider_frames[j]);
-    for (uint32_t v : regions.rigid_vertices[j]) {
-      points[j].push_back(TransformPoint(to_collider, regions.rest_positions[v]));
+// A character whose body is one region (no skeleton) may cut it into this many times
+// hulls.max_pieces: a standing human needs about 32 convex pieces to stay within 30 mm of its
+// skin (a skeleton-less CesiumMan: 104 mm at 8 pieces, 25 mm at 32).
+constexpr uint32_t kSingleRegionPieceFactor = 4;
+
+// One collider to build: a bone's region, or a convex piece of it (regions/convex_pieces.h).
+struct HullJob {
+  uint32_t joint = 0;
+  uint32_t piece = 0, pieces = 1;
+  std::vector<Float3> points;  // collider frame
+  double piece_bloat = 0.0;    // metres, the piece's convex hull beyond the body (0: not split)
+};
+
+// Each bone's region (its rigid, then its shaping vertices), split into convex pieces that fit
+// the body when hulls.max_pieces > 1, as collider points in the bone's collider frame.
+std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
+                              std::span<const uint32_t> triangles, uint32_t joints) {
+  std::vector<std::vector<ConvexPiece>> split(joints);
+  if (config.hull_max_pieces > 1) {
+    const MeshReference body(regions.rest_positions, triangles);
+    ConvexPieceOptions options;
+    options.max_bloat = config.max_bloat;
+    options.max_pieces = config.hull_max_pieces;
+    // A body without a skeleton (or with one bone) is one region: the whole budget is its own.
+    uint32_t regions_with_points = 0;
+    for (uint32_t j = 0; j < joints; ++j) {
+      regions_with_points +=
+          !regions.rigid_vertices[j].empty() || !regions.shaping_vertices[j].empty();
     }
-    for (uint32_t v : regions.shaping_vertices[j]) {
-      points[j].push_back(TransformPoint(to_collider, regions.rest_positions[v]));
+    if (regions_with_points == 1) options.max_pieces *= kSingleRegionPieceFactor;
+      // One bone per iteration, results in per-bone slots: identical at any thread count.
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int64_t j = 0; j < static_cast<int64_t>(joints); ++j) {
+      std::vector<uint32_t> region = regions.rigid_vertices[j];
+      region.insert(region.end(), regions.shaping_vertices[j].begin(),
+                    regions.shaping_vertices[j].end());
+      if (region.empty()) continue;
+      split[j] = SplitIntoConvexPieces(regions.rest_positions, triangles, region, body, options);
     }
   }
-  return points;
+  std::vector<HullJob> jobs;
+  for (uint32_t j = 0; j < joints; ++j) {
+    const Mat34 to_collider = InverseRigid(regions.collider_frames[j]);
+    const auto add = [&](std::span<const uint32_t> vertices, uint32_t piece, uint32_t pieces,
+                         double bloat) {
+      HullJob job{j, piece, pieces, {}, bloat};
+      for (uint32_t v : vertices) {
+        job.points.push_back(TransformPoint(to_collider, regions.rest_positions[v]));
+      }
+      jobs.push_back(std::move(job));
+    };
+    if (split[j].size() > 1) {
+      const uint32_t n = static_cast<uint32_t>(split[j].size());
+      for (uint32_t k = 0; k < n; ++k) add(split[j][k].vertices, k, n, split[j][k].bloat);
+      continue;
+    }
+    std::vector<uint32_t> region = regions.rigid_vertices[j];
+    region.insert(region.end(), regions.shaping_vertices[j].begin(),
+                  regions.shaping_vertices[j].end());
+    if (!region.empty()) add(region, 0, 1, split[j].empty() ? 0.0 : split[j][0].bloat);
+  }
+  return jobs;
 }
 
-// One bone's collider as built: the hull, its hierarchies and map table, or why it failed.
+// One collider as built: the hull, its hierarchies and map table, or why it failed.
 struct BoneHull {
   HullColliderData hull;
   HullStats stats;
@@ -161,21 +213,18 @@ struct BoneHull {
   MapTableStats table;
 };
 
-// Hull geometry, Kirkpatrick hierarchies and map table of every bone that has collider points.
-std::vector<BoneHull> BuildBoneHulls(const BakeConfig& config,
-                                     const std::vector<std::vector<Float3>>& points) {
-  const uint32_t joints = static_cast<uint32_t>(points.size());
-  std::vector<BoneHull> built(joints);
+// Hull geometry, Kirkpatrick hierarchies and map table of every job.
+std::vector<BoneHull> BuildBoneHulls(const BakeConfig& config, const std::vector<HullJob>& jobs) {
+  std::vector<BoneHull> built(jobs.size());
   // One resolution setting for both shapes: rows x cols of whichever table a collider gets.
   MapTableOptions map_options = config.map_table;
   map_options.cylinder_rows = map_options.sphere_rows;
   map_options.cylinder_cols = map_options.sphere_cols;
-  // One bone per iteration, results in per-bone slots: identical output at any thread count.
+  // One collider per iteration, results in per-job slots: identical output at any thread count.
 #pragma omp parallel for schedule(dynamic, 1)
-  for (int64_t j = 0; j < static_cast<int64_t>(joints); ++j) {
-    if (points[j].empty()) continue;
-    BoneHull& b = built[j];
-    b.status = BuildHullGeometry(points[j], config.hull, &b.hull, &b.stats);
+  for (int64_t i = 0; i < static_cast<int64_t>(jobs.size()); ++i) {
+    BoneHull& b = built[i];
+    b.status = BuildHullGeometry(jobs[i].points, config.hull, &b.hull, &b.stats);
     if (b.status.ok()) b.status = BuildKirkpatrick(&b.hull, config.kirkpatrick, &b.kirkpatrick);
     if (b.status.ok()) b.status = BuildMapTable(&b.hull, map_options, &b.table);
   }
@@ -243,23 +292,26 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
                  CharacterAsset* asset, json* report) {
   const SkeletonData& skeleton = character.skeleton;
   const uint32_t joints = skeleton.joint_count();
-  const std::vector<std::vector<Float3>> points = ColliderPoints(regions, joints);
-  std::vector<BoneHull> built = BuildBoneHulls(config, points);
+  const std::vector<HullJob> jobs = HullJobs(config, regions, character.mesh.triangles, joints);
+  std::vector<BoneHull> built = BuildBoneHulls(config, jobs);
   json colliders = json::array();
   json left_out = json::array();
-  for (uint32_t j = 0; j < joints; ++j) {
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    const uint32_t j = jobs[i].joint;
     const std::string& bone = skeleton.joint_names[j];
-    if (points[j].empty()) continue;  // no rigid or shaping vertices: nothing to cover
-    if (!built[j].status.ok()) {
-      const std::string where = LeaveToJointSphere(skeleton, j, regions);
+    if (!built[i].status.ok()) {
+      // A whole bone too small for a solid: its joint sphere covers it. A piece: nothing does.
+      const std::string where = jobs[i].pieces == 1 ? LeaveToJointSphere(skeleton, j, regions)
+                                                    : std::string("not covered");
       left_out.push_back({{"bone", bone},
+                          {"piece", jobs[i].piece},
                           {"rigid_vertices", regions.rigid_vertices[j].size()},
                           {"shaping_vertices", regions.shaping_vertices[j].size()},
-                          {"reason", built[j].status.message()},
+                          {"reason", built[i].status.message()},
                           {"covered_by", where}});
       continue;
     }
-    HullColliderData& hull = built[j].hull;
+    HullColliderData& hull = built[i].hull;
     hull.joint = static_cast<int32_t>(j);
     Mat34 rest_to_bind;
     if (!InverseAffine(regions.rest_skinning[j], &rest_to_bind)) {
@@ -267,7 +319,11 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
       continue;
     }
     hull.bind_frame = Multiply(rest_to_bind, regions.collider_frames[j]);
-    colliders.push_back(HullReport(bone, regions, j, built[j]));
+    json entry = HullReport(bone, regions, j, built[i]);
+    entry["piece"] = jobs[i].piece;
+    entry["pieces"] = jobs[i].pieces;
+    entry["points"] = jobs[i].points.size();
+    colliders.push_back(std::move(entry));
     asset->hulls.push_back(std::move(hull));
   }
   (*report)["colliders"] = colliders;
@@ -326,11 +382,10 @@ void WarnIfHullsCoverLittle(const BakeConfig& config, double fraction, size_t hu
   if (fraction >= kLowHullVertexFraction) return;
   const auto value = [](float v) { return std::to_string(v).substr(0, 4); };
   std::string advice =
-      config.shape_threshold > 0.51f
-          ? "; hulls.shape_threshold 0.51 (the default; " + value(config.shape_threshold) +
-                " here) lets the flexible vertices shape their heaviest bone's hull too "
-                "(CesiumMan: 0 % of the measured motions missed instead of 6 %; "
-                "docs/ALGORITHMS.md §2.1)"
+      config.shape_threshold > 0.f
+          ? "; hulls.shape_threshold 0 (the default; " + value(config.shape_threshold) +
+                " here) lets every triangle shape the hull of the bone that carries most of it "
+                "(docs/ALGORITHMS.md §2.1)"
           : "; most vertices are blended with no bone above half their weight, which no "
             "hull can follow: use the body maps for this character";
   warnings->push_back("only " + std::to_string(static_cast<int>(std::lround(fraction * 100.0))) +
@@ -377,10 +432,24 @@ void BakeSpheres(const BakeConfig& config, const Regions& regions, Character& ch
         "spheres.cover is left_by_hulls but no hull was baked: the joint spheres cover every "
         "flexible vertex (paper B)");
   }
-  asset->joint_spheres = left_by_hulls ? BuildJointSpheres(regions, config.sphere_delta,
-                                                           asset->hulls, character.mesh.triangles)
-                                       : BuildJointSpheres(regions, config.sphere_delta);
-  if (!left_by_hulls && !asset->hulls.empty()) {
+  json left_out = json::array();
+  if (config.sphere_cover == SphereCover::kSurface) {
+    const MeshReference body(regions.rest_positions, character.mesh.triangles);
+    std::vector<SphereLeftOut> dropped;
+    asset->joint_spheres = BuildSurfaceJointSpheres(regions, body, config.sphere_delta,
+                                                    config.sphere_min_radius, &dropped);
+    for (const SphereLeftOut& d : dropped) {
+      left_out.push_back(
+          {{"joint", asset->skeleton.joint_names[d.joint]},
+           {"parent", d.parent_joint >= 0 ? asset->skeleton.joint_names[d.parent_joint] : ""},
+           {"reason", d.reason}});
+    }
+  } else {
+    asset->joint_spheres = left_by_hulls ? BuildJointSpheres(regions, config.sphere_delta,
+                                                             asset->hulls, character.mesh.triangles)
+                                         : BuildJointSpheres(regions, config.sphere_delta);
+  }
+  if (config.sphere_cover == SphereCover::kFlexible && !asset->hulls.empty()) {
     AdviseSphereCover(config, regions, character, *asset, &character.warnings);
   }
   json spheres = json::array();
@@ -391,6 +460,7 @@ void BakeSpheres(const BakeConfig& config, const Regions& regions, Character& ch
          {"radius_mm", s.radius * 1000.f}});
   }
   (*report)["joint_spheres"] = spheres;
+  (*report)["joint_spheres_left_out"] = left_out;
 }
 
 // The proxies' fit to the rest-pose body (fit/collider_fit.h): each collider's bloat on its

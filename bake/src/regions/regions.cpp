@@ -43,6 +43,45 @@ bool IsAncestor(const SkeletonData& s, int32_t ancestor, int32_t joint) {
   return false;
 }
 
+// shape_threshold 0: every triangle shapes the hull of the bone with the largest summed weight
+// over its three corners, all three corners included, so the hulls hold the whole rest-pose
+// surface (on a low-poly mesh a triangle between two bones' vertices is a large part of it).
+// Neighbouring hulls then overlap by the triangles along their seam.
+void AssignTriangles(const MeshData& mesh, Regions* regions) {
+  const size_t joints = regions->shaping_vertices.size();
+  std::vector<int32_t> rigid_to(mesh.vertex_count(), -1);
+  for (size_t j = 0; j < joints; ++j) {
+    for (uint32_t v : regions->rigid_vertices[j]) rigid_to[v] = static_cast<int32_t>(j);
+  }
+  std::vector<float> weight(joints, 0.f);
+  std::vector<int32_t> touched;
+  for (size_t t = 0; t + 2 < mesh.triangles.size(); t += 3) {
+    touched.clear();
+    for (size_t c = 0; c < 3; ++c) {
+      const uint32_t v = mesh.triangles[t + c];
+      for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k) {
+        const int32_t j = mesh.influence_joints[k];
+        if (weight[j] == 0.f) touched.push_back(j);
+        weight[j] += mesh.influence_weights[k];
+      }
+    }
+    int32_t best = -1;
+    for (int32_t j : touched) {
+      if (best < 0 || weight[j] > weight[best] || (weight[j] == weight[best] && j < best)) best = j;
+    }
+    for (int32_t j : touched) weight[j] = 0.f;
+    if (best < 0) continue;
+    for (size_t c = 0; c < 3; ++c) {
+      const uint32_t v = mesh.triangles[t + c];
+      if (rigid_to[v] != best) regions->shaping_vertices[best].push_back(v);
+    }
+  }
+  for (std::vector<uint32_t>& list : regions->shaping_vertices) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+}
+
 }  // namespace
 
 Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions,
@@ -50,8 +89,8 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
   if (!(rigid_threshold > 0.5f && rigid_threshold <= 1.f)) {
     return Status(StatusCode::kInvalidArgument, "hulls.rigid_threshold must be in (0.5, 1]");
   }
-  if (!(shape_threshold > 0.5f && shape_threshold <= 1.f)) {
-    return Status(StatusCode::kInvalidArgument, "hulls.shape_threshold must be in (0.5, 1]");
+  if (!(shape_threshold >= 0.f && shape_threshold <= 1.f)) {
+    return Status(StatusCode::kInvalidArgument, "hulls.shape_threshold must be in [0, 1]");
   }
   *regions = Regions{};
   regions->rigid_threshold = rigid_threshold;
@@ -109,6 +148,7 @@ Status SplitRegions(const Character& character, float rigid_threshold, Regions* 
     }
     regions->joints[it->second].flexible_vertices.push_back(v);
   }
+  if (shape_threshold == 0.f) AssignTriangles(character.mesh, regions);
   // Bones that are not ancestor and descendant have no joint origin: centre on the vertices.
   for (JointRegion& region : regions->joints) {
     if (IsAncestor(skeleton, region.parent, region.child)) continue;

@@ -20,6 +20,7 @@ namespace drape::bake {
 enum class SphereCover : uint8_t {
   kFlexible = 0,     // every flexible vertex of the joint's two bones (paper B)
   kLeftByHulls = 1,  // only what the bones' hulls leave out of the rest-pose mesh
+  kSurface = 2,      // as large as the body around the joint centre allows (no bulge)
 };
 
 struct BakeConfig {
@@ -41,23 +42,31 @@ struct BakeConfig {
 
   bool hulls_enabled = true;      // paper B: a convex collider per bone
   float rigid_threshold = 0.99f;  // a vertex is rigid to its heaviest bone at this weight, (0.5, 1]
-  // A flexible vertex also shapes its heaviest bone's hull at min(this, rigid_threshold), (0.5, 1]
+  // A flexible vertex also shapes its heaviest bone's hull at min(this, rigid_threshold), [0, 1]
   // (it stays in its joint sphere too); 1: hulls are shaped by rigid vertices only (paper B).
-  // 0.51 by default: on every measured character it misses fewer penetrations than paper B's
-  // rigid-only hulls, at the rest pose and posed (docs/ALGORITHMS.md §2.1).
-  float shape_threshold = 0.51f;
+  // 0 by default: every triangle shapes the hull of the bone that carries most of it, so the
+  // hulls hold the whole rest-pose surface whatever the rig's weights (smoothly weighted game
+  // rigs have few vertices near any threshold; docs/ALGORITHMS.md §2.1).
+  float shape_threshold = 0.f;
   HullOptions hull;
   // Metres, > 0: the report warns about every hull or joint sphere whose surface reaches farther
   // than this outside the body beyond its delta (the fit, measured against the exact mesh).
   float max_bloat = 0.015f;
+  // >= 1: a bone's region whose convex hull bulges beyond max_bloat is cut into at most this many
+  // convex pieces, each its own hull (regions/convex_pieces.h); 1: one hull per bone (paper B).
+  uint32_t hull_max_pieces = 8;
   KirkpatrickOptions kirkpatrick;
   MapTableOptions map_table;
 
   bool spheres_enabled = true;  // paper B: a sphere per joint over its flexible vertices
   float sphere_delta = 0.005f;  // metres added to each joint sphere's radius, >= 0
-  // What a joint sphere holds (spheres.cover). Paper B's default; kLeftByHulls shrinks the spheres
-  // of smoothly weighted rigs (CesiumMan: 12-34 cm radii) to what the hulls do not hold.
-  SphereCover sphere_cover = SphereCover::kFlexible;
+  // What a joint sphere holds (spheres.cover). kSurface by default: as large as the body around
+  // the joint allows, so it never bulges out of the body; paper B's kFlexible reaches every
+  // blended vertex (0.2-0.8 m radii on smoothly weighted rigs).
+  SphereCover sphere_cover = SphereCover::kSurface;
+  // Metres, >= 0: with kSurface, a joint whose centre is nearer the body surface than this gets
+  // no sphere (it would hold nothing a hull does not).
+  float sphere_min_radius = 0.01f;
 };
 
 // Reads a JSON config file over the defaults in `config`. `path` names the file in messages.

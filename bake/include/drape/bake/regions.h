@@ -25,14 +25,16 @@ struct Regions {
   std::vector<Mat34> collider_frames;  // per joint: rigid rest-pose joint frame -> asset
   std::vector<std::vector<uint32_t>> rigid_vertices;  // per joint
   // Per joint: flexible vertices whose heaviest bone it is, at a weight in [shape_threshold,
-  // rigid_threshold). They shape the bone's hull as well as being in their joint sphere.
+  // rigid_threshold) (ties go to the lower joint index). They shape the bone's hull as well as being in their joint sphere.
   std::vector<std::vector<uint32_t>> shaping_vertices;
   std::vector<JointRegion> joints;  // one per bone pair with flexible vertices
 };
 
 // rigid_threshold in (0.5, 1]: a vertex is rigid to its heaviest bone when that weight reaches it.
-// shape_threshold in (0.5, 1]: a flexible vertex also shapes its heaviest bone's hull when that
-// weight reaches min(shape_threshold, rigid_threshold) (1: no flexible vertex does).
+// shape_threshold in [0, 1]: a flexible vertex also shapes its heaviest bone's hull when that
+// weight reaches min(shape_threshold, rigid_threshold) (1: none does). 0: every triangle shapes
+// the hull of the bone with the largest summed weight over its corners (all three corners), so
+// the hulls hold the whole rest-pose surface.
 Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions,
                     float shape_threshold = 1.f);
 

@@ -1,0 +1,39 @@
+#pragma once
+// A bone's region split into convex pieces that fit the body. One convex hull per bone bridges
+// whatever the bone's skin wraps around: the arms and the torso of a body without a skeleton, a
+// creature's head and jaw, the air in an armpit. Each piece gets its own hull (with its OBB,
+// Kirkpatrick hierarchies and map table), all moving with the bone.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "drape/formats/types.h"
+
+namespace drape::bake {
+
+class MeshReference;
+
+struct ConvexPieceOptions {
+  double max_bloat = 0.015;  // metres: a piece whose hull bulges farther out of the body splits
+  uint32_t max_pieces = 8;   // per bone, >= 1
+};
+
+struct ConvexPiece {
+  std::vector<uint32_t> vertices;  // indices into the rest positions, sorted
+  double bloat = 0.0;  // metres: how far the convex hull of the vertices reaches out of the body
+};
+
+// `vertices`: the bone's region (indices into rest_positions); `triangles`: the rest-pose mesh's
+// triangles (those with all three corners in the region travel whole with one piece, so the
+// pieces' hulls together hold every such triangle). `body`: the rest-pose body. The worst piece
+// is cut in two while it bloats beyond max_bloat and the budget allows, by the plane (across one
+// of its three principal axes, at one of seven quantiles) that leaves the least hull volume: a
+// hull that bridges two parts holds air, which a cut between them removes. Deterministic.
+std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_positions,
+                                               std::span<const uint32_t> triangles,
+                                               std::span<const uint32_t> vertices,
+                                               const MeshReference& body,
+                                               const ConvexPieceOptions& options);
+
+}  // namespace drape::bake
