@@ -342,8 +342,14 @@ void CheckHull(const HullColliderData& h, size_t index, size_t joints, Checker& 
       !c.Require(!h.planes.empty() && h.planes.size() <= 4096, at + ".planes",
                  "count is not in [1, 4096]") ||
       !c.Require(h.triangles.size() % 3 == 0, at + ".triangles", "size is not a multiple of 3") ||
-      !c.Size(h.triangle_planes.size(), h.triangles.size() / 3, at + ".triangle_planes"))
+      !c.Size(h.triangle_planes.size(), h.triangles.size() / 3, at + ".triangle_planes") ||
+      !c.Require(h.plane_internal.empty() || h.plane_internal.size() == h.planes.size(),
+                 at + ".plane_internal", "is neither empty nor one flag per plane"))
     return;
+  for (size_t i = 0; i < h.plane_internal.size(); ++i)
+    if (!c.Require(h.plane_internal[i] <= 1, at + ".plane_internal[" + std::to_string(i) + "]",
+                   "is not 0 or 1"))
+      return;
   for (size_t i = 0; i < h.vertices.size(); ++i)
     if (!c.Finite(h.vertices[i], at + ".vertices[" + std::to_string(i) + "]")) return;
   for (size_t i = 0; i < h.triangles.size(); ++i)

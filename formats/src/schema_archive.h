@@ -4,6 +4,7 @@
 // not know, naming the type. Arrays are bounded by the payload size before anything is
 // allocated, so a corrupt count cannot make the loader allocate gigabytes.
 
+#include <algorithm>
 #include <cereal/archives/json.hpp>
 #include <cereal/archives/portable_binary.hpp>
 #include <cereal/cereal.hpp>
@@ -234,15 +235,15 @@ void serialize(Archive& ar, MeshData& m, const uint32_t version) {
 // version 3): `layers` (uint8) follows `layout`, before the span table, and `gap_texels`
 // follows the span table. Writing is always
 // version 3; a version-1 pose loads as dense with an empty span table, and versions 1 and 2
-// load with one layer. Format version N holds exactly class version N (what its writer wrote):
-// a newer class in an older format is impossible, an older one in a newer format is a forgery
-// that would not re-encode to the same bytes. A format version that changes another type only
-// must map its own BodyMapPose version here.
+// load with one layer. Format version N holds exactly class version min(N, 3) (what its writer
+// wrote; format version 4 changed HullColliderData only): a newer class in an older format is
+// impossible, an older one in a newer format is a forgery that would not re-encode to the same
+// bytes.
 template <class Archive>
 void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
   detail::CheckVersionRange(version, 1, 3, "BodyMapPose");
   if constexpr (Archive::is_loading::value) {
-    if (detail::g_format_version != 0 && version != detail::g_format_version) {
+    if (detail::g_format_version != 0 && version != std::min(detail::g_format_version, 3u)) {
       throw DecodeError("BodyMapPose version " + std::to_string(version) + " in a format version " +
                         std::to_string(detail::g_format_version) + " file");
     }
@@ -320,12 +321,21 @@ void serialize(Archive& ar, MapTableData& t, const uint32_t version) {
 
 template <class Archive>
 void serialize(Archive& ar, HullColliderData& h, const uint32_t version) {
-  detail::CheckVersion(version, 1, "HullColliderData");
+  detail::CheckVersionRange(version, 1, 2, "HullColliderData");
+  if constexpr (Archive::is_loading::value) {
+    // Version 2 from format version 4 on, 1 before (as BodyMapPose's check explains).
+    if (detail::g_format_version != 0 && version != (detail::g_format_version >= 4 ? 2u : 1u)) {
+      throw DecodeError("HullColliderData version " + std::to_string(version) +
+                        " in a format version " + std::to_string(detail::g_format_version) +
+                        " file");
+    }
+  }
   ar(cereal::make_nvp("joint", h.joint), cereal::make_nvp("bind_frame", h.bind_frame));
   Array(ar, "vertices", h.vertices);
   Array(ar, "triangles", h.triangles);
   Array(ar, "triangle_planes", h.triangle_planes);
   Array(ar, "planes", h.planes);
+  if (version >= 2) Array(ar, "plane_internal", h.plane_internal);  // format 4
   ar(cereal::make_nvp("obb", h.obb), cereal::make_nvp("projection_axis", h.projection_axis),
      cereal::make_nvp("projection_u", h.projection_u),
      cereal::make_nvp("projection_v", h.projection_v), cereal::make_nvp("upper", h.upper),
@@ -359,6 +369,6 @@ CEREAL_CLASS_VERSION(drape::BodyMapPose, 3)  // 2: layout, spans (format 2); 3: 
 CEREAL_CLASS_VERSION(drape::BodyMapSet, 1)
 CEREAL_CLASS_VERSION(drape::KirkpatrickHierarchy, 1)
 CEREAL_CLASS_VERSION(drape::MapTableData, 1)
-CEREAL_CLASS_VERSION(drape::HullColliderData, 1)
+CEREAL_CLASS_VERSION(drape::HullColliderData, 2)
 CEREAL_CLASS_VERSION(drape::JointSphereData, 1)
 CEREAL_CLASS_VERSION(drape::CharacterAsset, 1)

@@ -67,6 +67,7 @@ inline CharacterAsset SmallAsset() {
   hull.obb.axes[2] = {0, 0, 1};
   hull.planes = {
       {{0, 0, -1}, 0}, {{0, -1, 0}, 0}, {{-1, 0, 0}, 0}, {{0.577f, 0.577f, 0.577f}, 0.578f}};
+  hull.plane_internal = {0, 1, 0, 0};  // one face a cut between convex pieces
   hull.upper.vertices_uv = {0, 0, 1, 0, 0, 1};
   hull.upper.node_triangles = {0, 1, 2, 0, 1, 2};
   hull.upper.child_offsets = {0, 0, 1};

@@ -42,6 +42,13 @@ TEST(AssetFile, OutOfRangeIndicesAreRefusedWithTheField) {
   CharacterAsset flat = SmallAsset();
   flat.hulls[0].obb.axes[1] = {1, 0, 0};
   EXPECT_NE(ValidateAsset(flat).message().find("obb.axes are not orthonormal"), std::string::npos);
+  CharacterAsset cut = SmallAsset();
+  cut.hulls[0].plane_internal.pop_back();  // a flag per plane, or none
+  EXPECT_NE(ValidateAsset(cut).message().find("hulls[0].plane_internal is neither empty"),
+            std::string::npos);
+  cut.hulls[0].plane_internal = {0, 2, 0, 0};
+  EXPECT_NE(ValidateAsset(cut).message().find("hulls[0].plane_internal[1] is not 0 or 1"),
+            std::string::npos);
   CharacterAsset dup = SmallAsset();
   dup.skeleton.joint_names[2] = "root";
   EXPECT_NE(ValidateAsset(dup).message().find("'root' is a duplicate"), std::string::npos);

@@ -156,10 +156,10 @@ struct HullJob {
 // Each bone's region (its rigid, then its shaping vertices), split into convex pieces that fit
 // the body when hulls.max_pieces > 1, as collider points in the bone's collider frame.
 std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
-                              std::span<const uint32_t> triangles, uint32_t joints) {
+                              std::span<const uint32_t> triangles, const MeshReference& body,
+                              uint32_t joints) {
   std::vector<std::vector<ConvexPiece>> split(joints);
   if (config.hull_max_pieces > 1) {
-    const MeshReference body(regions.rest_positions, triangles);
     ConvexPieceOptions options;
     options.max_bloat = config.max_bloat;
     options.max_pieces = config.hull_max_pieces;
@@ -231,6 +231,39 @@ std::vector<BoneHull> BuildBoneHulls(const BakeConfig& config, const std::vector
   return built;
 }
 
+// A convex piece's faces that lie inside the body (its cuts from the bone's other pieces): the
+// runtime's push-out leaves through the nearest other face. A face is inside when a point just
+// off its centroid is inside the body and farther than delta + 2 mm from its surface.
+void MarkInternalPlanes(const Mat34& collider_to_asset, const MeshReference& body, float delta,
+                        HullColliderData* hull) {
+  const size_t planes = hull->planes.size();
+  std::vector<double> area(planes, 0.0);
+  std::vector<Float3> centroid(planes, Float3{0.f, 0.f, 0.f});
+  for (size_t t = 0; t < hull->triangle_planes.size(); ++t) {
+    const Float3 a = hull->vertices[hull->triangles[3 * t]];
+    const Float3 b = hull->vertices[hull->triangles[3 * t + 1]];
+    const Float3 c = hull->vertices[hull->triangles[3 * t + 2]];
+    const float w = 0.5f * Length(Cross(b - a, c - a));
+    const uint32_t p = hull->triangle_planes[t];
+    area[p] += w;
+    centroid[p] = centroid[p] + (a + b + c) * (w / 3.f);
+  }
+  hull->plane_internal.assign(planes, 0);
+  size_t internal = 0;
+  for (size_t p = 0; p < planes; ++p) {
+    if (!(area[p] > 0.0)) continue;
+    const Float3 local =
+        centroid[p] * static_cast<float>(1.0 / area[p]) + hull->planes[p].normal * 0.002f;
+    const Float3 at = TransformPoint(collider_to_asset, local);
+    const double q[3] = {at.x, at.y, at.z};
+    if (body.Inside(q) && body.Distance(q) > delta + 0.002) {
+      hull->plane_internal[p] = 1;
+      ++internal;
+    }
+  }
+  if (internal == 0 || internal == planes) hull->plane_internal.clear();
+}
+
 // Too few points for a solid: the joint sphere shared with the parent covers the rigid vertices
 // (the shaping ones are in their joint spheres already). Returns where they went, for the report.
 std::string LeaveToJointSphere(const SkeletonData& skeleton, uint32_t j, Regions& regions) {
@@ -292,7 +325,9 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
                  CharacterAsset* asset, json* report) {
   const SkeletonData& skeleton = character.skeleton;
   const uint32_t joints = skeleton.joint_count();
-  const std::vector<HullJob> jobs = HullJobs(config, regions, character.mesh.triangles, joints);
+  const MeshReference body(regions.rest_positions, character.mesh.triangles);
+  const std::vector<HullJob> jobs =
+      HullJobs(config, regions, character.mesh.triangles, body, joints);
   std::vector<BoneHull> built = BuildBoneHulls(config, jobs);
   json colliders = json::array();
   json left_out = json::array();
@@ -319,6 +354,9 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
       continue;
     }
     hull.bind_frame = Multiply(rest_to_bind, regions.collider_frames[j]);
+    if (jobs[i].pieces > 1) {
+      MarkInternalPlanes(regions.collider_frames[j], body, config.hull.delta, &hull);
+    }
     json entry = HullReport(bone, regions, j, built[i]);
     entry["piece"] = jobs[i].piece;
     entry["pieces"] = jobs[i].pieces;

@@ -30,7 +30,22 @@ void HullColliderSet::PushOut(const HullRecord& h, Float3 p, float max_value,
                               ContactQuery* c) const {
   const uint32_t b = h.plane_begin;
   const PlaneSoa soa{&plane_nx_[b], &plane_ny_[b], &plane_nz_[b], &plane_d_[b], h.plane_padded};
-  const uint32_t j = kernels_->first_equal(soa, p, max_value);
+  uint32_t j = kernels_->first_equal(soa, p, max_value);
+  if (plane_internal_[b + j]) {
+    // The nearest face is a cut inside the body: leave through the nearest outer face instead
+    // (the depth is then the distance to it).
+    uint32_t outer = h.plane_count;
+    float outer_max = -INFINITY;
+    for (uint32_t i = 0; i < h.plane_count; ++i) {
+      const float v = PlaneSignedDistance(planes_[b + i], p);
+      if (!plane_internal_[b + i] && v > outer_max) outer = i, outer_max = v;
+    }
+    if (outer < h.plane_count) {
+      j = outer;
+      max_value = outer_max;
+      c->depth = c->inside_end ? std::max(c->depth, -outer_max) : c->depth;
+    }
+  }
   const Plane& plane = planes_[b + j];
   const Float3 projected = p - plane.normal * max_value;
   c->point = NudgeOut(projected, plane.normal, 1.f + std::fabs(plane.offset),

@@ -63,6 +63,10 @@ struct HullColliderData {
   std::vector<uint32_t> triangles;        // 3 per triangle, counter-clockwise outside
   std::vector<uint32_t> triangle_planes;  // plane index of each triangle
   std::vector<Plane> planes;              // coplanar triangles share one plane
+  // Per plane, 1 when its face lies inside the body: the cut between two convex pieces of one
+  // bone. A particle inside leaves through the nearest other face (leaving through the cut would
+  // put it in the neighbouring piece). Empty: no such face.
+  std::vector<uint8_t> plane_internal;
   Obb obb;
   Float3 projection_axis;             // unit; "upper" faces have dot(n, axis) > 0
   Float3 projection_u, projection_v;  // unit, (u, v, axis) right-handed
