@@ -208,9 +208,9 @@ void Measurement::MeasureDefaultHullVariants(const Context& context, const Chara
   }
 }
 
-// The same character in a pose of its longest clip, 40 % into it (limbs bent, unlike the rest
-// pose): maps baked for that pose, hulls and spheres posed by its skinning matrices (what the
-// runtime does every frame), against the posed exact mesh. A shorter sweep: the defaults and
+// The same character in two poses of its longest clip, 40 % and 80 % into it (limbs bent, unlike
+// the rest pose): maps baked for that pose, hulls and spheres posed by its skinning matrices (what
+// the runtime does every frame), against the posed exact mesh. A shorter sweep: the defaults and
 // the settings the rest pose singles out.
 void Measurement::RunPosed(const CharacterSpec& spec, const bake::Character& character,
                            const HullAssets& hull_assets) {
@@ -218,7 +218,13 @@ void Measurement::RunPosed(const CharacterSpec& spec, const bake::Character& cha
   const ClipData& clip = *std::max_element(
       character.clips.begin(), character.clips.end(),
       [](const ClipData& a, const ClipData& b) { return a.duration < b.duration; });
-  const float time = 0.4f * clip.duration;
+  for (const float fraction : {0.4f, 0.8f})
+    RunPosedAt(spec, character, hull_assets, clip, fraction);
+}
+
+void Measurement::RunPosedAt(const CharacterSpec& spec, const bake::Character& character,
+                             const HullAssets& hull_assets, const ClipData& clip, float fraction) {
+  const float time = fraction * clip.duration;
   SkeletonPose pose;
   std::vector<Float3> positions(character.mesh.vertex_count());
   if (!pose.Init(character.skeleton).ok() || !pose.SampleClip(clip, time, false).ok() ||

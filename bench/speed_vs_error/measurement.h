@@ -69,6 +69,8 @@ class Measurement {
                                   const std::string& label, std::unique_ptr<Method> default_maps);
   void RunPosed(const CharacterSpec& spec, const bake::Character& character,
                 const HullAssets& hull_assets);
+  void RunPosedAt(const CharacterSpec& spec, const bake::Character& character,
+                  const HullAssets& hull_assets, const ClipData& clip, float fraction);
 
   // Report sections (measurement_sections.cpp).
   void ResolutionIndependence(const CharacterSpec& spec, const Context& base);

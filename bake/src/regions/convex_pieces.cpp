@@ -122,6 +122,9 @@ std::array<Vec3, 3> PrincipalAxes(const std::vector<Vec3>& points) {
   return axes;
 }
 
+// Candidate cuts per principal axis: at q / kQuantiles of the elements' order, 0 < q < kQuantiles.
+constexpr uint32_t kQuantiles = 8;
+
 // Cuts the piece in two by the candidate plane that leaves the least hull volume. False when
 // no candidate puts something on both sides.
 bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece* right) {
@@ -142,8 +145,8 @@ bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece*
     for (uint32_t v : piece.loose) keys.push_back(Dot(ToVec3(c.positions[v]), axis));
     std::vector<double> sorted = keys;
     std::sort(sorted.begin(), sorted.end());
-    for (int q = 1; q <= 7; ++q) {
-      const double cut = sorted[sorted.size() * static_cast<size_t>(q) / 8];
+    for (uint32_t q = 1; q < kQuantiles; ++q) {
+      const double cut = sorted[sorted.size() * q / kQuantiles];
       WorkPiece a, b;
       size_t k = 0;
       for (uint32_t t : piece.triangles) (keys[k++] < cut ? a : b).triangles.push_back(t);
