@@ -81,9 +81,18 @@ NAMED="$WORK/unknown_key.json" expect_error bad_config_key "$MANNEQUIN" "no_such
 echo '{"maps": {"clip": "wlak"}}' >"$WORK/bad_clip.json"
 NAMED="$WORK/bad_clip.json" expect_error bad_maps_clip "$MANNEQUIN" \
   "bad_clip.json: /maps/clip: no clip named 'wlak' in '.*mannequin.gltf' \(clips: walk" --config "$WORK/bad_clip.json"
-# --strict: a bake with warnings fails like any error (the mannequin's report always has one: the
-# frame it was read in), naming the count and the first warning.
-expect_error strict "$MANNEQUIN" "--strict: [0-9]+ warnings?(, the first)?: [a-z]" --strict
+# --strict: a bake with warnings fails like any error (a 1 mm hulls.max_bloat makes every hull a
+# warning), naming the count and the first warning; without warnings it bakes.
+echo '{"maps": {"enabled": false}, "hulls": {"max_bloat": 0.001, "max_pieces": 1}}' >"$WORK/tight.json"
+expect_error strict "$MANNEQUIN" "--strict: [0-9]+ warnings?(, the first)?: [a-z0-9]" --strict \
+  --config "$WORK/tight.json"
+echo '{"maps": {"enabled": false}, "hulls": {"max_bloat": 1}}' >"$WORK/loose.json"
+if "$BAKE" "$MANNEQUIN" -o "$WORK/strict.drape" --config "$WORK/loose.json" --strict 2>"$WORK/strict.err" &&
+  [ -s "$WORK/strict.drape" ] && [ ! -s "$WORK/strict.err" ]; then
+  passed=$((passed + 1))
+else
+  fail "--strict on a bake without warnings (a glTF states its unit and up axis): $(cat "$WORK/strict.err")"
+fi
 # What assimp drops without a word is counted: an OBJ with a two-corner face and empty f lines
 # bakes, and says so on stderr and in the report.
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 2\nf\nf 2 4 3\nf 1 4 2\nf  \n' >"$WORK/sloppy.obj"

@@ -45,8 +45,9 @@ Status CheckImportInputs(const std::string& path, const ImportOptions& options) 
   return Status::Ok();
 }
 
-// The source's name, the tool version and the asset frame, with the frame's provenance as the
-// first warning of the report.
+// The source's name, the tool version and the asset frame with its provenance; the provenance is
+// the report's first warning when it was assumed (a format that states no unit or up axis, or
+// the size heuristic) rather than given by the config, the file, or the format's specification.
 void RecordSourceInfo(const std::string& path, const detail::AssetFrame& frame,
                       Character* character) {
   character->info.source_name = std::filesystem::path(path).filename().string();
@@ -56,10 +57,18 @@ void RecordSourceInfo(const std::string& path, const detail::AssetFrame& frame,
   character->info.source_to_asset = detail::ToMat34(frame.to_asset);
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) character->source_to_asset[4 * r + c] = frame.to_asset(r, c);
-  character->warnings.insert(character->warnings.begin(), "unit scale " + detail::Fmt(frame.scale) +
-                                                              " m/unit from " + frame.scale_source +
-                                                              "; up axis " + frame.up + " from " +
-                                                              frame.up_source);
+  character->frame_provenance = "unit scale " + detail::Fmt(frame.scale) + " m/unit from " +
+                                frame.scale_source + "; up axis " + frame.up + " from " +
+                                frame.up_source;
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool specified = extension == ".gltf" || extension == ".glb";  // metres, +Y up by spec
+  const bool assumed = frame.scale_source.find(", then x") != std::string::npos ||
+                       (!specified && (frame.scale_source.rfind("format default", 0) == 0 ||
+                                       frame.up_source == "format default"));
+  if (assumed) {
+    character->warnings.insert(character->warnings.begin(), character->frame_provenance);
+  }
 }
 
 // The import's stages, in this process.

@@ -396,6 +396,7 @@ void StartAsset(const Character& character, CharacterAsset* asset, json* report)
   asset->mesh = character.mesh;
 
   (*report)["unit_scale"] = character.info.unit_scale;
+  (*report)["frame"] = character.frame_provenance;
   (*report)["up_axis"] = character.info.up_axis;
   json matrix = json::array();
   for (int r = 0; r < 4; ++r) {

@@ -15,6 +15,9 @@ struct Character {
   MeshData mesh;                // bind pose, welded, weights renormalised
   double source_to_asset[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // row-major 4x4
   std::vector<std::string> warnings;  // for the bake report
+  // Where the unit scale and up axis came from (config, file metadata, format default): the
+  // report's "frame". A warning too when it was assumed rather than read.
+  std::string frame_provenance;
 };
 
 }  // namespace drape::bake
