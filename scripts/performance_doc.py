@@ -87,7 +87,27 @@ def read_rows(out):
             r["base"], _, pose = r["character"].partition(" posed (")
             r["posed"] = pose.rstrip(")")
             rows.append(r)
-    return rows
+    # The tables show each character at rest and in its first measured pose; the CSV holds the
+    # others (the full sweep poses characters at 40 % and 80 % of their longest clip).
+    first_pose = {}
+    for r in rows:
+        if r["posed"]:
+            first_pose.setdefault(r["base"], r["posed"])
+    return [r for r in rows if not r["posed"] or r["posed"] == first_pose[r["base"]]]
+
+
+def read_proxy_rows(out):
+    """{character at rest: {query set: row}} of the default hulls and joint colliders."""
+    path = os.path.join(out, "speed_vs_error.csv")
+    proxies = {}
+    if not os.path.exists(path):
+        return proxies
+    with open(path, newline="", encoding="utf-8") as f:
+        for r in csv.DictReader(f):
+            if (r["family"] == "hulls+spheres" and r["setting"].startswith("default (")
+                    and r["setting"].endswith("spheres)") and " posed (" not in r["character"]):
+                proxies.setdefault(r["character"], {})[r["query_set"]] = r
+    return proxies
 
 
 def read_sections(out):
@@ -259,8 +279,6 @@ def needs(doc, rows):
         "ray", [r for r in people if r["setting"].endswith("(paper B)")])
     row("the exact answer (reference)", "winding number + CGAL AABB tree",
         [r for r in rows if r["peer"] and r["setting"].startswith("exact")], "exact")
-    doc.add("", "Hulls fit coarse or smoothly weighted rigs badly, and joint spheres alone are "
-            "no body collider: see the missed column of every character below.")
 
 
 def charts(doc, characters):
@@ -321,6 +339,7 @@ def speed_vs_error(doc, rows, sections):
                     f"{ratio(fcl, h)} |")
         doc.source("speed against error")
 
+    proxy_targets(doc, read_proxy_rows(doc.out))
     doc.add("### Charts", "",
             "x: ns per particle at one thread (log); y: p99 penetration after response and the "
             "missed rate; one marker per setting, the line is the Pareto front, dashed lines the "
@@ -384,21 +403,48 @@ def key_rows(rs):
         if best is not front[0]:
             tag(best, "P")
     for r in rs:
-        if default_maps(r) or default_hulls(r):
+        # Posed, the default maps only add their cost (the cheapest passing maps show the pose).
+        if (default_maps(r) and not posed) or default_hulls(r):
             tag(r, "default")
     tag(cheapest(rs, passes), "cheapest passing")
     if not posed:
-        tag(cheapest(rs, clean_continuous_hulls), "cheapest continuous hulls")
         tag(cheapest(rs, lambda r: r["family"] == "maps+hulls"), "maps + hulls")
     return sorted(tags.values(), key=lambda t: t[0]["ns_per_particle_1t"] or 0)
+
+
+def proxy_targets(doc, proxies):
+    if not proxies:
+        return
+    doc.add("### Proxy colliders (hulls + joint colliders, defaults, rest pose)", "",
+            "Targets: motions that start clear of the body (thin crossings, fast segments) missed "
+            "≤ 0.5 %; penetration after the response p99 ≤ 5 mm, max ≤ 20 mm; ≤ 150 ns per "
+            "particle on people. Bold: not met. The bake report's `fit` gives each collider's "
+            "bloat and the body's coverage.", "",
+            "| character | colliders | missed % thin / fast | p99 / max mm thin + fast | ns 1t |",
+            "|---|---|---|---|---|")
+    for c, sets in proxies.items():
+        thin, fast, every = sets.get("thin_crossing"), sets.get("fast"), sets.get("all")
+        if not (thin and fast and every):
+            continue
+        missed = [float(thin["missed_rate"]) * 100, float(fast["missed_rate"]) * 100]
+        p99 = max(float(thin["penetration_p99_mm"]), float(fast["penetration_p99_mm"]))
+        worst = max(float(thin["penetration_max_mm"]), float(fast["penetration_max_mm"]))
+        speed = float(every["ns_per_particle_1t"])
+        bold = lambda text, bad: f"**{text}**" if bad else text  # noqa: E731
+        counts = every["setting"].rsplit("(", 1)[-1].rstrip(")")
+        doc.add(f"| {c} | {counts} | "
+                f"{bold(f'{missed[0]:.2f} / {missed[1]:.2f}', max(missed) > 0.5)} | "
+                f"{bold(f'{p99:.1f} / {worst:.1f}', p99 > 5 or worst > 20)} | "
+                f"{bold(ns(speed), every['human'] == '1' and speed > 150)} |")
+    doc.source("speed against error")
 
 
 def characters_table(doc, characters):
     doc.add("### Every character", "",
             "Per character and pose: the fastest and the most accurate point of the Pareto fronts "
-            "(P), the bake's defaults, the cheapest setting meeting the body-map target, the "
-            "cheapest continuous hull setting and maps with hulls. People posed 40 % into their "
-            "longest clip (full sweep): the cheapest passing maps and the defaults.", "",
+            "(P), the bake's defaults, the cheapest setting meeting the body-map target and maps "
+            "with hulls. People posed 40 % into their longest clip (full sweep): the cheapest "
+            "passing maps and the default hulls.", "",
             "| character | method | setting | ns 1t / 2t | missed % | p99 mm | false % | normal "
             "p50 ° | baked | why |", "|---|---|---|---|---|---|---|---|---|---|")
     for c, rs in characters.items():
