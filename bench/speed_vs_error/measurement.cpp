@@ -1,5 +1,6 @@
 #include "measurement.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -185,8 +186,12 @@ void Measurement::MeasureDefaultHullVariants(const Context& context, const Chara
        HullResponse::kMapTableRay, true},
       {", discrete (end position only)", InsideTest::kPlanes, HullResponse::kPushOut, false},
   };
+  // A hull the bake kept without Kirkpatrick hierarchies rules the Kirkpatrick test out.
+  const bool hierarchies =
+      std::all_of(a.hulls.begin(), a.hulls.end(),
+                  [](const HullColliderData& h) { return !h.upper.node_triangles.empty(); });
   for (const Variant& v : variants) {
-    if (options_.quick && v.inside == InsideTest::kKirkpatrick) continue;
+    if ((options_.quick || !hierarchies) && v.inside == InsideTest::kKirkpatrick) continue;
     HullColliderOptions o;
     o.inside_test = v.inside;
     o.response = v.response;

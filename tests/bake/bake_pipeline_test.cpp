@@ -63,6 +63,12 @@ TEST_P(BakeEveryCharacter, HullsContainTheirRigidVerticesAndAreConvex) {
   bake::Regions regions;
   ASSERT_TRUE(bake::SplitRegions(character, config.rigid_threshold, &regions).ok());
   ASSERT_FALSE(result.asset.hulls.empty());
+  // A hull whose Kirkpatrick hierarchy cannot be built is kept (the plane test covers it):
+  // RiggedFigure's head lost its only collider that way.
+  for (const auto& left : result.report["hulls"]["left_out"]) {
+    EXPECT_EQ(left["reason"].get<std::string>().rfind("Kirkpatrick", 0), std::string::npos)
+        << left.dump();
+  }
   // A bone may have several convex pieces: each rigid vertex's delta-ball is inside one of them.
   std::vector<std::vector<const HullColliderData*>> hulls_of(regions.collider_frames.size());
   for (const HullColliderData& hull : result.asset.hulls) {

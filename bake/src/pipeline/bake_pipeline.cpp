@@ -158,6 +158,12 @@ struct HullJob {
 std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
                               std::span<const uint32_t> triangles, const MeshReference& body,
                               uint32_t joints) {
+  const auto region_of = [&](size_t j) {
+    std::vector<uint32_t> region = regions.rigid_vertices[j];
+    region.insert(region.end(), regions.shaping_vertices[j].begin(),
+                  regions.shaping_vertices[j].end());
+    return region;
+  };
   std::vector<std::vector<ConvexPiece>> split(joints);
   if (config.hull_max_pieces > 1) {
     ConvexPieceOptions options;
@@ -173,9 +179,7 @@ std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
       // One bone per iteration, results in per-bone slots: identical at any thread count.
 #pragma omp parallel for schedule(dynamic, 1)
     for (int64_t j = 0; j < static_cast<int64_t>(joints); ++j) {
-      std::vector<uint32_t> region = regions.rigid_vertices[j];
-      region.insert(region.end(), regions.shaping_vertices[j].begin(),
-                    regions.shaping_vertices[j].end());
+      const std::vector<uint32_t> region = region_of(static_cast<size_t>(j));
       if (region.empty()) continue;
       split[j] = SplitIntoConvexPieces(regions.rest_positions, triangles, region, body, options);
     }
@@ -196,9 +200,7 @@ std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
       for (uint32_t k = 0; k < n; ++k) add(split[j][k].vertices, k, n, split[j][k].bloat);
       continue;
     }
-    std::vector<uint32_t> region = regions.rigid_vertices[j];
-    region.insert(region.end(), regions.shaping_vertices[j].begin(),
-                  regions.shaping_vertices[j].end());
+    const std::vector<uint32_t> region = region_of(j);
     if (!region.empty()) add(region, 0, 1, split[j].empty() ? 0.0 : split[j][0].bloat);
   }
   return jobs;
@@ -210,6 +212,9 @@ struct BoneHull {
   HullStats stats;
   Status status;
   KirkpatrickStats kirkpatrick;
+  // Why the hull has no Kirkpatrick hierarchies (empty: it has them). The hull is kept: the
+  // default plane test does not need them, and a body part without a collider lets cloth in.
+  std::string kirkpatrick_failure;
   MapTableStats table;
 };
 
@@ -225,8 +230,10 @@ std::vector<BoneHull> BuildBoneHulls(const BakeConfig& config, const std::vector
   for (int64_t i = 0; i < static_cast<int64_t>(jobs.size()); ++i) {
     BoneHull& b = built[i];
     b.status = BuildHullGeometry(jobs[i].points, config.hull, &b.hull, &b.stats);
-    if (b.status.ok()) b.status = BuildKirkpatrick(&b.hull, config.kirkpatrick, &b.kirkpatrick);
-    if (b.status.ok()) b.status = BuildMapTable(&b.hull, map_options, &b.table);
+    if (!b.status.ok()) continue;
+    const Status kirkpatrick = BuildKirkpatrick(&b.hull, config.kirkpatrick, &b.kirkpatrick);
+    if (!kirkpatrick.ok()) b.kirkpatrick_failure = kirkpatrick.message();
+    b.status = BuildMapTable(&b.hull, map_options, &b.table);
   }
   return built;
 }
@@ -295,11 +302,13 @@ json HullReport(const std::string& bone, const Regions& regions, uint32_t j, con
           {"budget_reached", st.budget_reached},
           {"growth_mm", st.growth_mm},
           {"kirkpatrick",
-           {{"axis", kirkpatrick.axis_index},
-            {"upper_nodes", kirkpatrick.upper.nodes},
-            {"lower_nodes", kirkpatrick.lower.nodes},
-            {"levels", std::max(kirkpatrick.upper.levels, kirkpatrick.lower.levels)},
-            {"mean_tests", kirkpatrick.mean_tests}}},
+           b.kirkpatrick_failure.empty()
+               ? json{{"axis", kirkpatrick.axis_index},
+                      {"upper_nodes", kirkpatrick.upper.nodes},
+                      {"lower_nodes", kirkpatrick.lower.nodes},
+                      {"levels", std::max(kirkpatrick.upper.levels, kirkpatrick.lower.levels)},
+                      {"mean_tests", kirkpatrick.mean_tests}}
+               : json{{"not_built", b.kirkpatrick_failure}}},
           {"map_table",
            {{"kind", table.kind == MapTableKind::kSphere ? "sphere" : "cylinder"},
             {"rows", table.rows},
@@ -361,6 +370,8 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
     entry["piece"] = jobs[i].piece;
     entry["pieces"] = jobs[i].pieces;
     entry["points"] = jobs[i].points.size();
+    // Before inflation and simplification: how far the piece's own convex hull leaves the body.
+    if (jobs[i].pieces > 1) entry["piece_bloat_mm"] = jobs[i].piece_bloat * 1000.0;
     colliders.push_back(std::move(entry));
     asset->hulls.push_back(std::move(hull));
   }
@@ -413,6 +424,22 @@ void StartAsset(const Character& character, CharacterAsset* asset, json* report)
   (*report)["clips"] = clips;
   (*report)["mesh"] = {{"vertices", asset->mesh.vertex_count()},
                        {"triangles", asset->mesh.triangle_count()}};
+}
+
+// Hulls kept without Kirkpatrick hierarchies (their shadow boundary is not one simple cycle on
+// any OBB axis): the default plane test covers them; the Kirkpatrick inside test refuses the asset.
+void WarnAboutHullsWithoutKirkpatrick(const json& hulls, std::vector<std::string>* warnings) {
+  std::string bones;
+  size_t count = 0;
+  for (const json& c : hulls["colliders"]) {
+    if (!c["kirkpatrick"].contains("not_built")) continue;
+    bones += (count++ == 0 ? "'" : ", '") + c["bone"].get<std::string>() + "'";
+  }
+  if (count == 0) return;
+  warnings->push_back(std::to_string(count) + (count == 1 ? " hull has" : " hulls have") +
+                      " no Kirkpatrick hierarchy (" + bones +
+                      "; the report says why): the plane inside test covers them, and "
+                      "HullColliderOptions::inside_test kKirkpatrick refuses this asset");
 }
 
 // A warning when the hulls shape less than kLowHullVertexFraction of the vertices, with advice.
@@ -621,6 +648,7 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     timings["hulls_ms"] = MillisecondsSince(start);
     WarnIfHullsCoverLittle(config, hulls["hull_vertex_fraction"].get<double>(), asset.hulls.size(),
                            &character.warnings);
+    WarnAboutHullsWithoutKirkpatrick(hulls, &character.warnings);
   }
   if (config.spheres_enabled) {
     start = Clock::now();
