@@ -4,8 +4,9 @@
 #  2. formats + runtime alone with -DDRAPE_BUILD_BAKE=OFF: builds, passes its tests, and its link
 #     lines name no assimp, CGAL or OSMesa;
 #  3. cmake --install of that build, and a tiny consumer that find_package(drape)s it;
-#  4. formats + runtime tests again, and the bad-model corpus through drape-bake, under
-#     AddressSanitizer + UndefinedBehaviorSanitizer;
+#  4. formats + runtime tests again (what an engine links and feeds untrusted .drape files),
+#     under AddressSanitizer + UndefinedBehaviorSanitizer; the bad-model corpus through drape-bake
+#     runs in stage 1 (the model reader runs in a child process there);
 #  5. each libFuzzer target over its seed corpus, reproducibly: a fixed seed and 100 000 inputs
 #     (DRAPE_FUZZ_RUNS; scripts/fuzz.sh alone runs a million, or explores with a random seed).
 set -uo pipefail
@@ -74,7 +75,7 @@ install_consumer() {
 }
 check "installed drape::runtime links into a consumer" install_consumer
 
-echo "== 4. formats + runtime tests and the bad-model corpus under ASan + UBSan"
+echo "== 4. formats + runtime tests under ASan + UBSan"
 if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     LSAN_OPTIONS=suppressions=$root/tests/tools/lsan_suppressions.txt run_ctest build-sanitize
