@@ -25,7 +25,9 @@ struct Regions {
   std::vector<Mat34> collider_frames;  // per joint: rigid rest-pose joint frame -> asset
   std::vector<std::vector<uint32_t>> rigid_vertices;  // per joint
   // Per joint: flexible vertices whose heaviest bone it is, at a weight in [shape_threshold,
-  // rigid_threshold) (ties go to the lower joint index). They shape the bone's hull as well as being in their joint sphere.
+  // rigid_threshold) (ties go to the lower joint index); with shape_threshold 0, the corners of
+  // the triangles the bone carries most of. They shape the bone's hull (flexible ones stay in
+  // their joint sphere too).
   std::vector<std::vector<uint32_t>> shaping_vertices;
   std::vector<JointRegion> joints;  // one per bone pair with flexible vertices
 };

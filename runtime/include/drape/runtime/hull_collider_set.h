@@ -276,7 +276,7 @@ class HullColliderSet {
   std::vector<SphereRecord> spheres_;
   // Planes, SoA, each hull's range padded to a multiple of 8 with planes that never win.
   SimdFloats plane_nx_, plane_ny_, plane_nz_, plane_d_;
-  std::vector<Plane> planes_;  // unpadded copy, plane_begin-relative as in the SoA
+  std::vector<Plane> planes_;            // unpadded copy, plane_begin-relative as in the SoA
   std::vector<uint8_t> plane_internal_;  // per plane as planes_: 1 for a cut between pieces
   // Triangles for the map-table ray: 9 floats (3 vertices) each, plus their planes.
   std::vector<float> ray_triangles_;
