@@ -175,9 +175,9 @@ double DistanceSquared(Float3 a, Float3 b) {
   return dx * dx + dy * dy + dz * dz;
 }
 
-// How bad an iterate is, from the contacts of the segment previous -> iterate: first the number
-// of colliders the segment passes through and ends outside (the particle tunnelled), then the
-// deepest the iterate lies inside one. Lower is better; ties go to the later iterate.
+// How bad an iterate is, from the contacts of the segment previous -> iterate: first the deepest
+// it lies inside one of them, then the number of colliders the segment passes through and ends
+// outside (the particle tunnelled). Lower is better; ties go to the later iterate.
 struct IterateScore {
   uint32_t crossings = 0;
   float depth = 0.f;  // metres
@@ -242,7 +242,7 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
   double budget_squared = 0.0;
   // The best iterate so far (Gauss-Seidel passes can make a pinched particle worse).
   Float3 best_position = position, best_velocity = vel;
-  IterateScore best_score{UINT32_MAX, 0.f};
+  IterateScore best_score{UINT32_MAX, INFINITY};  // worse than any iterate
   ContactFrames pass_contacts;
   const auto score_of = [&](const ContactFrames& c) {
     IterateScore score;
