@@ -571,6 +571,67 @@ TEST(HullColliderTest, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
   }
 }
 
+// 78 colliders (two and a half words of the grouped broad phase's masks), crowded so that the
+// particles in the middle reach more than kMaxCandidates of them: the grouped first broad phase
+// (selected substep) keeps exactly the candidates of each particle's own broad phase (other
+// fractions), at every instruction set.
+TEST(HullColliderTest, GroupedBroadPhaseOfManyCollidersMatchesThePerParticleOne) {
+  std::mt19937 rng(21);
+  std::vector<HullColliderData> hulls;
+  for (int i = 0; i < 48; ++i) {
+    Float3 axes[3];
+    RotatedAxes(7.5 * i, {1.f, float(i % 5), 0.5f}, axes);
+    HullColliderData h =
+        MakeEllipsoid({0.04f, 0.08f, 0.05f}, 1,
+                      RandomIn(rng, {-0.06f, -0.06f, -0.06f}, {0.06f, 0.06f, 0.06f}), axes);
+    h.joint = i % 3;
+    hulls.push_back(h);
+  }
+  std::vector<JointSphereData> spheres;
+  for (int i = 0; i < 30; ++i) {
+    spheres.push_back({i % 3, -1, RandomIn(rng, {-0.03f, -0.03f, -0.03f}, {0.03f, 0.03f, 0.03f}),
+                       0.05f + 0.001f * float(i)});
+  }
+  HullColliderSet set = BuildSet(hulls, spheres, 3);
+  const std::vector<Mat34> start = {Mat34{}, RotationAbout(-10, {0, 1, 0}, {0.1f, 0, 0}), Mat34{}};
+  const std::vector<Mat34> end = {RotationAbout(5, {0, 0, 1}, {0, 0, 0}),
+                                  RotationAbout(10, {0, 1, 0}, {0.1f, 0, 0}),
+                                  RotationAbout(-8, {1, 0, 0}, {0.f, 0.1f, 0})};
+  ASSERT_TRUE(set.SetPose(start, end).ok());
+  std::vector<Float3> previous, positions, velocities;
+  for (int i = 0; i < 6003; ++i) {
+    const Float3 p = RandomIn(rng, {-0.2f, -0.2f, -0.2f}, {0.2f, 0.2f, 0.2f});
+    previous.push_back(p);
+    positions.push_back(p + RandomIn(rng, {-0.03f, -0.03f, -0.03f}, {0.03f, 0.03f, 0.03f}));
+    velocities.push_back(RandomIn(rng, {-1, -1, -1}, {1, 1, 1}));
+  }
+  const ResponseParams params;
+  const float s0 = 0.25f, s1 = 0.5f;
+  std::vector<Float3> p1 = positions, v1 = velocities;
+  std::vector<uint8_t> f1(positions.size());
+  uint32_t c1 = 0;
+  ASSERT_TRUE(set.CollideBatch(previous, p1, v1, f1, params, s0, s1, &c1).ok());  // per particle
+  EXPECT_GT(c1, 400u);
+  for (InstructionSet instruction_set :
+       {InstructionSet::kScalar, InstructionSet::kSse2, InstructionSet::kAvx2}) {
+    HullColliderOptions options;
+    options.instruction_set = instruction_set;
+    ASSERT_TRUE(set.SetOptions(options).ok());
+    if (set.instruction_set() != instruction_set) continue;  // the CPU lacks it
+    SCOPED_TRACE(ToString(instruction_set));
+    ASSERT_TRUE(set.SelectSubstep(s0, s1).ok());
+    std::vector<Float3> p2 = positions, v2 = velocities;
+    std::vector<uint8_t> f2(positions.size());
+    uint32_t c2 = 0;
+    ASSERT_TRUE(set.CollideBatch(previous, p2, v2, f2, params, s0, s1, &c2).ok());  // grouped
+    EXPECT_EQ(c1, c2);
+    EXPECT_EQ(std::memcmp(p1.data(), p2.data(), p1.size() * sizeof(Float3)), 0);
+    EXPECT_EQ(std::memcmp(v1.data(), v2.data(), v1.size() * sizeof(Float3)), 0);
+    EXPECT_EQ(f1, f2);
+    ASSERT_TRUE(set.SelectSubstep(0.f, 1.f).ok());
+  }
+}
+
 TEST(HullColliderTest, InvalidInputIsFlaggedAndLeftUntouched) {
   HullColliderSet set = BuildSet({MakeBox({0.1f, 0.1f, 0.1f})}, {}, 1);
   const float nan = std::nanf(""), inf = std::numeric_limits<float>::infinity();

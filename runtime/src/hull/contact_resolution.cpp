@@ -194,8 +194,13 @@ uint32_t HullColliderSet::ParticleContacts(Float3 p0, Float3 p1, float s0, float
                                            ContactFrames* out) const {
   uint32_t count = 0;
   if (first_candidates != nullptr) {
-    for (uint32_t mask = *first_candidates; mask != 0; mask &= mask - 1)
-      out->candidates[count++] = static_cast<uint32_t>(__builtin_ctz(mask));
+    // The lowest kMaxCandidates indices, as BroadPhase keeps.
+    const uint32_t words = (collider_count_ + 31) / 32;
+    for (uint32_t w = 0; w < words; ++w) {
+      for (uint32_t mask = first_candidates[w]; mask != 0 && count < kMaxCandidates;
+           mask &= mask - 1)
+        out->candidates[count++] = 32 * w + static_cast<uint32_t>(__builtin_ctz(mask));
+    }
   } else {
     count = BroadPhase(p0, p1, s0, s1, kActive, out->candidates);
   }

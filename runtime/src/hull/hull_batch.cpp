@@ -16,24 +16,30 @@ uint32_t HullColliderSet::BroadPhase(Float3 p0, Float3 p1, float s0, float s1, b
   // Sphere around the particle's segment against the colliders' swept spheres. The whole-step
   // spheres filter first when the fractions are not the selected ones; the candidates are then
   // tested against their swept sphere over [s0, s1] computed here, with the same arithmetic as
-  // SelectSubstep's, so both paths keep exactly the same candidates.
-  const float* xs = active ? sweep_x_.data() : full_x_.data();
-  const float* ys = active ? sweep_y_.data() : full_y_.data();
-  const float* zs = active ? sweep_z_.data() : full_z_.data();
-  const float* rs = active ? sweep_r_.data() : full_r_.data();
+  // SelectSubstep's, so both paths keep exactly the same candidates: the lowest kMaxCandidates
+  // indices that pass the swept test (the whole-step test runs in chunks until that many pass).
   const Float3 mid = (p0 + p1) * 0.5f;
   const float half = Length(p1 - p0) * 0.50001f;
-  uint32_t count =
-      kernels_->spheres(xs, ys, zs, rs, collider_count_, mid, half, out, kMaxCandidates);
-  if (active) return count;
+  if (active) {
+    return kernels_->spheres(sweep_x_.data(), sweep_y_.data(), sweep_z_.data(), sweep_r_.data(),
+                             collider_count_, mid, half, out, kMaxCandidates);
+  }
+  constexpr uint32_t kChunk = 64;  // colliders per whole-step test, a multiple of kPlanePad
+  uint32_t whole_step[kChunk];
   uint32_t kept = 0;
-  for (uint32_t i = 0; i < count; ++i) {
-    Float3 center;
-    float radius;
-    ComputeSweep(out[i], s0, s1, &center, &radius);
-    const float dx = mid.x - center.x, dy = mid.y - center.y, dz = mid.z - center.z;
-    const float rr = radius + half;
-    if (dx * dx + dy * dy + dz * dz <= rr * rr) out[kept++] = out[i];
+  for (uint32_t base = 0; base < collider_count_ && kept < kMaxCandidates; base += kChunk) {
+    const uint32_t chunk = std::min(kChunk, collider_count_ - base);
+    const uint32_t count = kernels_->spheres(&full_x_[base], &full_y_[base], &full_z_[base],
+                                             &full_r_[base], chunk, mid, half, whole_step, kChunk);
+    for (uint32_t i = 0; i < count && kept < kMaxCandidates; ++i) {
+      const uint32_t k = base + whole_step[i];
+      Float3 center;
+      float radius;
+      ComputeSweep(k, s0, s1, &center, &radius);
+      const float dx = mid.x - center.x, dy = mid.y - center.y, dz = mid.z - center.z;
+      const float rr = radius + half;
+      if (dx * dx + dy * dy + dz * dz <= rr * rr) out[kept++] = k;
+    }
   }
   return kept;
 }
@@ -60,24 +66,29 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
   const bool active = substep_start == active_s0_ && substep_end == active_s1_;
   const int64_t count = static_cast<int64_t>(n);
   uint32_t contacts = 0;
-  if (active && collider_count_ <= 32) {
+  if (active && collider_count_ <= kMaxGroupedColliders) {
     // The first broad phase of a group of particles at once (four or eight: the kernels' lane
     // count; no branch per particle and collider); a particle without candidates is done
     // (ResolveParticle would leave it as it is).
     const uint32_t width = kernels_->group_width;
+    const uint32_t words = (collider_count_ + 31) / 32;
     const int64_t groups = (count + width - 1) / width;
 #pragma omp parallel for schedule(dynamic, 32) reduction(+ : contacts) if (count > 4096)
     for (int64_t g = 0; g < groups; ++g) {
       const size_t first = static_cast<size_t>(g) * width;
       const uint32_t lanes = static_cast<uint32_t>(std::min<size_t>(width, n - first));
-      uint32_t masks[8];
+      uint32_t masks[8 * kMaxGroupedColliders / 32];
       const uint32_t finite =
           kernels_->sphere_masks(&previous[first], &positions[first], &velocities[first], lanes,
                                  sweep_x_.data(), sweep_y_.data(), sweep_z_.data(), sweep_r_.data(),
                                  collider_count_, sweep_union_center_, sweep_union_radius_, masks);
       // Only the invalid lanes and those with candidates need more; the others are done.
       uint32_t work = ~finite;
-      for (uint32_t l = 0; l < width; ++l) work |= masks[l] != 0 ? 1u << l : 0u;
+      for (uint32_t l = 0; l < width; ++l) {
+        uint32_t any = 0;
+        for (uint32_t w = 0; w < words; ++w) any |= masks[l * words + w];
+        work |= any != 0 ? 1u << l : 0u;
+      }
       work &= (1u << lanes) - 1;
       std::memset(&flags[first], kCollisionNone, lanes);
       for (; work != 0; work &= work - 1) {
@@ -88,7 +99,7 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
           continue;
         }
         ResolveParticle<true>(previous[k], &positions[k], &velocities[k], &flags[k], params,
-                              substep_start, substep_end, &masks[l]);
+                              substep_start, substep_end, &masks[l * words]);
         if (flags[k] & kCollisionContact) ++contacts;
       }
     }

@@ -52,10 +52,12 @@ struct PlaneKernels {
   uint32_t (*spheres)(const float* xs, const float* ys, const float* zs, const float* rs,
                       uint32_t total, Float3 mid, float half, uint32_t* out, uint32_t capacity);
   // The broad phase of group_width particles at once (lanes at and beyond `lanes` repeat the
-  // first): per particle, the bit mask of the colliders k < total (<= 32) that `spheres` keeps for
-  // its segment p0 -> p1 (mid = (p0 + p1) * 0.5, half = |p1 - p0| * 0.50001). A group wholly
-  // outside the union sphere gets empty masks without the per-collider tests. Returns the lanes
-  // whose previous and current positions and velocity are all finite (bit l for lane l).
+  // first): per particle, the bit mask of the colliders k < total that `spheres` keeps for its
+  // segment p0 -> p1 (mid = (p0 + p1) * 0.5, half = |p1 - p0| * 0.50001), in words of 32
+  // colliders: lane l's word w (colliders 32w .. 32w + 31) at masks[l * words + w], words =
+  // ceil(total / 32). A group wholly outside the union sphere gets empty masks without the
+  // per-collider tests. Returns the lanes whose previous and current positions and velocity are
+  // all finite (bit l for lane l).
   uint32_t (*sphere_masks)(const Float3* p0, const Float3* p1, const Float3* velocity,
                            uint32_t lanes, const float* xs, const float* ys, const float* zs,
                            const float* rs, uint32_t total, Float3 union_center, float union_radius,

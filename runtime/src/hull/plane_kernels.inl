@@ -207,21 +207,25 @@ struct PlaneLanes {
     const F ud2 = Add(Add(Mul(ux, ux), Mul(uy, uy)), Mul(uz, uz));
     const F urr = Mul(Add(P::Splat(union_radius), half), P::Splat(1.00001f));
     const F near = LessEq(ud2, Mul(urr, urr));
-    I acc = P::ZeroI();
-    if (LaneBits(And(near, finite)) != 0) {
-      for (uint32_t k = 0; k < total; ++k) {
+    // One 32-bit word per 32 colliders; lane l's word w at masks[l * words + w].
+    const uint32_t words = (total + 31) / 32;
+    const bool any_near = LaneBits(And(near, finite)) != 0;
+    for (uint32_t w = 0; w < words; ++w) {
+      I acc = P::ZeroI();
+      const uint32_t end = total < 32 * w + 32 ? total : 32 * w + 32;
+      for (uint32_t k = 32 * w; any_near && k < end; ++k) {
         const F dx = Sub(mx, P::Splat(xs[k]));
         const F dy = Sub(my, P::Splat(ys[k]));
         const F dz = Sub(mz, P::Splat(zs[k]));
         const F d2 = Add(Add(Mul(dx, dx), Mul(dy, dy)), Mul(dz, dz));
         const F rr = Add(P::Splat(rs[k]), half);
         const F inside = LessEq(d2, Mul(rr, rr));
-        acc = Or(acc, And(AsInt(inside), P::SplatI(static_cast<int32_t>(1u << k))));
+        acc = Or(acc, And(AsInt(inside), P::SplatI(static_cast<int32_t>(1u << (k - 32 * w)))));
       }
+      alignas(32) int32_t stored[P::kCount];
+      P::Store(stored, acc);
+      for (int l = 0; l < P::kCount; ++l) masks[l * words + w] = static_cast<uint32_t>(stored[l]);
     }
-    alignas(32) int32_t stored[P::kCount];
-    P::Store(stored, acc);
-    for (int l = 0; l < P::kCount; ++l) masks[l] = static_cast<uint32_t>(stored[l]);
     return finite_lanes;
   }
 

@@ -211,6 +211,9 @@ class HullColliderSet {
                                Float3 p1) const;
   // At most this many colliders are resolved per particle (the lowest indices).
   static constexpr uint32_t kMaxCandidates = 32;
+  // CollideBatch's grouped broad phase (bit masks of 32-collider words on the stack) up to this
+  // many colliders; beyond, each particle runs its own.
+  static constexpr uint32_t kMaxGroupedColliders = 256;
   uint32_t BroadPhase(Float3 p0, Float3 p1, float s0, float s1, bool active, uint32_t* out) const;
   // One particle's candidates, their transforms and contacts, on the stack (raw storage: only
   // the first `count` are constructed, so the common path does not pay for the rest).
@@ -242,7 +245,7 @@ class HullColliderSet {
   bool InsideAny(Float3 x, uint8_t kinds) const;
   void UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuery* best) const;
   // kActive: the fractions are the selected substep's. first_candidates: the first pass's broad
-  // phase already done, as a bit mask (at most 32 colliders).
+  // phase already done, as bit masks of 32 colliders each (ceil(collider count / 32) words).
   template <bool kActive>
   void ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, uint8_t* flags,
                        const ResponseParams& params, float s0, float s1,
