@@ -53,13 +53,21 @@ Mesh MakeBox(Float3 lo, Float3 hi) {
   return box;
 }
 
-// A hull collider made of the box, carried by joint 0 with the given bind frame.
+// A hull collider made of the box, carried by joint 0 with the given bind frame: one plane per
+// triangle (the inside test uses the planes, the distances and samples the triangles).
 HullColliderData HullOf(const Mesh& box, const Mat34& bind_frame = Mat34{}) {
   HullColliderData hull;
   hull.joint = 0;
   hull.bind_frame = bind_frame;
   hull.vertices = box.positions;
   hull.triangles = box.triangles;
+  for (size_t t = 0; t < box.triangles.size(); t += 3) {
+    const Float3 a = box.positions[box.triangles[t]], b = box.positions[box.triangles[t + 1]],
+                 c = box.positions[box.triangles[t + 2]];
+    const Float3 n = NormalizeOr(Cross(b - a, c - a), {0.f, 1.f, 0.f});
+    hull.triangle_planes.push_back(static_cast<uint32_t>(hull.planes.size()));
+    hull.planes.push_back({n, Dot(n, a)});
+  }
   return hull;
 }
 
@@ -106,6 +114,23 @@ TEST(ColliderFit, AHullPushedOutBloatsByTheExcessBeyondDelta) {
 
 // A 0.3 m sphere around a 0.2 m cube: its surface is 0.3 - 0.1 m from a face centre (less the
 // 5 mm delta: 195 mm) and 0.3 - 0.1 sqrt(3) m from a corner (122 mm).
+// A simplified hull can hold sliver triangles whose float normals point anywhere. The inside
+// test is the hull's planes (as at run time), so a sliver on the top face wound the wrong way
+// changes neither the coverage nor the bloat (a plane through it would call the hull outside).
+TEST(ColliderFit, ASliverTriangleDoesNotTurnTheHullInsideOut) {
+  const Mesh body = MakeBox({-0.2f, -0.3f, -0.1f}, {0.2f, 0.3f, 0.1f});
+  HullColliderData hull = HullOf(body);
+  const uint32_t sliver = static_cast<uint32_t>(hull.vertices.size());
+  hull.vertices.push_back({0.f, 0.3f, -0.1f + 1e-6f});  // just off the top face's edge x = 0
+  hull.vertices.push_back({0.f, 0.3f, 0.1f});
+  hull.vertices.push_back({1e-6f, 0.3f, 0.f});  // wound facing -y, into the hull
+  hull.triangles.insert(hull.triangles.end(), {sliver, sliver + 2, sliver + 1});
+  hull.triangle_planes.push_back(0);
+  const ColliderFit fit = Fit(body, {hull}, {});
+  EXPECT_EQ(fit.coverage, 1.0);
+  EXPECT_LT(fit.hulls[0].max_mm, 1e-3);
+}
+
 TEST(ColliderFit, ASphereLargerThanTheBodyBloatsByItsExcess) {
   const Mesh body = MakeBox({-0.1f, -0.1f, -0.1f}, {0.1f, 0.1f, 0.1f});
   JointSphereData sphere;

@@ -21,7 +21,8 @@ struct PlacedHull {
   bool placed = false;
   std::vector<double> vertices;  // 3 per vertex, metres
   std::vector<uint32_t> triangles;
-  std::vector<double> planes;  // 4 per triangle: unit outward normal n, offset d (n.p = d on it)
+  // 4 per plane of the hull (the runtime's inside test): unit outward normal n, offset d.
+  std::vector<double> planes;
   double lo[3] = {INFINITY, INFINITY, INFINITY};
   double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
 };
@@ -58,18 +59,25 @@ PlacedHull PlaceHull(const HullColliderData& hull, std::span<const Mat34> rest_s
     if (corner[0] >= vertex_count || corner[1] >= vertex_count || corner[2] >= vertex_count)
       continue;
     placed.triangles.insert(placed.triangles.end(), corner, corner + 3);
-    const double* a = &placed.vertices[3 * size_t{corner[0]}];
-    const double* b = &placed.vertices[3 * size_t{corner[1]}];
-    const double* c = &placed.vertices[3 * size_t{corner[2]}];
-    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                   e1[0] * e2[1] - e1[1] * e2[0]};
-    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    // A zero-area triangle bounds nothing: its plane (0, 0) never rejects a point.
-    for (double& x : n) x = length > 0.0 ? x / length : 0.0;
+  }
+  // The baked planes, not planes through the triangles: a simplified hull's sliver triangles
+  // give normals of any direction, and such a plane would call most of the hull outside.
+  // Normals move by the inverse transpose (bind_frame may scale), a point of the plane by world.
+  Mat34 to_local;
+  if (!InverseAffine(world, &to_local)) return placed;
+  for (const Plane& plane : hull.planes) {
+    const Float3 n = plane.normal;
+    double m[3] = {0, 0, 0};
+    for (int r = 0; r < 3; ++r) {  // (to_local's 3x3)^T n
+      m[r] = double(to_local.m[r]) * n.x + double(to_local.m[4 + r]) * n.y +
+             double(to_local.m[8 + r]) * n.z;
+    }
+    const double length = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    if (!(length > 0.0)) continue;
+    for (double& x : m) x /= length;
+    const Float3 on = TransformPoint(world, n * plane.offset);
     placed.planes.insert(placed.planes.end(),
-                         {n[0], n[1], n[2], n[0] * a[0] + n[1] * a[1] + n[2] * a[2]});
+                         {m[0], m[1], m[2], m[0] * on.x + m[1] * on.y + m[2] * on.z});
   }
   return placed;
 }
