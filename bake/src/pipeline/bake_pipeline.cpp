@@ -187,20 +187,19 @@ std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
   std::vector<HullJob> jobs;
   for (uint32_t j = 0; j < joints; ++j) {
     const Mat34 to_collider = InverseRigid(regions.collider_frames[j]);
-    const auto add = [&](std::span<const uint32_t> vertices, uint32_t piece, uint32_t pieces,
+    const auto add = [&](std::span<const Float3> rest_points, uint32_t piece, uint32_t pieces,
                          double bloat) {
       HullJob job{j, piece, pieces, {}, bloat};
-      for (uint32_t v : vertices) {
-        job.points.push_back(TransformPoint(to_collider, regions.rest_positions[v]));
-      }
+      for (const Float3& p : rest_points) job.points.push_back(TransformPoint(to_collider, p));
       jobs.push_back(std::move(job));
     };
     if (split[j].size() > 1) {
       const uint32_t n = static_cast<uint32_t>(split[j].size());
-      for (uint32_t k = 0; k < n; ++k) add(split[j][k].vertices, k, n, split[j][k].bloat);
+      for (uint32_t k = 0; k < n; ++k) add(split[j][k].points, k, n, split[j][k].bloat);
       continue;
     }
-    const std::vector<uint32_t> region = region_of(j);
+    std::vector<Float3> region;
+    for (uint32_t v : region_of(j)) region.push_back(regions.rest_positions[v]);
     if (!region.empty()) add(region, 0, 1, split[j].empty() ? 0.0 : split[j][0].bloat);
   }
   return jobs;

@@ -20,16 +20,17 @@ struct ConvexPieceOptions {
 };
 
 struct ConvexPiece {
-  std::vector<uint32_t> vertices;  // indices into the rest positions, sorted
-  double bloat = 0.0;  // metres: how far the convex hull of the vertices reaches out of the body
+  // Rest-pose points: the piece's region vertices and where the cuts crossed its triangles.
+  std::vector<Float3> points;
+  double bloat = 0.0;  // metres: how far the convex hull of the points reaches out of the body
 };
 
 // `vertices`: the bone's region (indices into rest_positions); `triangles`: the rest-pose mesh's
-// triangles (those with all three corners in the region travel whole with one piece, so the
-// pieces' hulls together hold every such triangle). `body`: the rest-pose body. The worst piece
-// is cut in two while it bloats beyond max_bloat and the budget allows, by the plane (across one
-// of its three principal axes, at one of seven quantiles) that leaves the least hull volume: a
-// hull that bridges two parts holds air, which a cut between them removes. Deterministic.
+// triangles (those with all three corners in the region are clipped by the cuts, so the pieces'
+// hulls together hold every such triangle). `body`: the rest-pose body. The worst piece is cut
+// in two while it bloats beyond max_bloat and the budget allows: of the planes across its three
+// principal axes and the frame's three axes at seven quantiles, the three that leave the least
+// hull volume are measured, and the one whose worse side bloats least wins. Deterministic.
 std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_positions,
                                                std::span<const uint32_t> triangles,
                                                std::span<const uint32_t> vertices,
