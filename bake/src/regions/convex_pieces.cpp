@@ -216,6 +216,7 @@ bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece*
 std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_positions,
                                                std::span<const uint32_t> triangles,
                                                std::span<const uint32_t> vertices,
+                                               std::span<const Float3> interior,
                                                const MeshReference& body,
                                                const ConvexPieceOptions& options) {
   const Context c{body};
@@ -234,6 +235,7 @@ std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_posi
   for (uint32_t v : vertices) {
     if (!in_triangle[v]) whole.loose.push_back(ToVec3(rest_positions[v]));
   }
+  for (const Float3& p : interior) whole.loose.push_back(ToVec3(p));
   detail::SortUnique(&whole.loose);
   whole.bloat = Bloat(c, PiecePoints(whole));
   std::vector<WorkPiece> pieces{std::move(whole)};

@@ -64,8 +64,9 @@ struct HullColliderData {
   std::vector<uint32_t> triangle_planes;  // plane index of each triangle
   std::vector<Plane> planes;              // coplanar triangles share one plane
   // Per plane, 1 when its face lies inside the body: the cut between two convex pieces of one
-  // bone. A particle inside leaves through the nearest other face (leaving through the cut would
-  // put it in the neighbouring piece). Empty: no such face.
+  // bone, or a bone's end buried in its neighbour. A particle inside leaves through the nearest
+  // other face (leaving through it would put it in the neighbouring collider). Empty: no such
+  // face.
   std::vector<uint8_t> plane_internal;
   Obb obb;
   Float3 projection_axis;             // unit; "upper" faces have dot(n, axis) > 0
