@@ -483,6 +483,32 @@ std::vector<HullColliderData> SceneHulls() {
 // Two slabs that overlap by a centimetre and face each other 2 degrees off parallel (a thigh
 // pressed against a thigh): their response planes meet in a line far away. The particle must
 // not be thrown along it: it ends near where it started (the pinch has no room), finite.
+// Two halves of a body that overlap by 2 cm across their cut, the cut faces not flagged (a bone's
+// end buried in its neighbour looks the same). A particle at rest inside both, nearest to the
+// cut faces: each one's exit lies inside the other, so pushing out of one and then the other
+// leaves it inside. The nearest exit of the union is the shared face 30 mm away (within twice the
+// sum of the depths, 8 + 12 mm), where CollideBatch and Query put it.
+TEST(HullColliderTest, AParticleInsideTwoHalvesLeavesThroughTheirUnionsNearestFace) {
+  const HullColliderData left = MakeBox({0.055f, 0.1f, 0.09f}, {-0.045f, 0.f, -0.01f});
+  const HullColliderData right = MakeBox({0.055f, 0.1f, 0.09f}, {0.045f, 0.f, -0.01f});
+  HullColliderSet set = BuildSet({left, right}, {}, 1);
+  const Float3 p = {0.002f, 0.f, 0.05f};
+  ASSERT_LT(MaxPlane(left, p), 0.f);
+  ASSERT_LT(MaxPlane(right, p), 0.f);
+  std::vector<Float3> previous = {p}, positions = {p}, velocities = {{0.f, 0.f, 0.f}};
+  std::vector<uint8_t> flags(1);
+  ASSERT_TRUE(set.CollideBatch(previous, positions, velocities, flags, ResponseParams{}).ok());
+  EXPECT_TRUE(flags[0] & kCollisionContact);
+  EXPECT_GT(MaxPlane(left, positions[0]), 0.f);
+  EXPECT_GT(MaxPlane(right, positions[0]), 0.f);
+  EXPECT_NEAR(positions[0].z, 0.08f, 1e-3f);
+  EXPECT_NEAR(positions[0].x, p.x, 1e-3f);
+  const ContactQuery c = set.Query(p, p);
+  ASSERT_TRUE(c.contact);
+  EXPECT_NEAR(c.point.z, 0.08f, 1e-3f);
+  EXPECT_NEAR(c.normal.z, 1.f, 1e-5f);
+}
+
 TEST(HullColliderTest, NearlyOpposingCollidersDoNotThrowAParticleAway) {
   Float3 axes_b[3];
   RotatedAxes(2.0, {0.f, 0.f, 1.f}, axes_b);

@@ -280,7 +280,7 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
       converged = true;
       break;
     }
-    const ContactQuery* contacts = pass_contacts.contacts();
+    ContactQuery* contacts = pass_contacts.contacts();
     uint32_t* order = pass_contacts.order;
     if (pass == 0) budget_squared = Budget(p0, position, pass_contacts, params.separation);
     // Deepest first; ties keep collider order (insertion sort is stable).
@@ -292,6 +292,20 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
         --j;
       }
       order[j] = key;
+    }
+    // Inside from the start: when the deepest collider's exit lies inside another, the nearest
+    // face exit of their union instead, if within the budget (out of the torso piece into its
+    // neighbour, and back, leaves the particle inside both). Beyond it (the exit of two
+    // overlapping colliders is their crease, no single face's), the contact planes find it.
+    ContactQuery& deepest = contacts[order[0]];
+    if ((deepest.flags & kCollisionStartedInside) != 0 &&
+        InsideAnyCandidate(ExitProbe(deepest), pass_contacts)) {
+      ContactQuery exit;
+      if (NearestUnionExit(position, pass_contacts, &exit) &&
+          DistanceSquared(exit.point, p0) <= budget_squared) {
+        exit.flags = deepest.flags;
+        deepest = exit;
+      }
     }
     for (uint32_t rank = 0; rank < hits; ++rank) {
       const uint32_t i = order[rank];

@@ -174,37 +174,31 @@ bool HullColliderSet::InsideAny(Float3 x, uint8_t kinds) const {
 }
 
 void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuery* best) const {
-  // Candidates: the exit of every collider the end is inside, followed out of whatever other
-  // collider it lands in (at most three hops). The one nearest p1 that is outside all of them
-  // and within the particle's reach (its motion plus kUnionDepthFactor times the sum of its
-  // depths, from p0: the bound every response keeps) wins. None: the deepest contact stays.
+  // The exits of every collider the end is inside (each outer face, each sphere), nearest first
+  // (union_exit.cpp); the first that is outside every collider of `kinds` and within the
+  // particle's reach (its motion plus kUnionDepthFactor times the sum of its depths, from p0:
+  // the bound every response keeps) wins. None: the deepest contact stays.
   double reach = std::sqrt(double(Dot(p1 - p0, p1 - p0)));
-  for (uint32_t k = 0; k < motions_.size(); ++k) {
-    if (HasKind(k, kinds))
-      reach += kUnionDepthFactor * ColliderContact(k, active_[k], p1, p1).depth;
-  }
-  double nearest = std::numeric_limits<double>::infinity();
+  uint32_t holding[kMaxCandidates];
+  const ActiveFrames* frames[kMaxCandidates];
+  uint32_t count = 0;
   for (uint32_t k = 0; k < motions_.size(); ++k) {
     if (!HasKind(k, kinds)) continue;
-    ContactQuery c = ColliderContact(k, active_[k], p1, p1);
-    if (!c.inside_end) continue;
-    for (int hop = 0; hop < 4 && c.contact; ++hop) {
-      const double distance = std::sqrt(double(Dot(c.point - p1, c.point - p1)));
-      if (!(distance < nearest) || std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) {
-        break;
-      }
-      const Float3 probe = ExitProbe(c);
-      uint32_t holder = UINT32_MAX;
-      for (uint32_t m = 0; m < motions_.size() && holder == UINT32_MAX; ++m) {
-        if (HasKind(m, kinds) && ColliderContact(m, active_[m], probe, probe).inside_end)
-          holder = m;
-      }
-      if (holder == UINT32_MAX) {
-        nearest = distance;
-        *best = c;
-        break;
-      }
-      c = ColliderContact(holder, active_[holder], probe, probe);
+    const ContactQuery c = ColliderContact(k, active_[k], p1, p1);
+    reach += kUnionDepthFactor * c.depth;
+    if (c.inside_end && count < kMaxCandidates) {
+      holding[count] = k;
+      frames[count++] = &active_[k];
+    }
+  }
+  ExitCandidate exits[kMaxExits];
+  const uint32_t n = CollectExits(p1, holding, frames, count, exits);
+  for (uint32_t e = 0; e < std::min(n, kMaxExitTries); ++e) {
+    const ContactQuery c = ExitContact(p1, exits[e]);
+    if (std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) break;  // farther ones too
+    if (!InsideAny(ExitProbe(c), kinds)) {
+      *best = c;
+      return;
     }
   }
 }

@@ -235,6 +235,23 @@ class HullColliderSet {
   uint32_t ParticleContacts(Float3 p0, Float3 p1, float s0, float s1,
                             const uint32_t* first_candidates, uint32_t skip,
                             ContactFrames* out) const;
+  // Exits from a point inside overlapping colliders (union_exit.cpp): a hull's outer face (the
+  // point projected onto its plane) or a sphere's radial exit (plane kSphereExit).
+  static constexpr uint32_t kSphereExit = UINT32_MAX;
+  static constexpr uint32_t kMaxExits = 128;     // nearest exits kept per point
+  static constexpr uint32_t kMaxExitTries = 32;  // tested for being outside every collider
+  struct ExitCandidate {                         // 24 bytes
+    float distance;                              // metres from the point to the exit
+    uint32_t collider, plane;
+    const ActiveFrames* frames;
+  };
+  uint32_t CollectExits(Float3 x, const uint32_t* colliders, const ActiveFrames* const* frames,
+                        uint32_t count, ExitCandidate* exits) const;
+  ContactQuery ExitContact(Float3 x, const ExitCandidate& exit) const;
+  // The nearest exit of x (the end of the segment) from the candidates that hold it which lies
+  // outside every candidate; false when none of the nearest kMaxExitTries does (a pinch).
+  bool NearestUnionExit(Float3 x, const ContactFrames& candidates, ContactQuery* exit) const;
+  bool InsideAnyCandidate(Float3 x, const ContactFrames& candidates) const;
   // The squared distance from p0 a response may leave the particle at (kUnionDepthFactor).
   static double Budget(Float3 p0, Float3 p1, const ContactFrames& contacts, float separation);
   // Query's helpers: whether collider k is of a kind in `kinds`; the point just outside the
