@@ -27,6 +27,7 @@
 #include "fit/collider_fit.h"
 #include "fit/fit_report.h"
 #include "regions/convex_pieces.h"
+#include "regions/interior_points.h"
 #include "regions/surface_spheres.h"
 
 namespace drape::bake {
@@ -153,47 +154,20 @@ struct HullJob {
   double piece_bloat = 0.0;    // metres, the piece's convex hull beyond the body (0: not split)
 };
 
-// Points along each bone (joint to child joints, rest pose) that are inside the body by more than
-// delta. A bone's hull holds them with its surface: the hulls of the surface patches the bones
-// carry (or the convex pieces of one) need not reach the body's middle (patches around a torso
-// are orange segments whose hulls leave the centre empty: 30 % of static points inside the Fox
-// met no collider); a fan from the bone to its patch fills it.
-std::vector<std::vector<Float3>> BoneInteriorPoints(const Regions& regions,
-                                                    std::span<const int32_t> parents,
-                                                    const MeshReference& body, float delta) {
-  constexpr int kSamples = 8;  // per bone segment, joint included, child excluded
-  const size_t joints = regions.collider_frames.size();
-  const auto position = [&](size_t j) {
-    const Mat34& m = regions.collider_frames[j];
-    return Float3{m.m[3], m.m[7], m.m[11]};
-  };
-  std::vector<std::vector<Float3>> interior(joints);
-  const auto add_if_inside = [&](size_t j, Float3 p) {
-    const double q[3] = {p.x, p.y, p.z};
-    if (body.Inside(q) && body.Distance(q) > delta) interior[j].push_back(p);
-  };
-  for (size_t j = 0; j < joints; ++j) add_if_inside(j, position(j));
-  for (size_t c = 0; c < joints && c < parents.size(); ++c) {
-    const int32_t j = parents[c];
-    if (j < 0 || static_cast<size_t>(j) >= joints) continue;
-    const Float3 from = position(static_cast<size_t>(j)), to = position(c);
-    for (int k = 1; k < kSamples; ++k) {
-      add_if_inside(static_cast<size_t>(j),
-                    from + (to - from) * (static_cast<float>(k) / kSamples));
-    }
-  }
-  return interior;
-}
-
-// Each bone's region (its rigid, then its shaping vertices, and the points along the bone inside
-// the body), split into convex pieces that fit the body when hulls.max_pieces > 1, as collider
-// points in the bone's collider frame.
+// Each bone's region (its rigid, then its shaping vertices, and its points inside the body,
+// regions/interior_points.h), split into convex pieces that fit the body when hulls.max_pieces
+// > 1, as collider points in the bone's collider frame.
 std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
-                              std::span<const uint32_t> triangles, const MeshReference& body,
+                              const MeshData& mesh, const MeshReference& body,
                               std::span<const int32_t> parents) {
+  const std::span<const uint32_t> triangles = mesh.triangles;
   const uint32_t joints = static_cast<uint32_t>(regions.collider_frames.size());
-  const std::vector<std::vector<Float3>> interior =
+  std::vector<std::vector<Float3>> interior =
       BoneInteriorPoints(regions, parents, body, config.hull.delta);
+  const std::vector<std::vector<Float3>> grid =
+      BodyInteriorPoints(regions.rest_positions, mesh, body, config.hull.delta);
+  for (uint32_t j = 0; j < joints && j < grid.size(); ++j)
+    interior[j].insert(interior[j].end(), grid[j].begin(), grid[j].end());
   const auto region_of = [&](size_t j) {
     std::vector<uint32_t> region = regions.rigid_vertices[j];
     region.insert(region.end(), regions.shaping_vertices[j].begin(),
@@ -401,7 +375,7 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
   const SkeletonData& skeleton = character.skeleton;
   const MeshReference body(regions.rest_positions, character.mesh.triangles);
   const std::vector<HullJob> jobs =
-      HullJobs(config, regions, character.mesh.triangles, body, skeleton.parents);
+      HullJobs(config, regions, character.mesh, body, skeleton.parents);
   std::vector<BoneHull> built = BuildBoneHulls(config, jobs);
   json colliders = json::array();
   json left_out = json::array();
