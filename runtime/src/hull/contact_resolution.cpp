@@ -241,9 +241,8 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
   // from the first pass's contacts. An entry response keeps the particle within its motion of
   // p0 (projecting the end onto an entry plane shortens the segment), a push-out moves it by the
   // depth; inside overlapping colliders the nearest exit of their union can be deeper than any
-  // one of them (HullColliderSet::kUnionDepthFactor). Contact planes of two colliders that meet
-  // far from the body would break it: that response is undone. A response beyond it (contact planes
-  // of two colliders meeting far from the body) is undone.
+  // one of them (HullColliderSet::kUnionDepthFactor). A response beyond it (contact planes of two
+  // colliders meeting far from the body) is undone.
   double budget_squared = 0.0;
   // The best iterate so far (Gauss-Seidel passes can make a pinched particle worse).
   Float3 best_position = position, best_velocity = vel;
@@ -280,7 +279,7 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
       converged = true;
       break;
     }
-    ContactQuery* contacts = pass_contacts.contacts();
+    const ContactQuery* contacts = pass_contacts.contacts();
     uint32_t* order = pass_contacts.order;
     if (pass == 0) budget_squared = Budget(p0, position, pass_contacts, params.separation);
     // Deepest first; ties keep collider order (insertion sort is stable).
@@ -292,20 +291,6 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
         --j;
       }
       order[j] = key;
-    }
-    // Inside from the start: when the deepest collider's exit lies inside another, the nearest
-    // face exit of their union instead, if within the budget (out of the torso piece into its
-    // neighbour, and back, leaves the particle inside both). Beyond it (the exit of two
-    // overlapping colliders is their crease, no single face's), the contact planes find it.
-    ContactQuery& deepest = contacts[order[0]];
-    if ((deepest.flags & kCollisionStartedInside) != 0 &&
-        InsideAnyCandidate(ExitProbe(deepest), pass_contacts)) {
-      ContactQuery exit;
-      if (NearestUnionExit(position, pass_contacts, &exit) &&
-          DistanceSquared(exit.point, p0) <= budget_squared) {
-        exit.flags = deepest.flags;
-        deepest = exit;
-      }
     }
     for (uint32_t rank = 0; rank < hits; ++rank) {
       const uint32_t i = order[rank];
@@ -338,6 +323,24 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
     keep_if_best(score_of(pass_contacts));
     position = best_position;
     vel = best_velocity;
+    // Still inside, having started inside: each collider's exit lay inside another (out of one
+    // half of a torso into the other, and back). The nearest face exit of their union, within
+    // the budget, from where the particle was (beyond it, the exit of two colliders is their
+    // crease, which the contact planes found if they could).
+    if (best_score.depth > 0.f) {
+      ParticleContacts<kActive>(p0, *p1, s0, s1, nullptr, UINT32_MAX, &pass_contacts);
+      bool started_inside = false;
+      const ContactQuery* contacts = pass_contacts.contacts();
+      for (uint32_t h = 0; h < pass_contacts.hits; ++h)
+        started_inside |= (contacts[pass_contacts.order[h]].flags & kCollisionStartedInside) != 0;
+      ContactQuery exit;
+      if (started_inside &&
+          NearestUnionExit(p0, *p1, pass_contacts, std::sqrt(budget_squared), &exit)) {
+        position = *p1;
+        vel = *velocity;
+        ApplyResponse(exit, params, &position, &vel);
+      }
+    }
   }
   *p1 = position;
   *velocity = vel;

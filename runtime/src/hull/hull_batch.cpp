@@ -173,34 +173,4 @@ bool HullColliderSet::InsideAny(Float3 x, uint8_t kinds) const {
   return false;
 }
 
-void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuery* best) const {
-  // The exits of every collider the end is inside (each outer face, each sphere), nearest first
-  // (union_exit.cpp); the first that is outside every collider of `kinds` and within the
-  // particle's reach (its motion plus kUnionDepthFactor times the sum of its depths, from p0:
-  // the bound every response keeps) wins. None: the deepest contact stays.
-  double reach = std::sqrt(double(Dot(p1 - p0, p1 - p0)));
-  uint32_t holding[kMaxCandidates];
-  const ActiveFrames* frames[kMaxCandidates];
-  uint32_t count = 0;
-  for (uint32_t k = 0; k < motions_.size(); ++k) {
-    if (!HasKind(k, kinds)) continue;
-    const ContactQuery c = ColliderContact(k, active_[k], p1, p1);
-    reach += kUnionDepthFactor * c.depth;
-    if (c.inside_end && count < kMaxCandidates) {
-      holding[count] = k;
-      frames[count++] = &active_[k];
-    }
-  }
-  ExitCandidate exits[kMaxExits];
-  const uint32_t n = CollectExits(p1, holding, frames, count, exits);
-  for (uint32_t e = 0; e < std::min(n, kMaxExitTries); ++e) {
-    const ContactQuery c = ExitContact(p1, exits[e]);
-    if (std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) break;  // farther ones too
-    if (!InsideAny(ExitProbe(c), kinds)) {
-      *best = c;
-      return;
-    }
-  }
-}
-
 }  // namespace drape

@@ -1,6 +1,7 @@
 // The nearest exit of the union of overlapping colliders from a point inside them: where a
 // particle inside a torso piece, its neighbouring piece and a joint sphere goes, rather than out
-// of the deepest one into another (docs/ALGORITHMS.md §8.6).
+// of the deepest one into another (docs/ALGORITHMS.md §8.6). Only particles inside colliders
+// whose deepest exit lies inside another come here.
 #include <algorithm>
 #include <cmath>
 
@@ -11,73 +12,64 @@ namespace drape {
 
 using detail::NudgeOut;
 
-uint32_t HullColliderSet::CollectExits(Float3 x, const uint32_t* colliders,
-                                       const ActiveFrames* const* frames, uint32_t count,
-                                       ExitCandidate* exits) const {
-  // Every outer face of every hull holding x (its projection there is on or outside that hull),
-  // and every sphere's radial exit; the nearest kMaxExits, nearest first.
-  uint32_t n = 0;
-  const auto add = [&](ExitCandidate e) {
-    if (n < kMaxExits) {
-      exits[n++] = e;
-      return;
-    }
-    uint32_t farthest = 0;
-    for (uint32_t i = 1; i < n; ++i)
-      farthest = exits[i].distance > exits[farthest].distance ? i : farthest;
-    if (e.distance < exits[farthest].distance) exits[farthest] = e;
-  };
+uint32_t HullColliderSet::CollectExits(const ExitHolders& holders, ExitKey* keys,
+                                       uint8_t* holder_of) const {
+  // Every outer face of every holder (its projection is on or outside that hull) and every
+  // sphere's radial exit, at most kMaxExits (the rest are left out: a point inside that many
+  // faces' worth of colliders is in a pinch the contact planes handle).
   const uint32_t hull_total = static_cast<uint32_t>(hulls_.size());
-  for (uint32_t i = 0; i < count; ++i) {
-    const uint32_t k = colliders[i];
-    const Float3 local = TransformPoint(frames[i]->to_local_end, x);
+  uint32_t n = 0;
+  for (uint32_t i = 0; i < holders.count && n < kMaxExits; ++i) {
+    const uint32_t k = holders.colliders[i];
+    const Float3 local = holders.local[i];
     if (k < hull_total) {
       const HullRecord& h = hulls_[k];
-      float max_value = -INFINITY;
-      for (uint32_t j = 0; j < h.plane_count; ++j)
-        max_value = std::max(max_value, PlaneSignedDistance(planes_[h.plane_begin + j], local));
-      if (max_value > 0.f) continue;  // not inside this hull
-      for (uint32_t j = 0; j < h.plane_count; ++j) {
+      for (uint32_t j = 0; j < h.plane_count && n < kMaxExits; ++j) {
         if (plane_internal_[h.plane_begin + j]) continue;
-        add({-PlaneSignedDistance(planes_[h.plane_begin + j], local), k, j, frames[i]});
+        keys[n] = {-PlaneSignedDistance(planes_[h.plane_begin + j], local), k, j};
+        holder_of[n++] = static_cast<uint8_t>(i);
       }
     } else {
-      const float radius = spheres_[k - hull_total].radius;
-      const float r = Length(local);
-      if (r > radius) continue;
-      add({radius - r, k, kSphereExit, frames[i]});
+      keys[n] = {spheres_[k - hull_total].radius - Length(local), k, kSphereExit};
+      holder_of[n++] = static_cast<uint8_t>(i);
     }
   }
-  // Ties keep the collider and plane order: identical at any thread count.
-  std::sort(exits, exits + n, [](const ExitCandidate& a, const ExitCandidate& b) {
-    return a.distance < b.distance ||
-           (a.distance == b.distance &&
-            (a.collider < b.collider || (a.collider == b.collider && a.plane < b.plane)));
-  });
   return n;
 }
 
-ContactQuery HullColliderSet::ExitContact(Float3 x, const ExitCandidate& e) const {
-  const Float3 local = TransformPoint(e.frames->to_local_end, x);
+uint32_t HullColliderSet::NextExit(const ExitKey* keys, uint32_t count, const ExitKey& after) {
+  // The smallest key after `after` by a scan: a sort would cost more than the one or two exits
+  // usually tried.
+  uint32_t best = count;
+  for (uint32_t i = 0; i < count; ++i) {
+    if (after < keys[i] && (best == count || keys[i] < keys[best])) best = i;
+  }
+  return best;
+}
+
+ContactQuery HullColliderSet::ExitContact(const ExitHolders& holders, uint32_t holder,
+                                          const ExitKey& key) const {
+  const Float3 local = holders.local[holder];
   ContactQuery c;
   c.contact = true;
   c.inside_end = true;
   c.t = 0.f;
-  c.depth = std::max(e.distance, 0.f);
-  if (e.plane == kSphereExit) {
-    const float radius = spheres_[e.collider - hulls_.size()].radius;
+  c.depth = std::max(key.distance, 0.f);
+  if (key.plane == kSphereExit) {
+    const float radius = spheres_[key.collider - hulls_.size()].radius;
     const Float3 n = NormalizeOr(local, Float3{0.f, 1.f, 0.f});
     c.normal = n;
     c.point = NudgeOut(n * radius, n, radius, [&](Float3 p) { return Length(p) - radius; });
   } else {
-    const Plane& plane = planes_[hulls_[e.collider].plane_begin + e.plane];
+    const Plane& plane = planes_[hulls_[key.collider].plane_begin + key.plane];
     const Float3 projected = local - plane.normal * PlaneSignedDistance(plane, local);
     c.normal = plane.normal;
     c.point = NudgeOut(projected, plane.normal, 1.f + std::fabs(plane.offset),
                        [&](Float3 p) { return PlaneSignedDistance(plane, p); });
   }
-  c.point = TransformPoint(e.frames->to_world_end, c.point);
-  c.normal = TransformVector(e.frames->to_world_end, c.normal);
+  const ActiveFrames& f = *holders.frames[holder];
+  c.point = TransformPoint(f.to_world_end, c.point);
+  c.normal = TransformVector(f.to_world_end, c.normal);
   return c;
 }
 
@@ -89,27 +81,67 @@ bool HullColliderSet::InsideAnyCandidate(Float3 x, const ContactFrames& candidat
   return false;
 }
 
-bool HullColliderSet::NearestUnionExit(Float3 x, const ContactFrames& candidates,
-                                       ContactQuery* exit) const {
-  uint32_t holding[kMaxCandidates];
-  const ActiveFrames* frames[kMaxCandidates];
-  uint32_t count = 0;
+bool HullColliderSet::NearestUnionExit(Float3 p0, Float3 x, const ContactFrames& candidates,
+                                       double max_distance, ContactQuery* exit) const {
+  ExitHolders holders;
   const ContactQuery* contacts = candidates.contacts();
   for (uint32_t i = 0; i < candidates.count; ++i) {
     if (!contacts[i].inside_end) continue;
-    holding[count] = candidates.candidates[i];
-    frames[count++] = candidates.frames[i];
+    const uint32_t h = holders.count++;
+    holders.colliders[h] = candidates.candidates[i];
+    holders.frames[h] = candidates.frames[i];
+    holders.local[h] = TransformPoint(candidates.frames[i]->to_local_end, x);
   }
-  ExitCandidate exits[kMaxExits];
-  const uint32_t n = CollectExits(x, holding, frames, count, exits);
-  for (uint32_t e = 0; e < std::min(n, kMaxExitTries); ++e) {
-    const ContactQuery c = ExitContact(x, exits[e]);
+  ExitKey keys[kMaxExits];
+  uint8_t holder_of[kMaxExits];
+  const uint32_t n = CollectExits(holders, keys, holder_of);
+  ExitKey key{-INFINITY, 0, 0};
+  for (uint32_t tries = 0, e = 0; tries < kMaxExitTries && (e = NextExit(keys, n, key)) < n;
+       ++tries) {
+    key = keys[e];
+    const ContactQuery c = ExitContact(holders, holder_of[e], key);
+    const Float3 d = c.point - p0;
+    if (std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z) > max_distance)
+      return false;  // nearest first: the others are beyond too (up to rounding)
     if (!InsideAnyCandidate(ExitProbe(c), candidates)) {
       *exit = c;
       return true;
     }
   }
   return false;
+}
+
+void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuery* best) const {
+  // Query's: the holders among every collider of `kinds`, an exit outside all of them, within
+  // the particle's reach (its motion plus kUnionDepthFactor times the sum of its depths, from
+  // p0: the bound every response keeps). None: the deepest contact stays.
+  double reach = std::sqrt(double(Dot(p1 - p0, p1 - p0)));
+  ExitHolders holders;
+  for (uint32_t k = 0; k < motions_.size(); ++k) {
+    if (!HasKind(k, kinds)) continue;
+    const ContactQuery c = ColliderContact(k, active_[k], p1, p1);
+    reach += kUnionDepthFactor * c.depth;
+    if (c.inside_end && holders.count < kMaxCandidates) {
+      const uint32_t h = holders.count++;
+      holders.colliders[h] = k;
+      holders.frames[h] = &active_[k];
+      holders.local[h] = TransformPoint(active_[k].to_local_end, p1);
+    }
+  }
+  ExitKey keys[kMaxExits];
+  uint8_t holder_of[kMaxExits];
+  const uint32_t n = CollectExits(holders, keys, holder_of);
+  ExitKey key{-INFINITY, 0, 0};
+  for (uint32_t tries = 0, e = 0; tries < kMaxExitTries && (e = NextExit(keys, n, key)) < n;
+       ++tries) {
+    key = keys[e];
+    const ContactQuery c = ExitContact(holders, holder_of[e], key);
+    if (std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) return;
+    if (!InsideAny(ExitProbe(c), kinds)) {
+      *best = c;
+      return;
+    }
+  }
 }
 
 }  // namespace drape

@@ -236,21 +236,35 @@ class HullColliderSet {
                             const uint32_t* first_candidates, uint32_t skip,
                             ContactFrames* out) const;
   // Exits from a point inside overlapping colliders (union_exit.cpp): a hull's outer face (the
-  // point projected onto its plane) or a sphere's radial exit (plane kSphereExit).
+  // point projected onto its plane) or a sphere's radial exit (plane kSphereExit), tried nearest
+  // first.
   static constexpr uint32_t kSphereExit = UINT32_MAX;
-  static constexpr uint32_t kMaxExits = 128;     // nearest exits kept per point
-  static constexpr uint32_t kMaxExitTries = 32;  // tested for being outside every collider
-  struct ExitCandidate {                         // 24 bytes
-    float distance;                              // metres from the point to the exit
+  static constexpr uint32_t kMaxExitTries = 16;  // exits tested for being outside everything
+  struct ExitKey {                               // 12 bytes
+    float distance;
     uint32_t collider, plane;
-    const ActiveFrames* frames;
+    bool operator<(const ExitKey& o) const {  // by distance, then collider, then plane
+      return distance < o.distance ||
+             (distance == o.distance &&
+              (collider < o.collider || (collider == o.collider && plane < o.plane)));
+    }
   };
-  uint32_t CollectExits(Float3 x, const uint32_t* colliders, const ActiveFrames* const* frames,
-                        uint32_t count, ExitCandidate* exits) const;
-  ContactQuery ExitContact(Float3 x, const ExitCandidate& exit) const;
-  // The nearest exit of x (the end of the segment) from the candidates that hold it which lies
-  // outside every candidate; false when none of the nearest kMaxExitTries does (a pinch).
-  bool NearestUnionExit(Float3 x, const ContactFrames& candidates, ContactQuery* exit) const;
+  struct ExitHolders {  // the colliders holding the point, and the point in their frames
+    uint32_t count = 0;
+    uint32_t colliders[kMaxCandidates];
+    const ActiveFrames* frames[kMaxCandidates];
+    Float3 local[kMaxCandidates];
+  };
+  static constexpr uint32_t kMaxExits = 512;  // exits considered per point
+  uint32_t CollectExits(const ExitHolders& holders, ExitKey* keys, uint8_t* holder_of) const;
+  // The index of the smallest key after `after` (start: ExitKey{-INFINITY, 0, 0}); count if none.
+  static uint32_t NextExit(const ExitKey* keys, uint32_t count, const ExitKey& after);
+  ContactQuery ExitContact(const ExitHolders& holders, uint32_t holder, const ExitKey& key) const;
+  // The nearest exit of x (the end of the segment) from the candidates that hold it that lies
+  // outside every candidate and within max_distance of p0; false when none of the nearest
+  // kMaxExitTries does (a pinch, or the crease of two colliders).
+  bool NearestUnionExit(Float3 p0, Float3 x, const ContactFrames& candidates, double max_distance,
+                        ContactQuery* exit) const;
   bool InsideAnyCandidate(Float3 x, const ContactFrames& candidates) const;
   // The squared distance from p0 a response may leave the particle at (kUnionDepthFactor).
   static double Budget(Float3 p0, Float3 p1, const ContactFrames& contacts, float separation);
