@@ -39,7 +39,9 @@ struct HullColliderSet::BuildStages {
       set->plane_nz_.push_back(plane.normal.z);
       set->plane_d_.push_back(plane.offset);
       set->planes_.push_back(plane);
-      set->plane_internal_.push_back(real && !h.plane_internal.empty() ? h.plane_internal[p] : 0);
+      const uint8_t internal = real && !h.plane_internal.empty() ? h.plane_internal[p] : 0;
+      set->plane_internal_.push_back(internal);
+      set->outer_plane_d_.push_back(internal ? kPadOffset : plane.offset);
     }
   }
   // The OBB, grown so that float rounding of the transforms and of the planes never rejects a
@@ -294,7 +296,7 @@ InstructionSet HullColliderSet::instruction_set() const {
 
 size_t HullColliderSet::memory_bytes() const {
   return sizeof(*this) + hulls_.size() * sizeof(HullRecord) +
-         spheres_.size() * sizeof(SphereRecord) + (plane_nx_.size() * 4) * sizeof(float) +
+         spheres_.size() * sizeof(SphereRecord) + (plane_nx_.size() * 5) * sizeof(float) +
          planes_.size() * sizeof(Plane) + plane_internal_.size() +
          ray_triangles_.size() * sizeof(float) + ray_triangle_planes_.size() * sizeof(uint32_t) +
          node_edges_.size() * sizeof(EdgeFunction) + node_leaf_plane_.size() * sizeof(int32_t) +

@@ -32,16 +32,13 @@ void HullColliderSet::PushOut(const HullRecord& h, Float3 p, float max_value,
   const PlaneSoa soa{&plane_nx_[b], &plane_ny_[b], &plane_nz_[b], &plane_d_[b], h.plane_padded};
   uint32_t j = kernels_->first_equal(soa, p, max_value);
   if (plane_internal_[b + j]) {
-    // The nearest face is a cut inside the body: leave through the nearest outer face instead
-    // (the depth is then the distance to it).
-    uint32_t outer = h.plane_count;
-    float outer_max = -INFINITY;
-    for (uint32_t i = 0; i < h.plane_count; ++i) {
-      const float v = PlaneSignedDistance(planes_[b + i], p);
-      if (!plane_internal_[b + i] && v > outer_max) outer = i, outer_max = v;
-    }
-    if (outer < h.plane_count) {
-      j = outer;
+    // The nearest face is inside the body: leave through the nearest outer face instead (the
+    // depth is then the distance to it). The outer planes' max: the internal ones padded.
+    const PlaneSoa outer{&plane_nx_[b], &plane_ny_[b], &plane_nz_[b], &outer_plane_d_[b],
+                         h.plane_padded};
+    const float outer_max = kernels_->max(outer, p);
+    if (outer_max > -1e37f) {  // some face is outer
+      j = kernels_->first_equal(outer, p, outer_max);
       max_value = outer_max;
       c->depth = c->inside_end ? std::max(c->depth, -outer_max) : c->depth;
     }

@@ -12,8 +12,7 @@ namespace drape {
 
 using detail::NudgeOut;
 
-uint32_t HullColliderSet::CollectExits(const ExitHolders& holders, ExitKey* keys,
-                                       uint8_t* holder_of) const {
+uint32_t HullColliderSet::CollectExits(const ExitHolders& holders, ExitKey* keys) const {
   // Every outer face of every holder (its projection is on or outside that hull) and every
   // sphere's radial exit, at most kMaxExits (the rest are left out: a point inside that many
   // faces' worth of colliders is in a pinch the contact planes handle).
@@ -26,30 +25,21 @@ uint32_t HullColliderSet::CollectExits(const ExitHolders& holders, ExitKey* keys
       const HullRecord& h = hulls_[k];
       for (uint32_t j = 0; j < h.plane_count && n < kMaxExits; ++j) {
         if (plane_internal_[h.plane_begin + j]) continue;
-        keys[n] = {-PlaneSignedDistance(planes_[h.plane_begin + j], local), k, j};
-        holder_of[n++] = static_cast<uint8_t>(i);
+        keys[n++] = {-PlaneSignedDistance(planes_[h.plane_begin + j], local), k, j, i};
       }
     } else {
-      keys[n] = {spheres_[k - hull_total].radius - Length(local), k, kSphereExit};
-      holder_of[n++] = static_cast<uint8_t>(i);
+      keys[n++] = {spheres_[k - hull_total].radius - Length(local), k, kSphereExit, i};
     }
   }
-  return n;
+  // Only the nearest kMaxExitTries are tried: a partial sort (the order is total: the same at
+  // any thread count).
+  const uint32_t tries = std::min(n, kMaxExitTries);
+  std::partial_sort(keys, keys + tries, keys + n);
+  return tries;
 }
 
-uint32_t HullColliderSet::NextExit(const ExitKey* keys, uint32_t count, const ExitKey& after) {
-  // The smallest key after `after` by a scan: a sort would cost more than the one or two exits
-  // usually tried.
-  uint32_t best = count;
-  for (uint32_t i = 0; i < count; ++i) {
-    if (after < keys[i] && (best == count || keys[i] < keys[best])) best = i;
-  }
-  return best;
-}
-
-ContactQuery HullColliderSet::ExitContact(const ExitHolders& holders, uint32_t holder,
-                                          const ExitKey& key) const {
-  const Float3 local = holders.local[holder];
+ContactQuery HullColliderSet::ExitContact(const ExitHolders& holders, const ExitKey& key) const {
+  const Float3 local = holders.local[key.holder];
   ContactQuery c;
   c.contact = true;
   c.inside_end = true;
@@ -67,7 +57,7 @@ ContactQuery HullColliderSet::ExitContact(const ExitHolders& holders, uint32_t h
     c.point = NudgeOut(projected, plane.normal, 1.f + std::fabs(plane.offset),
                        [&](Float3 p) { return PlaneSignedDistance(plane, p); });
   }
-  const ActiveFrames& f = *holders.frames[holder];
+  const ActiveFrames& f = *holders.frames[key.holder];
   c.point = TransformPoint(f.to_world_end, c.point);
   c.normal = TransformVector(f.to_world_end, c.normal);
   return c;
@@ -93,13 +83,9 @@ bool HullColliderSet::NearestUnionExit(Float3 p0, Float3 x, const ContactFrames&
     holders.local[h] = TransformPoint(candidates.frames[i]->to_local_end, x);
   }
   ExitKey keys[kMaxExits];
-  uint8_t holder_of[kMaxExits];
-  const uint32_t n = CollectExits(holders, keys, holder_of);
-  ExitKey key{-INFINITY, 0, 0};
-  for (uint32_t tries = 0, e = 0; tries < kMaxExitTries && (e = NextExit(keys, n, key)) < n;
-       ++tries) {
-    key = keys[e];
-    const ContactQuery c = ExitContact(holders, holder_of[e], key);
+  const uint32_t n = CollectExits(holders, keys);
+  for (uint32_t e = 0; e < n; ++e) {
+    const ContactQuery c = ExitContact(holders, keys[e]);
     const Float3 d = c.point - p0;
     if (std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z) > max_distance)
       return false;  // nearest first: the others are beyond too (up to rounding)
@@ -129,13 +115,9 @@ void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuer
     }
   }
   ExitKey keys[kMaxExits];
-  uint8_t holder_of[kMaxExits];
-  const uint32_t n = CollectExits(holders, keys, holder_of);
-  ExitKey key{-INFINITY, 0, 0};
-  for (uint32_t tries = 0, e = 0; tries < kMaxExitTries && (e = NextExit(keys, n, key)) < n;
-       ++tries) {
-    key = keys[e];
-    const ContactQuery c = ExitContact(holders, holder_of[e], key);
+  const uint32_t n = CollectExits(holders, keys);
+  for (uint32_t e = 0; e < n; ++e) {
+    const ContactQuery c = ExitContact(holders, keys[e]);
     if (std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) return;
     if (!InsideAny(ExitProbe(c), kinds)) {
       *best = c;

@@ -240,9 +240,10 @@ class HullColliderSet {
   // first.
   static constexpr uint32_t kSphereExit = UINT32_MAX;
   static constexpr uint32_t kMaxExitTries = 16;  // exits tested for being outside everything
-  struct ExitKey {                               // 12 bytes
-    float distance;
+  struct ExitKey {                               // 16 bytes
+    float distance;                              // metres from the point to the exit
     uint32_t collider, plane;
+    uint32_t holder;                          // index into ExitHolders (not part of the order)
     bool operator<(const ExitKey& o) const {  // by distance, then collider, then plane
       return distance < o.distance ||
              (distance == o.distance &&
@@ -256,10 +257,9 @@ class HullColliderSet {
     Float3 local[kMaxCandidates];
   };
   static constexpr uint32_t kMaxExits = 512;  // exits considered per point
-  uint32_t CollectExits(const ExitHolders& holders, ExitKey* keys, uint8_t* holder_of) const;
-  // The index of the smallest key after `after` (start: ExitKey{-INFINITY, 0, 0}); count if none.
-  static uint32_t NextExit(const ExitKey* keys, uint32_t count, const ExitKey& after);
-  ContactQuery ExitContact(const ExitHolders& holders, uint32_t holder, const ExitKey& key) const;
+  // The holders' exits, the nearest kMaxExitTries first and in order; returns how many to try.
+  uint32_t CollectExits(const ExitHolders& holders, ExitKey* keys) const;
+  ContactQuery ExitContact(const ExitHolders& holders, const ExitKey& key) const;
   // The nearest exit of x (the end of the segment) from the candidates that hold it that lies
   // outside every candidate and within max_distance of p0; false when none of the nearest
   // kMaxExitTries does (a pinch, or the crease of two colliders).
@@ -311,7 +311,8 @@ class HullColliderSet {
   // Planes, SoA, each hull's range padded to a multiple of 8 with planes that never win.
   SimdFloats plane_nx_, plane_ny_, plane_nz_, plane_d_;
   std::vector<Plane> planes_;            // unpadded copy, plane_begin-relative as in the SoA
-  std::vector<uint8_t> plane_internal_;  // per plane as planes_: 1 for a cut between pieces
+  std::vector<uint8_t> plane_internal_;  // per plane as planes_: 1 for a face inside the body
+  SimdFloats outer_plane_d_;  // plane_d_ with the internal planes' offsets padded (never win)
   // Triangles for the map-table ray: 9 floats (3 vertices) each, plus their planes.
   std::vector<float> ray_triangles_;
   std::vector<uint32_t> ray_triangle_planes_;  // hull-relative plane index
