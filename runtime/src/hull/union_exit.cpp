@@ -120,7 +120,9 @@ void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuer
     const ContactQuery c = ExitContact(holders, keys[e]);
     if (std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) return;
     if (!InsideAny(ExitProbe(c), kinds)) {
+      const uint8_t flags = best->flags;  // what the contact is (started inside) stays
       *best = c;
+      best->flags = flags;
       return;
     }
   }

@@ -257,6 +257,9 @@ class HullColliderSet {
     Float3 local[kMaxCandidates];
   };
   static constexpr uint32_t kMaxExits = 512;  // exits considered per point
+  // CollideBatch searches the union's exits for a particle still this deep after every pass
+  // (metres): a shallower best iterate stays (moving it across the union would be a jump).
+  static constexpr float kUnionExitMinDepth = 1e-3f;
   // The holders' exits, the nearest kMaxExitTries first and in order; returns how many to try.
   uint32_t CollectExits(const ExitHolders& holders, ExitKey* keys) const;
   ContactQuery ExitContact(const ExitHolders& holders, const ExitKey& key) const;
