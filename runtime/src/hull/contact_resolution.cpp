@@ -324,10 +324,9 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
     position = best_position;
     vel = best_velocity;
     // Still inside (beyond kUnionExitMinDepth), having started inside: each collider's exit lay
-    // inside another (out of one
-    // half of a torso into the other, and back). The nearest face exit of their union, within
-    // the budget, from where the particle was (beyond it, the exit of two colliders is their
-    // crease, which the contact planes found if they could).
+    // inside another (out of one half of a torso into the other, and back). The nearest face
+    // exit of their union, within the budget, from where the particle was (beyond it, the exit
+    // of two colliders is their crease, which the contact planes found if they could).
     if (best_score.depth > kUnionExitMinDepth) {
       ParticleContacts<kActive>(p0, *p1, s0, s1, nullptr, UINT32_MAX, &pass_contacts);
       bool started_inside = false;
