@@ -8,36 +8,26 @@
 #include <vector>
 
 #include "drape/bake/mesh_reference.h"
+#include "drape/bake/regions.h"
 #include "drape/runtime/math.h"
+#include "hull_fixtures.h"
 
 namespace drape {
 namespace {
 
-// A closed box 0.4 x 0.6 x 0.2 m, two triangles per face wound outward; the vertices with x < 0
-// weighted to joint 0, the others to joint 1.
+// A closed box 0.4 x 0.6 x 0.2 m (the hull fixture's surface, wound outward); the vertices with
+// x < 0 weighted to joint 0, the others to joint 1.
 MeshData TwoBoneBox() {
+  const HullColliderData box = test::MakeBox({0.2f, 0.3f, 0.1f});
   MeshData mesh;
-  const Float3 lo{-0.2f, -0.3f, -0.1f}, hi{0.2f, 0.3f, 0.1f};
-  for (int i = 0; i < 8; ++i) {
-    mesh.positions.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
-  }
-  const uint32_t faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
-  for (const auto& q : faces) {
-    const uint32_t corners[2][3] = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
-    for (const auto& c : corners) {
-      const Float3 a = mesh.positions[c[0]], b = mesh.positions[c[1]], d = mesh.positions[c[2]];
-      const bool outward = Dot(Cross(b - a, d - a), a) > 0.f;
-      mesh.triangles.insert(mesh.triangles.end(),
-                            {c[0], outward ? c[1] : c[2], outward ? c[2] : c[1]});
-    }
-  }
-  for (uint32_t v = 0; v < 8; ++v) {
+  mesh.positions = box.vertices;
+  mesh.triangles = box.triangles;
+  for (uint32_t v = 0; v < mesh.positions.size(); ++v) {
     mesh.influence_offsets.push_back(v);
     mesh.influence_joints.push_back(mesh.positions[v].x < 0.f ? 0 : 1);
     mesh.influence_weights.push_back(1.f);
   }
-  mesh.influence_offsets.push_back(8);
+  mesh.influence_offsets.push_back(static_cast<uint32_t>(mesh.positions.size()));
   return mesh;
 }
 
@@ -46,7 +36,7 @@ TEST(InteriorPoints, TheGridFillsTheBodyAndGoesToTheBoneOfTheNearestSurface) {
   const bake::MeshReference body(mesh.positions, mesh.triangles);
   const float delta = 0.005f;
   const std::vector<std::vector<Float3>> interior =
-      bake::BodyInteriorPoints(mesh.positions, mesh, body, delta);
+      bake::BodyInteriorPoints(mesh.positions, bake::TriangleBones(mesh, 2), 2, body, delta);
   ASSERT_EQ(interior.size(), 2u);
   // Cells of 0.6 / 32 m: about 21 x 32 x 11 centres, all but a delta-thin rind inside.
   size_t total = 0;
@@ -72,7 +62,7 @@ TEST(InteriorPoints, TheGridFillsTheBodyAndGoesToTheBoneOfTheNearestSurface) {
 TEST(InteriorPoints, AnEmptyOrFlatBodyHasNone) {
   MeshData mesh;
   const bake::MeshReference empty(mesh.positions, mesh.triangles);
-  EXPECT_TRUE(bake::BodyInteriorPoints(mesh.positions, mesh, empty, 0.005f).empty());
+  EXPECT_TRUE(bake::BodyInteriorPoints(mesh.positions, {}, 0, empty, 0.005f).empty());
   // One triangle: no inside.
   mesh.positions = {{0.f, 0.f, 0.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}};
   mesh.triangles = {0, 1, 2};
@@ -80,7 +70,8 @@ TEST(InteriorPoints, AnEmptyOrFlatBodyHasNone) {
   mesh.influence_joints = {0, 0, 0};
   mesh.influence_weights = {1.f, 1.f, 1.f};
   const bake::MeshReference flat(mesh.positions, mesh.triangles);
-  const auto interior = bake::BodyInteriorPoints(mesh.positions, mesh, flat, 0.005f);
+  const auto interior =
+      bake::BodyInteriorPoints(mesh.positions, bake::TriangleBones(mesh, 1), 1, flat, 0.005f);
   ASSERT_EQ(interior.size(), 1u);
   EXPECT_TRUE(interior[0].empty());
 }

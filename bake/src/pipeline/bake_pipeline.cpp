@@ -164,8 +164,8 @@ std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
   const uint32_t joints = static_cast<uint32_t>(regions.collider_frames.size());
   std::vector<std::vector<Float3>> interior =
       BoneInteriorPoints(regions, parents, body, config.hull.delta);
-  const std::vector<std::vector<Float3>> grid =
-      BodyInteriorPoints(regions.rest_positions, mesh, body, config.hull.delta);
+  const std::vector<std::vector<Float3>> grid = BodyInteriorPoints(
+      regions.rest_positions, TriangleBones(mesh, joints), joints, body, config.hull.delta);
   for (uint32_t j = 0; j < joints && j < grid.size(); ++j)
     interior[j].insert(interior[j].end(), grid[j].begin(), grid[j].end());
   const auto region_of = [&](size_t j) {

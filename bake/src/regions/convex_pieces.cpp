@@ -153,12 +153,12 @@ void Cut(const WorkPiece& piece, Vec3 axis, double cut, WorkPiece* below, WorkPi
   for (const Vec3& p : piece.loose) (Dot(p, axis) < cut ? below : above)->loose.push_back(p);
 }
 
-// Candidate cuts ranked by the hull volume they leave whose bloat is measured: the choice.
+// How many of the candidate cuts that leave the least hull volume have their bloat measured.
 constexpr size_t kBloatCandidates = 3;
 
 // Cuts the piece in two: of the candidate planes (three principal and three frame axes, seven
-// quantiles each), the few that leave the least hull volume are measured, and the one whose
-// worse side bloats least wins (ties: less volume). A cut between two parts removes the air a
+// evenly spaced positions each), the few that leave the least hull volume are measured, and the one
+// whose worse side bloats least wins (ties: less volume). A cut between two parts removes the air a
 // hull bridging them holds; the volume alone can prefer a cut that leaves the deep bridge on
 // one side. False when no candidate puts a solid on both sides. Sets both sides' bloat.
 bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece* right) {
@@ -192,7 +192,7 @@ bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece*
     }
   }
   if (candidates.empty()) return false;
-  // Stable: equal volumes keep the axis and quantile order (deterministic).
+  // Stable: equal volumes keep the axis and position order (deterministic).
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.volume < b.volume; });
   double best_bloat = INFINITY;

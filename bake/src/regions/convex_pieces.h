@@ -29,10 +29,10 @@ struct ConvexPiece {
 // triangles (those with all three corners in the region are clipped by the cuts, so the pieces'
 // hulls together hold every such triangle). `interior`: rest-pose points inside the body the
 // pieces' hulls hold too (along the bone), each going with the side of every cut it lies on.
-// `body`: the rest-pose body. The worst piece is cut
-// in two while it bloats beyond max_bloat and the budget allows: of the planes across its three
-// principal axes and the frame's three axes at seven quantiles, the three that leave the least
-// hull volume are measured, and the one whose worse side bloats least wins. Deterministic.
+// `body`: the rest-pose body. The worst piece is cut in two while it bloats beyond max_bloat and
+// the budget allows: of the planes across its three principal axes and the frame's three axes at
+// seven evenly spaced positions, the three that leave the least hull volume are measured, and
+// the one whose worse side bloats least wins. Deterministic.
 std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_positions,
                                                std::span<const uint32_t> triangles,
                                                std::span<const uint32_t> vertices,

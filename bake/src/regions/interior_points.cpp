@@ -16,34 +16,6 @@ bool DeepInside(const MeshReference& body, Float3 p, float delta) {
   return body.Inside(q) && body.Distance(q) > delta;
 }
 
-// The joint with the largest summed weight over the triangle's corners (ties: the lower index).
-int32_t TriangleBone(const MeshData& mesh, uint32_t triangle) {
-  std::vector<std::pair<uint32_t, float>> sums;
-  for (uint32_t k = 0; k < 3; ++k) {
-    const uint32_t v = mesh.triangles[3 * size_t{triangle} + k];
-    if (v + 1 >= mesh.influence_offsets.size()) continue;
-    for (uint32_t i = mesh.influence_offsets[v]; i < mesh.influence_offsets[v + 1]; ++i) {
-      const uint32_t joint = mesh.influence_joints[i];
-      auto it =
-          std::find_if(sums.begin(), sums.end(), [&](const auto& s) { return s.first == joint; });
-      if (it == sums.end()) {
-        sums.push_back({joint, mesh.influence_weights[i]});
-      } else {
-        it->second += mesh.influence_weights[i];
-      }
-    }
-  }
-  int32_t best = -1;
-  float best_weight = -1.f;
-  for (const auto& [joint, weight] : sums) {
-    if (weight > best_weight || (weight == best_weight && static_cast<int32_t>(joint) < best)) {
-      best = static_cast<int32_t>(joint);
-      best_weight = weight;
-    }
-  }
-  return best;
-}
-
 }  // namespace
 
 std::vector<std::vector<Float3>> BoneInteriorPoints(const Regions& regions,
@@ -72,10 +44,9 @@ std::vector<std::vector<Float3>> BoneInteriorPoints(const Regions& regions,
 }
 
 std::vector<std::vector<Float3>> BodyInteriorPoints(std::span<const Float3> rest_positions,
-                                                    const MeshData& mesh, const MeshReference& body,
+                                                    std::span<const int32_t> triangle_bones,
+                                                    uint32_t joints, const MeshReference& body,
                                                     float delta) {
-  uint32_t joints = 0;
-  for (uint16_t j : mesh.influence_joints) joints = std::max<uint32_t>(joints, j + 1u);
   std::vector<std::vector<Float3>> interior(joints);
   if (rest_positions.empty() || joints == 0) return interior;
   Float3 lo = rest_positions[0], hi = rest_positions[0];
@@ -106,7 +77,7 @@ std::vector<std::vector<Float3>> BodyInteriorPoints(std::span<const Float3> rest
     const double q[3] = {p.x, p.y, p.z};
     uint32_t triangle = kNoTriangle;
     body.ClosestPoint(q, nullptr, &triangle, nullptr);
-    if (triangle != kNoTriangle) owner[static_cast<size_t>(i)] = TriangleBone(mesh, triangle);
+    if (triangle < triangle_bones.size()) owner[static_cast<size_t>(i)] = triangle_bones[triangle];
   }
   for (int64_t i = 0; i < total; ++i) {
     const int32_t j = owner[static_cast<size_t>(i)];

@@ -9,7 +9,6 @@
 #include <span>
 #include <vector>
 
-#include "drape/formats/mesh_data.h"
 #include "drape/formats/types.h"
 
 namespace drape::bake {
@@ -23,13 +22,14 @@ std::vector<std::vector<Float3>> BoneInteriorPoints(const Regions& regions,
                                                     std::span<const int32_t> parents,
                                                     const MeshReference& body, float delta);
 
-// Per joint: the points of a grid over the body's bounding box (kInteriorGridCells cells along
-// its longest side) inside the body by more than delta, each given to the bone that carries the
-// nearest surface (the largest summed weight over that triangle's corners, as the regions
-// assign triangles). `rest_positions`: the rest-pose mesh; `mesh`: its triangles and weights.
+// Per joint (`joints` of them): the points of a grid over the body's bounding box
+// (kInteriorGridCells cells along its longest side) inside the body by more than delta, each given
+// to the bone that carries the nearest surface triangle (`triangle_bones`: TriangleBones in
+// regions.h, indexed as the body's triangles). `rest_positions`: the rest-pose mesh.
 inline constexpr uint32_t kInteriorGridCells = 32;
 std::vector<std::vector<Float3>> BodyInteriorPoints(std::span<const Float3> rest_positions,
-                                                    const MeshData& mesh, const MeshReference& body,
+                                                    std::span<const int32_t> triangle_bones,
+                                                    uint32_t joints, const MeshReference& body,
                                                     float delta);
 
 }  // namespace drape::bake

@@ -53,26 +53,12 @@ void AssignTriangles(const MeshData& mesh, Regions* regions) {
   for (size_t j = 0; j < joints; ++j) {
     for (uint32_t v : regions->rigid_vertices[j]) rigid_to[v] = static_cast<int32_t>(j);
   }
-  std::vector<float> weight(joints, 0.f);
-  std::vector<int32_t> touched;
-  for (size_t t = 0; t + 2 < mesh.triangles.size(); t += 3) {
-    touched.clear();
-    for (size_t c = 0; c < 3; ++c) {
-      const uint32_t v = mesh.triangles[t + c];
-      for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k) {
-        const int32_t j = mesh.influence_joints[k];
-        if (weight[j] == 0.f) touched.push_back(j);
-        weight[j] += mesh.influence_weights[k];
-      }
-    }
-    int32_t best = -1;
-    for (int32_t j : touched) {
-      if (best < 0 || weight[j] > weight[best] || (weight[j] == weight[best] && j < best)) best = j;
-    }
-    for (int32_t j : touched) weight[j] = 0.f;
+  const std::vector<int32_t> bones = TriangleBones(mesh, static_cast<uint32_t>(joints));
+  for (size_t t = 0; t < bones.size(); ++t) {
+    const int32_t best = bones[t];
     if (best < 0) continue;
     for (size_t c = 0; c < 3; ++c) {
-      const uint32_t v = mesh.triangles[t + c];
+      const uint32_t v = mesh.triangles[3 * t + c];
       if (rigid_to[v] != best) regions->shaping_vertices[best].push_back(v);
     }
   }
@@ -83,6 +69,32 @@ void AssignTriangles(const MeshData& mesh, Regions* regions) {
 }
 
 }  // namespace
+
+std::vector<int32_t> TriangleBones(const MeshData& mesh, uint32_t joint_count) {
+  std::vector<int32_t> bones(mesh.triangles.size() / 3, -1);
+  std::vector<float> weight(joint_count, 0.f);
+  std::vector<int32_t> touched;
+  for (size_t t = 0; t < bones.size(); ++t) {
+    touched.clear();
+    for (size_t c = 0; c < 3; ++c) {
+      const uint32_t v = mesh.triangles[3 * t + c];
+      if (size_t{v} + 1 >= mesh.influence_offsets.size()) continue;
+      for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k) {
+        const int32_t j = mesh.influence_joints[k];
+        if (static_cast<uint32_t>(j) >= joint_count) continue;
+        if (weight[j] == 0.f) touched.push_back(j);
+        weight[j] += mesh.influence_weights[k];
+      }
+    }
+    int32_t best = -1;
+    for (int32_t j : touched) {
+      if (best < 0 || weight[j] > weight[best] || (weight[j] == weight[best] && j < best)) best = j;
+    }
+    for (int32_t j : touched) weight[j] = 0.f;
+    bones[t] = best;
+  }
+  return bones;
+}
 
 Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions,
                     float shape_threshold) {

@@ -40,6 +40,11 @@ struct Regions {
 Status SplitRegions(const Character& character, float rigid_threshold, Regions* regions,
                     float shape_threshold = 1.f);
 
+// Per triangle (mesh.triangles / 3): the joint with the largest summed skin weight over its three
+// corners (ties: the lower index), the bone that carries it; -1 when no corner has an influence
+// below joint_count.
+std::vector<int32_t> TriangleBones(const MeshData& mesh, uint32_t joint_count);
+
 // Joint spheres (paper B §1.3, §3.1): centred on the joint, radius covering its flexible vertices
 // plus delta (metres). Written into the bind-pose frame the runtime expects. With the bones' hulls
 // (inflated, built from `regions`) and the mesh's triangles, a sphere covers only what the hulls
