@@ -1,7 +1,8 @@
 // The nearest exit of the union of overlapping colliders from a point inside them: where a
 // particle inside a torso piece, its neighbouring piece and a joint sphere goes, rather than out
-// of the deepest one into another (docs/ALGORITHMS.md §8.6). Only particles inside colliders
-// whose deepest exit lies inside another come here.
+// of the deepest one into another (docs/ALGORITHMS.md §8.6). Query comes here when the deepest
+// contact's exit lies inside another collider; CollideBatch for a particle that started inside
+// and is still more than kUnionExitMinDepth inside after every pass.
 #include <algorithm>
 #include <cmath>
 
@@ -63,6 +64,24 @@ ContactQuery HullColliderSet::ExitContact(const ExitHolders& holders, const Exit
   return c;
 }
 
+template <typename IsFree>
+bool HullColliderSet::FirstFreeExit(Float3 p0, const ExitHolders& holders, double max_distance,
+                                    IsFree is_free, ContactQuery* exit) const {
+  ExitKey keys[kMaxExits];
+  const uint32_t n = CollectExits(holders, keys);
+  for (uint32_t e = 0; e < n; ++e) {
+    const ContactQuery c = ExitContact(holders, keys[e]);
+    const Float3 d = c.point - p0;  // in double: coordinates up to float's range
+    if (std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z) > max_distance)
+      return false;  // nearest first: the others are beyond too (up to rounding)
+    if (is_free(ExitProbe(c))) {
+      *exit = c;
+      return true;
+    }
+  }
+  return false;
+}
+
 bool HullColliderSet::InsideAnyCandidate(Float3 x, const ContactFrames& candidates) const {
   for (uint32_t i = 0; i < candidates.count; ++i) {
     if (ColliderContact(candidates.candidates[i], *candidates.frames[i], x, x).inside_end)
@@ -82,19 +101,9 @@ bool HullColliderSet::NearestUnionExit(Float3 p0, Float3 x, const ContactFrames&
     holders.frames[h] = candidates.frames[i];
     holders.local[h] = TransformPoint(candidates.frames[i]->to_local_end, x);
   }
-  ExitKey keys[kMaxExits];
-  const uint32_t n = CollectExits(holders, keys);
-  for (uint32_t e = 0; e < n; ++e) {
-    const ContactQuery c = ExitContact(holders, keys[e]);
-    const Float3 d = c.point - p0;
-    if (std::sqrt(double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z) > max_distance)
-      return false;  // nearest first: the others are beyond too (up to rounding)
-    if (!InsideAnyCandidate(ExitProbe(c), candidates)) {
-      *exit = c;
-      return true;
-    }
-  }
-  return false;
+  return FirstFreeExit(
+      p0, holders, max_distance,
+      [&](Float3 probe) { return !InsideAnyCandidate(probe, candidates); }, exit);
 }
 
 void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuery* best) const {
@@ -114,17 +123,12 @@ void HullColliderSet::UnionExit(Float3 p0, Float3 p1, uint8_t kinds, ContactQuer
       holders.local[h] = TransformPoint(active_[k].to_local_end, p1);
     }
   }
-  ExitKey keys[kMaxExits];
-  const uint32_t n = CollectExits(holders, keys);
-  for (uint32_t e = 0; e < n; ++e) {
-    const ContactQuery c = ExitContact(holders, keys[e]);
-    if (std::sqrt(double(Dot(c.point - p0, c.point - p0))) > reach) return;
-    if (!InsideAny(ExitProbe(c), kinds)) {
-      const uint8_t flags = best->flags;  // what the contact is (started inside) stays
-      *best = c;
-      best->flags = flags;
-      return;
-    }
+  ContactQuery exit;
+  if (FirstFreeExit(
+          p0, holders, reach, [&](Float3 probe) { return !InsideAny(probe, kinds); }, &exit)) {
+    const uint8_t flags = best->flags;  // what the contact is (started inside) stays
+    *best = exit;
+    best->flags = flags;
   }
 }
 

@@ -263,6 +263,11 @@ class HullColliderSet {
   // The holders' exits, the nearest kMaxExitTries first and in order; returns how many to try.
   uint32_t CollectExits(const ExitHolders& holders, ExitKey* keys) const;
   ContactQuery ExitContact(const ExitHolders& holders, const ExitKey& key) const;
+  // The first of the holders' nearest exits, within max_distance of p0, whose probe is_free
+  // accepts (union_exit.cpp: the batch's candidates, or Query's colliders of some kinds).
+  template <typename IsFree>
+  bool FirstFreeExit(Float3 p0, const ExitHolders& holders, double max_distance, IsFree is_free,
+                     ContactQuery* exit) const;
   // The nearest exit of x (the end of the segment) from the candidates that hold it that lies
   // outside every candidate and within max_distance of p0; false when none of the nearest
   // kMaxExitTries does (a pinch, or the crease of two colliders).
