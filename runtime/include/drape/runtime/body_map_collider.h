@@ -115,6 +115,7 @@ class BodyMapCollider {
 
  private:
   friend class BodyMapSequence;
+  friend class BodyMapRenderer;
   friend struct detail::BodyMapWalk;
   friend struct BodyMapColliderAccess;  // tests and tools: body_map/body_map_collider_access.h
   struct Decoder;                       // body_map/body_map_decode.cpp

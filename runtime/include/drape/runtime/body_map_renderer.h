@@ -1,0 +1,111 @@
+#pragma once
+// Paper A's body maps for any pose the engine drives: skins the stored bind mesh with the frame's
+// skinning matrices, offsets it by epsilon along its vertex normals and rasterizes the front and
+// back surfaces (z-view, slab only) straight into a BodyMapCollider, over the window a region
+// box allows. How it works and what it costs: docs/ALGORITHMS.md §7.6, docs/PERFORMANCE.md.
+//
+//   BodyMapRenderer renderer;
+//   renderer.Init(asset.mesh, {.texel_size = 0.002f, .epsilon = asset.body_maps.epsilon});
+//   BodyMapCollider maps;
+//   renderer.Render(pose.skinning(), &maps, &garment_reach);  // per frame
+//   maps.CollideBatch(previous, positions, velocities, flags, params);
+//
+// Baked poses (BodyMapCollider::Build) stay exact for the poses a bake saw and hold air gaps;
+// rendered maps hold the slab alone (an arm before the chest fills the air between them).
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "drape/formats/mesh_data.h"
+#include "drape/formats/status.h"
+#include "drape/formats/types.h"
+#include "drape/runtime/body_map_collider.h"
+
+namespace drape {
+
+struct BodyMapRenderOptions {
+  float texel_size = 0.002f;  // metres, [1e-4, 1]: the maps' resolution
+  float epsilon = 0.005f;     // metres, [0, 1]: the surface offset along the vertex normals
+  DepthSampling sampling = DepthSampling::kNearest;
+  uint32_t max_side = 8192;  // texels, [16, 16384]: a pose whose window needs more is an error
+  // Texel corners lie at grid_x + k * texel_size (and y alike), every frame, so the grid does not
+  // slide under the body as it moves; a baked pose's origin puts both on one grid. Finite.
+  float grid_x = 0.f, grid_y = 0.f;  // metres
+};
+
+// An asset-frame box: only triangles that reach it are drawn and the window is cut to it. The
+// maps answer for points inside the box; outside it they may miss body parts (a scene's garment
+// reach, padded by what a particle moves in a step).
+struct RenderRegion {
+  static constexpr float kInf = std::numeric_limits<float>::infinity();
+  Float3 min{-kInf, -kInf, -kInf};  // metres
+  Float3 max{kInf, kInf, kInf};
+};
+
+// What the last Render drew.
+struct BodyMapRenderStats {
+  uint32_t width = 0, height = 0;  // texels of the window
+  uint32_t triangles_drawn = 0;    // triangles that reach the region
+  uint32_t valid_texels = 0;       // texels the body covers
+  uint32_t grew = 0;               // Render calls that had to enlarge the buffers (allocated)
+};
+
+class BodyMapRenderer {
+ public:
+  // Keeps a reference to `mesh`, which must outlive the renderer. Checks the mesh (indices,
+  // influences, finite positions) and the options, and reserves buffers for 1.5x the bind
+  // pose's window (allocates; the first Render into a collider allocates its grid once). On error
+  // the renderer is empty and Render fails.
+  Status Init(const MeshData& mesh, const BodyMapRenderOptions& options);
+
+  // Renders the pose `skinning` (one matrix per joint, SkeletonPose::skinning()) into *maps,
+  // replacing what it held (clip -1, time 0). region: null for the whole body. No allocation
+  // unless the window is larger than every earlier one (stats().grew counts those calls). Identical
+  // bits at any thread count. Too few matrices, a non-finite skinned vertex, an empty or inverted
+  // region, or a window over max_side: kInvalidArgument naming the reason, and *maps empty.
+  Status Render(std::span<const Mat34> skinning, BodyMapCollider* maps,
+                const RenderRegion* region = nullptr);
+
+  bool empty() const { return mesh_ == nullptr; }
+  const BodyMapRenderOptions& options() const { return options_; }
+  const BodyMapRenderStats& stats() const { return stats_; }
+  // The skinned, unoffset vertices of the last successful Render (asset frame, metres).
+  std::span<const Float3> posed_vertices() const { return posed_; }
+  size_t memory_bytes() const;  // the renderer's buffers, not the collider's
+
+ private:
+  struct Window {                           // the texel grid of one render
+    double origin_x = 0.0, origin_y = 0.0;  // metres, a multiple of the texel size
+    uint32_t width = 0, height = 0;         // texels
+  };
+  Status CheckRegion(const RenderRegion& region) const;
+  Status SkinAndOffset(std::span<const Mat34> skinning);
+  void ComputeNormals();
+  void CullTriangles(const RenderRegion& region);
+  Status PlaceWindow(const RenderRegion& region, Window* window) const;
+  void Rasterize(const Window& window, BodyMapCollider* maps);
+  void ShadeNormals(const Window& window, BodyMapCollider* maps) const;
+  void Publish(const Window& window, BodyMapCollider* maps);
+  void Reserve(size_t texels);
+
+  const MeshData* mesh_ = nullptr;
+  BodyMapRenderOptions options_;
+  uint32_t joints_needed_ = 0;  // 1 + the largest joint index the influences name
+  BodyMapRenderStats stats_;
+  // Per vertex: the triangles around it (compressed rows), for gathered normals.
+  std::vector<uint32_t> vertex_triangle_offsets_;
+  std::vector<uint32_t> vertex_triangles_;
+  std::vector<Float3> posed_;          // skinned vertices
+  std::vector<Float3> normals_;        // unit vertex normals (zero where undefined)
+  std::vector<Float3> offset_;         // posed + epsilon * normal
+  std::vector<Float3> face_normals_;   // per triangle, unnormalised (twice the area)
+  std::vector<uint32_t> drawn_;        // triangles that reach the region, ascending
+  std::vector<uint32_t> top_face_;     // per texel: the triangle of the front surface
+  std::vector<uint32_t> bottom_face_;  // per texel: the triangle of the back surface
+  size_t reserved_texels_ = 0;
+};
+
+}  // namespace drape

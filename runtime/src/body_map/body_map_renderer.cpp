@@ -1,0 +1,526 @@
+// BodyMapRenderer: the maps of a pose rendered at run time. Render is a recipe of stages:
+// skin and offset the mesh, cull the triangles to the region, place the window on the texel
+// lattice, rasterize both surfaces in row bands, shade the normals, and let the collider derive
+// its bounds and blocks (docs/ALGORITHMS.md §7.6).
+#include "drape/runtime/body_map_renderer.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "drape/runtime/math.h"
+#include "drape/runtime/normal_encoding.h"
+#include "drape/runtime/skinning.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace drape {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr uint32_t kNoFace = std::numeric_limits<uint32_t>::max();
+// Init reserves this much more than the bind pose's window in each dimension: a pose that
+// spreads the limbs needs a wider window.
+constexpr double kReserveGrowth = 1.5;
+
+Status Invalid(const std::string& message) {
+  return Status(StatusCode::kInvalidArgument, "BodyMapRenderer: " + message);
+}
+
+// One triangle set up for the rasterizer in window coordinates (texel units; texel (i, j) is
+// sampled at its centre (i + 1/2, j + 1/2)). Each edge is evaluated canonically, from its lower
+// to its higher vertex index, so the two triangles sharing an edge compute exactly negated values
+// and a texel centre on it is covered by both (the tests are inclusive): no crack, and a texel
+// covered twice keeps the same extreme depth whichever triangle draws it first.
+struct RasterTriangle {
+  struct Edge {
+    double ax, ay, dx, dy;  // canonical start vertex and its difference to the end vertex
+    double sign;            // +1 or -1: makes the value >= 0 inside the triangle
+    double RowTerm(double py) const { return dx * (py - ay); }
+    bool Inside(double row_term, double px) const {
+      return sign * (row_term - dy * (px - ax)) >= 0.0;
+    }
+    // Narrows [*lo, *hi] to about the texels inside the edge on this row, one texel generous on
+    // the side it cuts (the caller still tests each texel exactly). False: none inside.
+    bool Narrow(double row_term, int64_t* lo, int64_t* hi) const {
+      if (dy == 0.0) return Inside(row_term, 0.0);       // the same value all along the row
+      const double boundary = ax + row_term / dy - 0.5;  // texel index where the value is 0
+      if (!(std::fabs(boundary) < 1e15)) return true;
+      if (-sign * dy > 0.0) {
+        *lo = std::max(*lo, static_cast<int64_t>(std::floor(boundary)) - 1);
+      } else {
+        *hi = std::min(*hi, static_cast<int64_t>(std::ceil(boundary)) + 1);
+      }
+      return *lo <= *hi;
+    }
+  };
+  Edge edge[3];
+  double x0, y0;          // vertex 0
+  double grad_x, grad_y;  // dz per texel along x and y
+  double z0, z_min, z_max;
+  int64_t i_lo, i_hi, j_lo, j_hi;  // texel centres the triangle's box holds (may be empty)
+
+  // False when the triangle has no area in the window (it covers no texel centre).
+  bool SetUp(const Float3* vertices, const uint32_t v[3], double origin_x, double origin_y,
+             double inverse_texel, double width, double height) {
+    double x[3], y[3], z[3];
+    for (int k = 0; k < 3; ++k) {
+      x[k] = (static_cast<double>(vertices[v[k]].x) - origin_x) * inverse_texel;
+      y[k] = (static_cast<double>(vertices[v[k]].y) - origin_y) * inverse_texel;
+      z[k] = vertices[v[k]].z;
+    }
+    const double area2 = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    if (!(area2 != 0.0)) return false;
+    const double orientation = area2 > 0.0 ? 1.0 : -1.0;
+    for (int k = 0; k < 3; ++k) {
+      int from = (k + 1) % 3, to = (k + 2) % 3;  // counter-clockwise: the inside is on the left
+      double sign = orientation;
+      if (v[from] > v[to]) {
+        std::swap(from, to);
+        sign = -sign;
+      }
+      edge[k] = {x[from], y[from], x[to] - x[from], y[to] - y[from], sign};
+    }
+    x0 = x[0];
+    y0 = y[0];
+    const double inverse_area2 = 1.0 / area2;
+    grad_x = ((z[1] - z[0]) * (y[2] - y[0]) - (z[2] - z[0]) * (y[1] - y[0])) * inverse_area2;
+    grad_y = ((z[2] - z[0]) * (x[1] - x[0]) - (z[1] - z[0]) * (x[2] - x[0])) * inverse_area2;
+    z0 = z[0];
+    z_min = std::min({z[0], z[1], z[2]});
+    z_max = std::max({z[0], z[1], z[2]});
+    // Centres c = i + 1/2 within [min, max]: i in [ceil(min - 1/2), floor(max - 1/2)], kept
+    // within the window before the conversion (a vertex far outside a region).
+    const auto index = [](double c, double size) {
+      return static_cast<int64_t>(std::clamp(c, -1.0, size));
+    };
+    i_lo = index(std::ceil(std::min({x[0], x[1], x[2]}) - 0.5), width);
+    i_hi = index(std::floor(std::max({x[0], x[1], x[2]}) - 0.5), width);
+    j_lo = index(std::ceil(std::min({y[0], y[1], y[2]}) - 0.5), height);
+    j_hi = index(std::floor(std::max({y[0], y[1], y[2]}) - 0.5), height);
+    return true;
+  }
+  // The plane's z at a texel centre, clamped to the vertices' range (a sliver's steep gradient
+  // cannot extrapolate past its corners).
+  float Depth(double px, double py) const {
+    const double z = z0 + grad_x * (px - x0) + grad_y * (py - y0);
+    return static_cast<float>(std::clamp(z, z_min, z_max));
+  }
+};
+
+// The normal rule at a texel centre: the triangle's vertex normals interpolated with the clamped
+// barycentrics; its face normal where they cancel; `fallback` where it has none. Set up once per
+// triangle and reused along a row, where neighbouring texels mostly share their triangle.
+class NormalInterpolator {
+ public:
+  void SetUp(const Float3* offset, const Float3* normals, const uint32_t* triangles,
+             uint32_t triangle, Float3 face_normal, double origin_x, double origin_y,
+             double inverse_texel, Float3 fallback) {
+    const uint32_t* v = triangles + 3 * size_t{triangle};
+    double x[3], y[3];
+    for (int k = 0; k < 3; ++k) {
+      x[k] = (static_cast<double>(offset[v[k]].x) - origin_x) * inverse_texel;
+      y[k] = (static_cast<double>(offset[v[k]].y) - origin_y) * inverse_texel;
+      n_[k] = normals[v[k]];
+    }
+    const double inverse_area2 =
+        1.0 / ((x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]));
+    x0_ = x[0];
+    y0_ = y[0];
+    b1_x_ = (y[2] - y[0]) * inverse_area2;
+    b1_y_ = -(x[2] - x[0]) * inverse_area2;
+    b2_x_ = -(y[1] - y[0]) * inverse_area2;
+    b2_y_ = (x[1] - x[0]) * inverse_area2;
+    fallback_ = NormalizeOr(face_normal, fallback);
+    triangle_ = triangle;
+  }
+  uint32_t triangle() const { return triangle_; }
+  Float3 At(double px, double py) const {
+    const double dx = px - x0_, dy = py - y0_;
+    const double b1 = std::clamp(b1_x_ * dx + b1_y_ * dy, 0.0, 1.0);
+    const double b2 = std::clamp(b2_x_ * dx + b2_y_ * dy, 0.0, 1.0 - b1);
+    const float w1 = static_cast<float>(b1), w2 = static_cast<float>(b2);
+    // Unnormalised: the octahedral code divides by the L1 norm anyway.
+    const Float3 n = n_[0] * (1.f - w1 - w2) + n_[1] * w1 + n_[2] * w2;
+    return std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z) > 1e-6f ? n : fallback_;
+  }
+
+ private:
+  uint32_t triangle_ = kNoFace;
+  double x0_ = 0.0, y0_ = 0.0;
+  double b1_x_ = 0.0, b1_y_ = 0.0, b2_x_ = 0.0, b2_y_ = 0.0;  // barycentric gradients
+  Float3 n_[3];
+  Float3 fallback_;
+};
+
+}  // namespace
+
+Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& options) {
+  mesh_ = nullptr;
+  stats_ = {};
+  const BodyMapRenderOptions& o = options;
+  if (!(o.texel_size >= 1e-4f && o.texel_size <= 1.f)) {
+    return Invalid("texel_size " + std::to_string(o.texel_size) + " is outside [1e-4, 1] m");
+  }
+  if (!(o.epsilon >= 0.f && o.epsilon <= 1.f)) {
+    return Invalid("epsilon " + std::to_string(o.epsilon) + " is outside [0, 1] m");
+  }
+  if (o.max_side < 16 || o.max_side > 16384) {
+    return Invalid("max_side " + std::to_string(o.max_side) + " is outside [16, 16384]");
+  }
+  if (!std::isfinite(o.grid_x) || !std::isfinite(o.grid_y)) {
+    return Invalid("grid_x and grid_y must be finite");
+  }
+  if (o.sampling != DepthSampling::kNearest && o.sampling != DepthSampling::kBilinear) {
+    return Invalid("unknown depth sampling");
+  }
+  const uint32_t vertices = mesh.vertex_count();
+  if (mesh.triangles.empty() || mesh.triangles.size() % 3 != 0) {
+    return Invalid("the mesh has " + std::to_string(mesh.triangles.size()) +
+                   " triangle indices (a positive multiple of 3 is needed)");
+  }
+  for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+    if (mesh.triangles[k] >= vertices) {
+      return Invalid("triangle index " + std::to_string(k) + " names vertex " +
+                     std::to_string(mesh.triangles[k]) + " of " + std::to_string(vertices));
+    }
+  }
+  for (uint32_t v = 0; v < vertices; ++v) {
+    if (!IsFinite(mesh.positions[v])) {
+      return Invalid("vertex " + std::to_string(v) + " is not finite");
+    }
+  }
+  const bool skinned = mesh.influence_offsets.size() == size_t{vertices} + 1;
+  joints_needed_ = 0;
+  if (skinned) {
+    if (mesh.influence_offsets.back() > mesh.influence_joints.size()) {
+      return Invalid("the influence rows end past the influence arrays");
+    }
+    for (uint32_t k = 0; k < mesh.influence_offsets.back(); ++k) {
+      joints_needed_ = std::max<uint32_t>(joints_needed_, mesh.influence_joints[k] + 1u);
+    }
+  }
+  options_ = options;
+
+  // The triangles around each vertex, ascending: normals are gathered per vertex in a fixed
+  // order, so they do not depend on the thread count.
+  const uint32_t triangles = mesh.triangle_count();
+  vertex_triangle_offsets_.assign(size_t{vertices} + 1, 0u);
+  for (uint32_t index : mesh.triangles) ++vertex_triangle_offsets_[index + 1];
+  for (uint32_t v = 0; v < vertices; ++v) {
+    vertex_triangle_offsets_[v + 1] += vertex_triangle_offsets_[v];
+  }
+  vertex_triangles_.resize(mesh.triangles.size());
+  std::vector<uint32_t> fill(vertex_triangle_offsets_.begin(), vertex_triangle_offsets_.end() - 1);
+  for (uint32_t t = 0; t < triangles; ++t) {
+    for (int k = 0; k < 3; ++k) vertex_triangles_[fill[mesh.triangles[3 * t + k]]++] = t;
+  }
+  posed_.resize(vertices);
+  normals_.resize(vertices);
+  offset_.resize(vertices);
+  face_normals_.resize(triangles);
+  drawn_.reserve(triangles);
+
+  // The bind pose's window, grown: most poses then render without allocating.
+  Float3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+  for (const Float3& p : mesh.positions) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  const double pad = 2.0 * (static_cast<double>(o.epsilon) + o.texel_size);
+  const double side_x = (static_cast<double>(hi.x) - lo.x + pad) / o.texel_size + 3.0;
+  const double side_y = (static_cast<double>(hi.y) - lo.y + pad) / o.texel_size + 3.0;
+  const double limit = o.max_side;
+  reserved_texels_ = static_cast<size_t>(std::min(kReserveGrowth * side_x, limit) *
+                                         std::min(kReserveGrowth * side_y, limit));
+  top_face_.reserve(reserved_texels_);
+  bottom_face_.reserve(reserved_texels_);
+  mesh_ = &mesh;
+  return Status::Ok();
+}
+
+Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider* maps,
+                               const RenderRegion* region) {
+  if (maps == nullptr) return Invalid("no collider to render into");
+  maps->Clear();
+  stats_.width = stats_.height = stats_.triangles_drawn = stats_.valid_texels = 0;
+  if (mesh_ == nullptr) return Invalid("not initialised (Init failed or was not called)");
+  const RenderRegion everywhere;
+  const RenderRegion& box = region != nullptr ? *region : everywhere;
+  if (Status s = CheckRegion(box); !s.ok()) return s;
+  if (Status s = SkinAndOffset(skinning); !s.ok()) return s;
+  CullTriangles(box);
+  Window window;
+  if (Status s = PlaceWindow(box, &window); !s.ok()) return s;
+  if (window.width == 0) return Status::Ok();  // nothing of the body reaches the region
+  Publish(window, maps);
+  Rasterize(window, maps);
+  ShadeNormals(window, maps);
+  maps->Finish();
+  stats_.valid_texels = maps->stats().valid_texels;
+  return Status::Ok();
+}
+
+Status BodyMapRenderer::CheckRegion(const RenderRegion& region) const {
+  const float lo[3] = {region.min.x, region.min.y, region.min.z};
+  const float hi[3] = {region.max.x, region.max.y, region.max.z};
+  for (int c = 0; c < 3; ++c) {
+    if (std::isnan(lo[c]) || std::isnan(hi[c]) || !(lo[c] <= hi[c]) || lo[c] == kInf ||
+        hi[c] == -kInf) {
+      return Invalid("the region's axis " + std::to_string(c) + " is empty or not a number ([" +
+                     std::to_string(lo[c]) + ", " + std::to_string(hi[c]) + "])");
+    }
+  }
+  return Status::Ok();
+}
+
+// Stage 1: the skinned vertices, their normals, and the surface offset by epsilon.
+Status BodyMapRenderer::SkinAndOffset(std::span<const Mat34> skinning) {
+  if (skinning.size() < joints_needed_) {
+    return Invalid(std::to_string(skinning.size()) + " skinning matrices, the mesh's influences " +
+                   "name " + std::to_string(joints_needed_) + " joints");
+  }
+  if (Status s = SkinMesh(*mesh_, skinning, posed_); !s.ok()) return Invalid(s.message());
+  const int64_t vertices = static_cast<int64_t>(posed_.size());
+  int64_t first_bad = vertices;
+#pragma omp parallel for schedule(static) reduction(min : first_bad)
+  for (int64_t v = 0; v < vertices; ++v) {
+    // Beyond 1e15 m the window arithmetic loses every texel: a hostile matrix, not a pose.
+    const Float3 p = posed_[v];
+    const bool sane = std::fabs(p.x) < 1e15f && std::fabs(p.y) < 1e15f && std::fabs(p.z) < 1e15f;
+    if (!sane) first_bad = std::min(first_bad, v);
+  }
+  if (first_bad < vertices) {
+    return Invalid("skinned vertex " + std::to_string(first_bad) +
+                   " is not finite or beyond 1e15 m (check the skinning matrices)");
+  }
+  ComputeNormals();
+  const float epsilon = options_.epsilon;
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < vertices; ++v) offset_[v] = posed_[v] + normals_[v] * epsilon;
+  return Status::Ok();
+}
+
+// Area-weighted vertex normals, gathered per vertex in triangle order.
+void BodyMapRenderer::ComputeNormals() {
+  const uint32_t* tri = mesh_->triangles.data();
+  const int64_t triangles = static_cast<int64_t>(face_normals_.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t t = 0; t < triangles; ++t) {
+    const Float3 a = posed_[tri[3 * t]], b = posed_[tri[3 * t + 1]], c = posed_[tri[3 * t + 2]];
+    face_normals_[t] = Cross(b - a, c - a);
+  }
+  const int64_t vertices = static_cast<int64_t>(posed_.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t v = 0; v < vertices; ++v) {
+    Float3 sum{0.f, 0.f, 0.f};
+    for (uint32_t k = vertex_triangle_offsets_[v]; k < vertex_triangle_offsets_[v + 1]; ++k) {
+      sum += face_normals_[vertex_triangles_[k]];
+    }
+    normals_[v] = NormalizeOr(sum, Float3{0.f, 0.f, 0.f});
+  }
+}
+
+// Stage 2: the triangles whose offset box meets the region, ascending.
+void BodyMapRenderer::CullTriangles(const RenderRegion& region) {
+  drawn_.clear();
+  const uint32_t* tri = mesh_->triangles.data();
+  const uint32_t triangles = static_cast<uint32_t>(face_normals_.size());
+  for (uint32_t t = 0; t < triangles; ++t) {
+    const Float3 a = offset_[tri[3 * t]], b = offset_[tri[3 * t + 1]], c = offset_[tri[3 * t + 2]];
+    const bool reaches =
+        std::max({a.x, b.x, c.x}) >= region.min.x && std::min({a.x, b.x, c.x}) <= region.max.x &&
+        std::max({a.y, b.y, c.y}) >= region.min.y && std::min({a.y, b.y, c.y}) <= region.max.y &&
+        std::max({a.z, b.z, c.z}) >= region.min.z && std::min({a.z, b.z, c.z}) <= region.max.z;
+    if (reaches) drawn_.push_back(t);  // reserved for every triangle at Init
+  }
+  stats_.triangles_drawn = static_cast<uint32_t>(drawn_.size());
+}
+
+// Stage 3: the texel lattice (multiples of the texel size, so the grid does not slide between
+// frames) over the drawn triangles' box, cut to the region, with one background texel around.
+Status BodyMapRenderer::PlaceWindow(const RenderRegion& region, Window* window) const {
+  *window = Window{};
+  if (drawn_.empty()) return Status::Ok();
+  const uint32_t* tri = mesh_->triangles.data();
+  double lo_x = kInf, lo_y = kInf, hi_x = -kInf, hi_y = -kInf;
+  for (uint32_t t : drawn_) {
+    for (int k = 0; k < 3; ++k) {
+      const Float3 p = offset_[tri[3 * t + k]];
+      lo_x = std::min<double>(lo_x, p.x);
+      hi_x = std::max<double>(hi_x, p.x);
+      lo_y = std::min<double>(lo_y, p.y);
+      hi_y = std::max<double>(hi_y, p.y);
+    }
+  }
+  lo_x = std::max<double>(lo_x, region.min.x);
+  hi_x = std::min<double>(hi_x, region.max.x);
+  lo_y = std::max<double>(lo_y, region.min.y);
+  hi_y = std::min<double>(hi_y, region.max.y);
+  const double t = options_.texel_size;
+  const double gx = options_.grid_x, gy = options_.grid_y;
+  const double i0 = std::floor((lo_x - gx) / t) - 1.0, i1 = std::floor((hi_x - gx) / t) + 1.0;
+  const double j0 = std::floor((lo_y - gy) / t) - 1.0, j1 = std::floor((hi_y - gy) / t) + 1.0;
+  const double width = i1 - i0 + 1.0, height = j1 - j0 + 1.0;
+  if (!(width <= options_.max_side && height <= options_.max_side)) {
+    return Invalid("the pose needs a " + std::to_string(width) + " x " + std::to_string(height) +
+                   "-texel window (max_side " + std::to_string(options_.max_side) +
+                   "): pass a region or a larger texel size");
+  }
+  // The collider stores its origin in float; the raster samples the same lattice.
+  window->origin_x = static_cast<float>(gx + i0 * t);
+  window->origin_y = static_cast<float>(gy + j0 * t);
+  window->width = static_cast<uint32_t>(width);
+  window->height = static_cast<uint32_t>(height);
+  return Status::Ok();
+}
+
+// The collider's grid for this window, every texel background.
+void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
+  const size_t texels = static_cast<size_t>(window.width) * window.height;
+  if (texels > reserved_texels_) {
+    ++stats_.grew;
+    reserved_texels_ = texels;
+  }
+  Reserve(reserved_texels_);
+  // The collider's grid and everything Finish derives from it, for the largest window so far.
+  maps->slabs_.reserve(reserved_texels_);
+  maps->normals_.reserve(reserved_texels_);
+  maps->blocks_.reserve(reserved_texels_ / 64 + options_.max_side / 4 + 1);  // 8x8 blocks
+  if (options_.sampling == DepthSampling::kBilinear) maps->bilinear_ok_.reserve(reserved_texels_);
+  maps->slabs_.assign(texels, BodyMapCollider::Slab{-kInf, kInf});
+  maps->normals_.resize(texels);
+  top_face_.assign(texels, kNoFace);
+  bottom_face_.assign(texels, kNoFace);
+  maps->width_ = window.width;
+  maps->height_ = window.height;
+  maps->width_f_ = static_cast<float>(window.width);
+  maps->height_f_ = static_cast<float>(window.height);
+  maps->origin_x_ = static_cast<float>(window.origin_x);
+  maps->origin_y_ = static_cast<float>(window.origin_y);
+  maps->texel_size_ = options_.texel_size;
+  maps->inv_texel_size_ = 1.f / options_.texel_size;
+  maps->sampling_ = options_.sampling;
+  stats_.width = window.width;
+  stats_.height = window.height;
+}
+
+void BodyMapRenderer::Reserve(size_t texels) {
+  top_face_.reserve(texels);
+  bottom_face_.reserve(texels);
+}
+
+// Stage 4: per texel the highest (front) and lowest (back) z of the triangles covering its
+// centre, and which triangle it was (ties: the lower index, as triangles are drawn ascending).
+// Row bands run in parallel; each draws every triangle crossing its rows, so a texel is written
+// by one band only and the result does not depend on the banding.
+void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
+  const int64_t width = window.width, height = window.height;
+  int bands = 1;
+#ifdef _OPENMP
+  bands = 4 * omp_get_max_threads();
+#endif
+  const int64_t rows_per_band = std::max<int64_t>(8, (height + bands - 1) / bands);
+  const int64_t band_count = (height + rows_per_band - 1) / rows_per_band;
+  const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
+  const uint32_t* tri = mesh_->triangles.data();
+  BodyMapCollider::Slab* slabs = maps->slabs_.data();
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int64_t band = 0; band < band_count; ++band) {
+    const int64_t row_begin = band * rows_per_band;
+    const int64_t row_end = std::min(height, row_begin + rows_per_band);
+    for (uint32_t t : drawn_) {
+      const uint32_t* v = tri + 3 * size_t{t};
+      // Rows first, from the vertices alone: most triangles miss the band.
+      const double y_lo = std::min({offset_[v[0]].y, offset_[v[1]].y, offset_[v[2]].y});
+      const double y_hi = std::max({offset_[v[0]].y, offset_[v[1]].y, offset_[v[2]].y});
+      if ((y_hi - window.origin_y) * inverse_texel < static_cast<double>(row_begin) ||
+          (y_lo - window.origin_y) * inverse_texel > static_cast<double>(row_end) + 1.0) {
+        continue;
+      }
+      RasterTriangle r;
+      if (!r.SetUp(offset_.data(), v, window.origin_x, window.origin_y, inverse_texel,
+                   static_cast<double>(width), static_cast<double>(height))) {
+        continue;
+      }
+      const int64_t j_begin = std::max(r.j_lo, row_begin), j_end = std::min(r.j_hi + 1, row_end);
+      const int64_t i_begin = std::max<int64_t>(r.i_lo, 0), i_end = std::min(r.i_hi + 1, width);
+      for (int64_t j = j_begin; j < j_end; ++j) {
+        const double py = static_cast<double>(j) + 0.5;
+        const double row[3] = {r.edge[0].RowTerm(py), r.edge[1].RowTerm(py), r.edge[2].RowTerm(py)};
+        int64_t lo = i_begin, hi = i_end - 1;
+        if (!(r.edge[0].Narrow(row[0], &lo, &hi) && r.edge[1].Narrow(row[1], &lo, &hi) &&
+              r.edge[2].Narrow(row[2], &lo, &hi))) {
+          continue;
+        }
+        for (int64_t i = lo; i <= hi; ++i) {
+          const double px = static_cast<double>(i) + 0.5;
+          if (!(r.edge[0].Inside(row[0], px) && r.edge[1].Inside(row[1], px) &&
+                r.edge[2].Inside(row[2], px))) {
+            continue;
+          }
+          const float z = r.Depth(px, py);
+          const size_t k = static_cast<size_t>(j * width + i);
+          BodyMapCollider::Slab& s = slabs[k];
+          if (z > s.top) {
+            s.top = z;
+            top_face_[k] = t;
+          }
+          if (z < s.bottom) {
+            s.bottom = z;
+            bottom_face_[k] = t;
+          }
+        }
+      }
+    }
+  }
+}
+
+// Stage 5: the outward normal of each covered texel's front and back surfaces, oct16.
+void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) const {
+  const int64_t width = window.width, height = window.height;
+  const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
+  const uint32_t* tri = mesh_->triangles.data();
+  const std::array<uint16_t, 2> up = EncodeOct16({0.f, 0.f, 1.f});
+#pragma omp parallel for schedule(static)
+  for (int64_t j = 0; j < height; ++j) {
+    const double py = static_cast<double>(j) + 0.5;
+    NormalInterpolator front, back;
+    for (int64_t i = 0; i < width; ++i) {
+      const size_t k = static_cast<size_t>(j * width + i);
+      BodyMapCollider::TexelNormals& out = maps->normals_[k];
+      const uint32_t front_face = top_face_[k], back_face = bottom_face_[k];
+      if (front_face == kNoFace) {
+        out = {{up[0], up[1]}, {up[0], up[1]}};
+        continue;
+      }
+      if (front.triangle() != front_face) {
+        front.SetUp(offset_.data(), normals_.data(), tri, front_face, face_normals_[front_face],
+                    window.origin_x, window.origin_y, inverse_texel, Float3{0.f, 0.f, 1.f});
+      }
+      if (back.triangle() != back_face) {
+        back.SetUp(offset_.data(), normals_.data(), tri, back_face, face_normals_[back_face],
+                   window.origin_x, window.origin_y, inverse_texel, Float3{0.f, 0.f, -1.f});
+      }
+      const double px = static_cast<double>(i) + 0.5;
+      const std::array<uint16_t, 2> a = EncodeOct16(front.At(px, py));
+      const std::array<uint16_t, 2> b = EncodeOct16(back.At(px, py));
+      out = {{a[0], a[1]}, {b[0], b[1]}};
+    }
+  }
+}
+
+size_t BodyMapRenderer::memory_bytes() const {
+  return sizeof(*this) +
+         (vertex_triangle_offsets_.capacity() + vertex_triangles_.capacity() + drawn_.capacity() +
+          top_face_.capacity() + bottom_face_.capacity()) *
+             sizeof(uint32_t) +
+         (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *
+             sizeof(Float3);
+}
+
+}  // namespace drape

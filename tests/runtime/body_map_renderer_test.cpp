@@ -1,0 +1,261 @@
+// BodyMapRenderer: maps rendered from a skinned mesh follow the pose, agree with the offset
+// surface, give the same bits at any thread count, stop allocating once the window fits, and
+// reject hostile input with a message and an empty collider.
+
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "body_map/body_map_collider_access.h"
+#include "drape/runtime/body_map_renderer.h"
+#include "drape/runtime/math.h"
+#include "octahedron_sphere.h"
+
+namespace drape {
+namespace {
+
+constexpr float kRadius = 0.1f;     // metres
+constexpr float kEpsilon = 0.005f;  // metres
+constexpr float kTexel = 0.001f;    // metres
+
+// Two spheres of radius kRadius, the first at the origin bound to joint 0, the second at
+// (0.5, 0, 0) bound to joint 1. 4 subdivisions: the facets lie within 1.2 mm of the sphere.
+MeshData TwoSpheres() {
+  const test::UnitSphereMesh unit = test::OctahedronSphere(4);
+  MeshData mesh;
+  for (int sphere = 0; sphere < 2; ++sphere) {
+    const uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+    for (const auto& p : unit.positions) {
+      mesh.positions.push_back(
+          {static_cast<float>(p[0] * kRadius) + 0.5f * static_cast<float>(sphere),
+           static_cast<float>(p[1] * kRadius), static_cast<float>(p[2] * kRadius)});
+    }
+    for (const auto& t : unit.triangles) {
+      for (uint32_t k : t) mesh.triangles.push_back(base + k);
+    }
+  }
+  mesh.influence_offsets.push_back(0);
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    mesh.influence_joints.push_back(v < mesh.vertex_count() / 2 ? 0 : 1);
+    mesh.influence_weights.push_back(1.f);
+    mesh.influence_offsets.push_back(v + 1);
+  }
+  return mesh;
+}
+
+Mat34 Translation(float x, float y, float z) { return TranslationMatrix({x, y, z}); }
+
+BodyMapRenderOptions Options() {
+  BodyMapRenderOptions o;
+  o.texel_size = kTexel;
+  o.epsilon = kEpsilon;
+  return o;
+}
+
+// Every texel's slab and normals, for bitwise comparisons.
+std::vector<float> Texels(const BodyMapCollider& maps) {
+  std::vector<float> out;
+  for (uint32_t j = 0; j < maps.height(); ++j) {
+    for (uint32_t i = 0; i < maps.width(); ++i) {
+      float top = 0.f, bottom = 0.f;
+      const bool valid = BodyMapColliderAccess::TexelSlab(maps, i, j, &top, &bottom);
+      const Float3 f = BodyMapColliderAccess::TexelNormal(maps, i, j, false);
+      const Float3 b = BodyMapColliderAccess::TexelNormal(maps, i, j, true);
+      out.insert(out.end(), {valid ? 1.f : 0.f, top, bottom, f.x, f.y, f.z, b.x, b.y, b.z});
+    }
+  }
+  return out;
+}
+
+TEST(BodyMapRenderer, TheSlabIsTheOffsetSphere) {
+  const MeshData mesh = TwoSpheres();
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  const Mat34 identity[2] = {Mat34{}, Mat34{}};
+  BodyMapCollider maps;
+  ASSERT_TRUE(renderer.Render(identity, &maps).ok());
+  ASSERT_FALSE(maps.empty());
+  EXPECT_EQ(renderer.stats().triangles_drawn, mesh.triangle_count());
+  // Texel centres well inside the disk: top and bottom at +-sqrt((r + e)^2 - d^2) up to the
+  // facets (1.2 mm at 4 subdivisions); normals point away from the centre.
+  const float outer = kRadius + kEpsilon;
+  int checked = 0;
+  for (uint32_t j = 0; j < maps.height(); ++j) {
+    for (uint32_t i = 0; i < maps.width(); ++i) {
+      const float x = maps.origin_x() + (static_cast<float>(i) + 0.5f) * kTexel;
+      const float y = maps.origin_y() + (static_cast<float>(j) + 0.5f) * kTexel;
+      const float d = std::hypot(x, y);
+      if (d > 0.8f * kRadius) continue;
+      float top = 0.f, bottom = 0.f;
+      ASSERT_TRUE(BodyMapColliderAccess::TexelSlab(maps, i, j, &top, &bottom)) << x << ", " << y;
+      const float expected = std::sqrt(outer * outer - d * d);
+      EXPECT_NEAR(top, expected, 1.5e-3f);
+      EXPECT_NEAR(bottom, -expected, 1.5e-3f);
+      const Float3 n = BodyMapColliderAccess::TexelNormal(maps, i, j, false);
+      EXPECT_GT(Dot(n, NormalizeOr(Float3{x, y, top}, Float3{})), 0.99f);
+      const Float3 nb = BodyMapColliderAccess::TexelNormal(maps, i, j, true);
+      EXPECT_GT(Dot(nb, NormalizeOr(Float3{x, y, bottom}, Float3{})), 0.99f);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20000);
+  // Points: inside well within the offset sphere, outside beyond it.
+  EXPECT_TRUE(maps.IsInside({0.f, 0.f, 0.f}));
+  EXPECT_TRUE(maps.IsInside({0.5f, 0.f, 0.09f}));
+  EXPECT_FALSE(maps.IsInside({0.f, 0.f, outer + 0.002f}));
+  EXPECT_FALSE(maps.IsInside({0.25f, 0.f, 0.f}));  // between the spheres
+}
+
+TEST(BodyMapRenderer, TheMapsFollowTheJoints) {
+  const MeshData mesh = TwoSpheres();
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  // Joint 1 moves its sphere from (0.5, 0, 0) to (0.5, 0.6, 0.2).
+  const Mat34 pose[2] = {Mat34{}, Translation(0.f, 0.6f, 0.2f)};
+  BodyMapCollider maps;
+  ASSERT_TRUE(renderer.Render(pose, &maps).ok());
+  EXPECT_FALSE(maps.IsInside({0.5f, 0.f, 0.f}));
+  EXPECT_TRUE(maps.IsInside({0.5f, 0.6f, 0.2f}));
+  EXPECT_TRUE(maps.IsInside({0.5f, 0.6f, 0.2f + 0.09f}));
+  EXPECT_FALSE(maps.IsInside({0.5f, 0.6f, 0.2f + kRadius + kEpsilon + 0.002f}));
+  // A motion down onto the moved sphere stops on its offset surface.
+  const ContactQuery c = maps.Query({0.5f, 0.6f, 0.5f}, {0.5f, 0.6f, 0.2f});
+  ASSERT_TRUE(c.contact);
+  EXPECT_NEAR(c.point.z, 0.2f + kRadius + kEpsilon, 1.5e-3f);
+  EXPECT_GT(c.normal.z, 0.99f);
+  EXPECT_EQ(renderer.posed_vertices()[mesh.vertex_count() - 1].y, mesh.positions.back().y + 0.6f);
+}
+
+TEST(BodyMapRenderer, TheRegionCutsTheWindowAndTheTriangles) {
+  const MeshData mesh = TwoSpheres();
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  const Mat34 identity[2] = {Mat34{}, Mat34{}};
+  BodyMapCollider whole, cut;
+  ASSERT_TRUE(renderer.Render(identity, &whole).ok());
+  const uint32_t whole_width = renderer.stats().width;
+  RenderRegion region;
+  region.min = {0.35f, -0.2f, -0.2f};
+  region.max = {0.7f, 0.2f, 0.2f};
+  ASSERT_TRUE(renderer.Render(identity, &cut, &region).ok());
+  EXPECT_EQ(renderer.stats().triangles_drawn, mesh.triangle_count() / 2);
+  EXPECT_LT(renderer.stats().width, whole_width / 2);
+  EXPECT_FALSE(cut.IsInside({0.f, 0.f, 0.f}));
+  EXPECT_TRUE(cut.IsInside({0.5f, 0.f, 0.f}));
+  // Inside the region both answer alike.
+  for (float x = 0.36f; x < 0.64f; x += 0.0037f) {
+    for (float z = -0.12f; z < 0.12f; z += 0.0041f) {
+      EXPECT_EQ(whole.IsInside({x, 0.013f, z}), cut.IsInside({x, 0.013f, z})) << x << " " << z;
+    }
+  }
+  // A region the body does not reach: an empty collider, not an error.
+  region.min = {5.f, 5.f, 5.f};
+  region.max = {6.f, 6.f, 6.f};
+  ASSERT_TRUE(renderer.Render(identity, &cut, &region).ok());
+  EXPECT_TRUE(cut.empty());
+}
+
+TEST(BodyMapRenderer, IdenticalBitsAtAnyThreadCount) {
+  const MeshData mesh = TwoSpheres();
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  const Mat34 pose[2] = {
+      Mat34{}, Multiply(Translation(-0.3f, 0.05f, 0.04f),
+                        Mat34{{0.8f, -0.6f, 0.f, 0.f, 0.6f, 0.8f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f}})};
+  const int saved = omp_get_max_threads();
+  std::vector<float> reference;
+  for (int threads : {1, 2, 3, 4}) {
+    omp_set_num_threads(threads);
+    BodyMapCollider maps;
+    ASSERT_TRUE(renderer.Render(pose, &maps).ok());
+    const std::vector<float> texels = Texels(maps);
+    if (reference.empty()) {
+      reference = texels;
+      continue;
+    }
+    ASSERT_EQ(texels.size(), reference.size());
+    EXPECT_EQ(std::memcmp(texels.data(), reference.data(), texels.size() * sizeof(float)), 0)
+        << threads << " threads";
+  }
+  omp_set_num_threads(saved);
+}
+
+TEST(BodyMapRenderer, AllocatesOnlyWhenTheWindowGrows) {
+  const MeshData mesh = TwoSpheres();
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  const size_t renderer_bytes = renderer.memory_bytes();
+  BodyMapCollider maps;
+  const Mat34 identity[2] = {Mat34{}, Mat34{}};
+  ASSERT_TRUE(renderer.Render(identity, &maps).ok());
+  const size_t maps_bytes = maps.memory_bytes();
+  EXPECT_EQ(renderer.stats().grew, 0u);
+  for (float y = 0.f; y < 0.2f; y += 0.05f) {  // within 1.5x the bind pose's window
+    const Mat34 pose[2] = {Mat34{}, Translation(0.f, y, 0.f)};
+    ASSERT_TRUE(renderer.Render(pose, &maps).ok());
+  }
+  EXPECT_EQ(renderer.stats().grew, 0u);
+  EXPECT_EQ(renderer.memory_bytes(), renderer_bytes);
+  EXPECT_EQ(maps.memory_bytes(), maps_bytes);
+  // Spread far apart: the window grows once, and is counted.
+  const Mat34 far[2] = {Mat34{}, Translation(0.f, 1.f, 0.f)};
+  ASSERT_TRUE(renderer.Render(far, &maps).ok());
+  EXPECT_EQ(renderer.stats().grew, 1u);
+  EXPECT_TRUE(maps.IsInside({0.5f, 1.f, 0.f}));
+}
+
+TEST(BodyMapRenderer, HostileInputIsAnErrorAndAnEmptyCollider) {
+  const MeshData mesh = TwoSpheres();
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  BodyMapCollider maps;
+  const Mat34 identity[2] = {Mat34{}, Mat34{}};
+  const auto fails = [&](std::span<const Mat34> pose, const RenderRegion* region,
+                         const char* words) {
+    ASSERT_TRUE(renderer.Render(identity, &maps).ok());
+    ASSERT_FALSE(maps.empty());
+    const Status s = renderer.Render(pose, &maps, region);
+    EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(s.message().find(words), std::string::npos) << s.message();
+    EXPECT_TRUE(maps.empty());
+    EXPECT_FALSE(maps.IsInside({0.f, 0.f, 0.f}));
+  };
+  Mat34 nan = Mat34{};
+  nan.m[3] = std::nanf("");
+  fails(std::vector<Mat34>{Mat34{}, nan}, nullptr, "not finite");
+  fails(std::vector<Mat34>{Mat34{}, Translation(1e30f, 0.f, 0.f)}, nullptr, "beyond 1e15");
+  fails(std::vector<Mat34>{Mat34{}, Translation(1e6f, 0.f, 0.f)}, nullptr, "max_side");
+  fails(std::vector<Mat34>{Mat34{}}, nullptr, "2 joints");
+  RenderRegion inverted;
+  inverted.min = {1.f, 0.f, 0.f};
+  inverted.max = {0.f, 1.f, 1.f};
+  fails(identity, &inverted, "region");
+  RenderRegion not_a_number;
+  not_a_number.max.y = std::nanf("");
+  fails(identity, &not_a_number, "region");
+
+  // Init checks the mesh and the options.
+  BodyMapRenderOptions bad = Options();
+  bad.texel_size = 0.f;
+  EXPECT_NE(renderer.Init(mesh, bad).message().find("texel_size"), std::string::npos);
+  EXPECT_TRUE(renderer.empty());
+  EXPECT_FALSE(renderer.Render(identity, &maps).ok());
+  bad = Options();
+  bad.epsilon = std::nanf("");
+  EXPECT_NE(renderer.Init(mesh, bad).message().find("epsilon"), std::string::npos);
+  MeshData broken = mesh;
+  broken.triangles[7] = broken.vertex_count();
+  EXPECT_NE(renderer.Init(broken, Options()).message().find("triangle index 7"), std::string::npos);
+  broken = mesh;
+  broken.positions[3].y = std::numeric_limits<float>::infinity();
+  EXPECT_NE(renderer.Init(broken, Options()).message().find("vertex 3"), std::string::npos);
+  broken = mesh;
+  broken.triangles.pop_back();
+  EXPECT_FALSE(renderer.Init(broken, Options()).ok());
+}
+
+}  // namespace
+}  // namespace drape
