@@ -1,5 +1,5 @@
-// drape-query FILE.drape [--clip NAME --time T] (--points F | --segments F)
-//             [--method maps|hulls|spheres|all] [--mesh F.obj]
+// drape-query FILE.drape [--clip NAME --time T | --joint-matrices F] (--points F | --segments F)
+//             [--method maps|hulls|spheres|all] [--mesh F.obj] [--write-joint-matrices F]
 // The runtime's collision answers from the command line, for pipeline checks and debugging.
 // Input rows: "x y z" (points) or "x0 y0 z0 x1 y1 z1" (previous and current position), asset
 // frame, metres; '#' starts a comment; "nan" and "inf" are read as such. Output: CSV on stdout,
@@ -7,6 +7,12 @@
 // that is not finite, or beyond +-1e6 m (no body reaches there, and float positions that far are
 // metres apart), is not queried: it gets kCollisionInvalidInput (128), no contact, the position
 // unchanged, as the runtime's batch calls answer a non-finite particle.
+// --joint-matrices: one 4x4 world matrix per joint, in joint order, asset frame, 16 numbers per
+// line (row-major, last row 0 0 0 1). Every method answers for any pose: the body maps are the
+// baked ones where the asset holds this very pose, else rendered from the skinned mesh
+// (BodyMapRenderer) at the baked maps' texel size and epsilon, on their grid.
+// --write-joint-matrices: the pose's joint world matrices in that format (9 significant digits,
+// so reading them back gives the same floats).
 
 #include <cmath>
 #include <cstdio>
@@ -19,6 +25,7 @@
 
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
@@ -29,8 +36,10 @@ namespace {
 
 int Usage() {
   std::fprintf(stderr,
-               "usage: drape-query FILE.drape [--clip NAME --time T] (--points F | --segments F)\n"
-               "                   [--method maps|hulls|spheres|all] [--mesh F.obj]\n");
+               "usage: drape-query FILE.drape [--clip NAME --time T | --joint-matrices F]\n"
+               "                   (--points F | --segments F)\n"
+               "                   [--method maps|hulls|spheres|all] [--mesh F.obj]\n"
+               "                   [--write-joint-matrices F]\n");
   return 2;
 }
 
@@ -97,6 +106,77 @@ bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows
   return true;
 }
 
+// One affine 4x4 per line (row-major), exactly `joints` of them.
+bool ReadJointMatrices(const std::string& path, uint32_t joints, std::vector<drape::Mat34>* out,
+                       std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    *error = path + ": cannot open";
+    return false;
+  }
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::vector<double> values;
+    std::string bad;
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    if (!ParseNumbers(line, &values, &bad)) {
+      *error = where + "'" + bad + "' is not a number";
+      return false;
+    }
+    if (values.empty()) continue;
+    if (values.size() != 16) {
+      *error = where + "expected 16 numbers (a 4x4 matrix), got " + std::to_string(values.size());
+      return false;
+    }
+    drape::Mat34 m;
+    for (int k = 0; k < 12; ++k) {
+      if (!(std::fabs(values[k]) <= kMaxCoordinate)) {
+        *error = where + "entry " + std::to_string(k) + " is not finite or beyond 1e6";
+        return false;
+      }
+      m.m[k] = static_cast<float>(values[k]);
+    }
+    if (std::fabs(values[12]) > 1e-6 || std::fabs(values[13]) > 1e-6 ||
+        std::fabs(values[14]) > 1e-6 || std::fabs(values[15] - 1.0) > 1e-6) {
+      *error = where + "the last row is not 0 0 0 1 (not an affine matrix)";
+      return false;
+    }
+    out->push_back(m);
+  }
+  if (out->size() != joints) {
+    *error = path + ": " + std::to_string(out->size()) + " matrices, the skeleton has " +
+             std::to_string(joints) + " joints";
+    return false;
+  }
+  return true;
+}
+
+// The body maps of the pose: the baked ones when the asset holds this very pose (same clip and
+// time, no engine matrices), else rendered from the skinned mesh on the baked maps' grid.
+drape::Status PoseMaps(const drape::CharacterAsset& asset, const drape::SkeletonPose& pose,
+                       int32_t clip_index, float time, bool engine_pose,
+                       drape::BodyMapCollider* maps, bool* rendered) {
+  *rendered = false;
+  constexpr float kSameTime = 1e-4f;  // seconds
+  for (const drape::BodyMapPose& p : asset.body_maps.poses) {
+    const bool same_time = clip_index < 0 || std::fabs(p.time - time) <= kSameTime;
+    if (!engine_pose && p.clip == clip_index && same_time) return maps->Build(p);
+  }
+  drape::BodyMapRenderOptions options;
+  if (!asset.body_maps.poses.empty()) {
+    const drape::BodyMapPose& baked = asset.body_maps.poses.front();
+    options.texel_size = baked.texel_size;
+    options.epsilon = asset.body_maps.epsilon;
+    options.grid_x = baked.origin_x;
+    options.grid_y = baked.origin_y;
+  }
+  drape::BodyMapRenderer renderer;
+  if (drape::Status s = renderer.Init(asset.mesh, options); !s.ok()) return s;
+  *rendered = true;
+  return renderer.Render(pose.skinning(), maps);
+}
+
 void PrintRow(size_t row, const char* method, const drape::ContactQuery& q, const Segment& s) {
   // Position after response: the particle moved p0 -> p1 with velocity (p1 - p0) per unit time.
   drape::Float3 position = s.p1;
@@ -121,6 +201,7 @@ drape::ContactQuery Answer(const Segment& s, const Query& query) {
 
 int main(int argc, char** argv) {
   std::string path, clip_name, points_path, segments_path, method = "all", mesh_path;
+  std::string matrices_path, write_matrices_path;
   float time = 0.f;
   bool time_given = false;
   for (int i = 1; i < argc; ++i) {
@@ -139,6 +220,10 @@ int main(int argc, char** argv) {
       time = std::strtof(v.c_str(), &end);
       if (*end != '\0' || !std::isfinite(time)) return Fail("--time '" + v + "' is not a number");
       time_given = true;
+    } else if (a == "--joint-matrices") {
+      if (!value(&matrices_path)) return Usage();
+    } else if (a == "--write-joint-matrices") {
+      if (!value(&write_matrices_path)) return Usage();
     } else if (a == "--points") {
       if (!value(&points_path)) return Usage();
     } else if (a == "--segments") {
@@ -156,12 +241,17 @@ int main(int argc, char** argv) {
       path = a;
     }
   }
-  if (path.empty() || (points_path.empty() == segments_path.empty() && mesh_path.empty()))
+  if (path.empty() || (points_path.empty() == segments_path.empty() && mesh_path.empty() &&
+                       write_matrices_path.empty())) {
     return Usage();
+  }
   if (method != "maps" && method != "hulls" && method != "spheres" && method != "all") {
     return Fail("--method '" + method + "' is not maps, hulls, spheres or all");
   }
   if (time_given && clip_name.empty()) return Fail("--time needs --clip");
+  if (!matrices_path.empty() && !clip_name.empty()) {
+    return Fail("--joint-matrices and --clip both give the pose: pass one");
+  }
 
   drape::CharacterAsset asset;
   if (drape::Status s = drape::ReadAssetFile(path, &asset); !s.ok()) return Fail(s.message());
@@ -177,13 +267,42 @@ int main(int argc, char** argv) {
     }
   }
 
+  if (!matrices_path.empty()) {
+    std::vector<drape::Mat34> world;
+    std::string error;
+    if (!ReadJointMatrices(matrices_path, asset.skeleton.joint_count(), &world, &error)) {
+      return Fail(error);
+    }
+    if (drape::Status s = pose.SetJointWorldMatrices(world); !s.ok()) {
+      return Fail(matrices_path + ": " + s.message());
+    }
+  }
+
+  if (!write_matrices_path.empty()) {
+    std::ostringstream text;
+    text << "# joint world matrices of " << path << ", one 4x4 per joint (row-major)\n";
+    char number[32];
+    for (const drape::Mat34& m : pose.world()) {
+      for (int k = 0; k < 12; ++k) {
+        std::snprintf(number, sizeof(number), "%.9g ", static_cast<double>(m.m[k]));
+        text << number;
+      }
+      text << "0 0 0 1\n";
+    }
+    if (drape::Status s = drape::WriteFileAtomically(write_matrices_path, text.str()); !s.ok())
+      return Fail(s.message());
+  }
+
   if (!mesh_path.empty()) {
     std::vector<drape::Float3> posed(asset.mesh.vertex_count());
     if (drape::Status s = drape::SkinMesh(asset.mesh, pose.skinning(), posed); !s.ok())
       return Fail(s.message());
     std::ostringstream obj;
     obj << "# posed body mesh of " << path
-        << (clip_name.empty() ? " (rest pose)" : " clip " + clip_name) << "\n";
+        << (!matrices_path.empty() ? " (joint matrices " + matrices_path + ")"
+            : clip_name.empty()    ? " (rest pose)"
+                                   : " clip " + clip_name)
+        << "\n";
     for (const drape::Float3& p : posed) obj << "v " << p.x << ' ' << p.y << ' ' << p.z << '\n';
     for (size_t t = 0; t + 2 < asset.mesh.triangles.size(); t += 3) {
       obj << "f " << asset.mesh.triangles[t] + 1 << ' ' << asset.mesh.triangles[t + 1] + 1 << ' '
@@ -206,19 +325,16 @@ int main(int argc, char** argv) {
   const bool want_spheres = method == "spheres" || method == "all";
   drape::BodyMapCollider maps;
   if (want_maps) {
-    // The baked pose for this clip time: the nearest one of that clip (or the rest pose).
-    const drape::BodyMapPose* best = nullptr;
-    for (const drape::BodyMapPose& p : asset.body_maps.poses) {
-      if (p.clip != clip_index) continue;
-      if (best == nullptr || std::fabs(p.time - time) < std::fabs(best->time - time)) best = &p;
-    }
-    if (best == nullptr) {
-      if (method == "maps") {
-        return Fail(path + ": no body maps baked for " +
-                    (clip_name.empty() ? "the rest pose" : "clip '" + clip_name + "'"));
-      }
-    } else if (drape::Status s = maps.Build(*best); !s.ok()) {
-      return Fail(path + ": " + s.message());
+    bool rendered = false;
+    const drape::Status s =
+        PoseMaps(asset, pose, clip_index, time, !matrices_path.empty(), &maps, &rendered);
+    if (!s.ok()) {
+      if (method == "maps") return Fail(path + ": no body maps for this pose: " + s.message());
+      std::fprintf(stderr, "drape-query: note: no body maps for this pose: %s\n",
+                   s.message().c_str());
+    } else if (rendered) {
+      std::fprintf(stderr, "drape-query: note: body maps rendered for this pose (%ux%u texels)\n",
+                   maps.width(), maps.height());
     }
   }
   drape::HullColliderSet hulls;

@@ -207,6 +207,33 @@ if [ -e "$WORK/mannequin.drape" ]; then
   else
     fail "query refused huge or non-finite rows: $(cat "$WORK/q.err")"
   fi
+  # Any pose: a clip time between the baked poses and the same pose as joint world matrices give
+  # the same answers for every method (maps rendered from the skinned mesh for both); the body
+  # moved 1 m along x by the matrices is found there, and not where it was.
+  "$QUERY" "$WORK/mannequin.drape" --clip walk --time 0.37 --write-joint-matrices "$WORK/walk.txt"
+  "$QUERY" "$WORK/mannequin.drape" --clip walk --time 0.37 --points "$WORK/points.txt" >"$WORK/clip.csv" 2>"$WORK/clip.err"
+  "$QUERY" "$WORK/mannequin.drape" --joint-matrices "$WORK/walk.txt" --points "$WORK/points.txt" >"$WORK/matrices.csv" 2>/dev/null
+  if cmp -s "$WORK/clip.csv" "$WORK/matrices.csv" && [ "$(grep -c '^[0-9]*,maps,' "$WORK/clip.csv")" -eq 3 ] &&
+    grep -q "rendered for this pose" "$WORK/clip.err"; then
+    passed=$((passed + 1))
+  else
+    fail "query: a clip time and its joint matrices answer differently: $(cat "$WORK/clip.err") $(diff "$WORK/clip.csv" "$WORK/matrices.csv")"
+  fi
+  grep -v '^#' "$WORK/walk.txt" | awk '{$4 = $4 + 1; print}' >"$WORK/moved.txt"
+  printf '1 1.32 0.02\n0 1.32 0.02\n' >"$WORK/moved_points.txt"
+  "$QUERY" "$WORK/mannequin.drape" --joint-matrices "$WORK/moved.txt" --points "$WORK/moved_points.txt" >"$WORK/moved.csv" 2>/dev/null
+  check_flag 0 maps "$WORK/moved.csv" 1
+  check_flag 0 hulls "$WORK/moved.csv" 1
+  check_flag 1 maps "$WORK/moved.csv" 0
+  check_flag 1 hulls "$WORK/moved.csv" 0
+  head -n 4 "$WORK/walk.txt" >"$WORK/short.txt"
+  if "$QUERY" "$WORK/mannequin.drape" --joint-matrices "$WORK/short.txt" --points "$WORK/points.txt" >/dev/null 2>"$WORK/q.err"; then
+    fail "query accepted too few joint matrices"
+  elif grep -qE "short.txt: 3 matrices, the skeleton has [0-9]+ joints" "$WORK/q.err"; then passed=$((passed + 1)); else fail "query message: $(cat "$WORK/q.err")"; fi
+  printf '1 0 0 0 0 1 0 0 0 0 1 0 0 0 1 1\n' >"$WORK/projective.txt"
+  if "$QUERY" "$WORK/mannequin.drape" --joint-matrices "$WORK/projective.txt" --points "$WORK/points.txt" >/dev/null 2>"$WORK/q.err"; then
+    fail "query accepted a projective matrix"
+  elif grep -q "projective.txt:1: the last row is not 0 0 0 1" "$WORK/q.err"; then passed=$((passed + 1)); else fail "query message: $(cat "$WORK/q.err")"; fi
   printf '0 1 zero\n' >"$WORK/word.txt"
   if "$QUERY" "$WORK/mannequin.drape" --points "$WORK/word.txt" >/dev/null 2>"$WORK/q.err"; then
     fail "query accepted a word as a coordinate"
