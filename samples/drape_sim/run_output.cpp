@@ -186,7 +186,8 @@ nlohmann::json FrameJson(const FrameStats& f) {
           {"max_stretch", f.max_stretch},
           {"nan", !f.finite},
           {"rss_bytes", f.rss_bytes},
-          {"measure_ms", f.measure_ms}};
+          {"measure_ms", f.measure_ms},
+          {"maps_render_ms", f.maps_render_ms}};
 }
 
 }  // namespace drape::sim

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
 #include "drape/runtime/math.h"
@@ -79,6 +80,7 @@ RunSummary SummarizeRun(std::span<const FrameStats> frames) {
     step_ms[k] = f.step_ms;
     total += f.step_ms;
     summary.measure_ms_mean += f.measure_ms / static_cast<double>(n);
+    summary.maps_render_ms_mean += f.maps_render_ms / static_cast<double>(n);
     if (!f.finite) ++summary.nan_frames;
     if (f.inside_particles > 0) ++summary.frames_with_inside;
     summary.inside_particles_max = std::max(summary.inside_particles_max, f.inside_particles);
@@ -145,7 +147,9 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
     }
     has_hull_set_ = true;
   }
-  if (scene.use_maps) {
+  if (scene.use_maps && scene.maps_source == bake::MapSource::kRendered) {
+    if (Status s = InitRenderedMaps(asset); !s.ok()) return s;
+  } else if (scene.use_maps) {
     std::vector<BodyMapPose> poses;
     for (const BodyMapPose& p : asset.body_maps.poses)
       if (p.clip == clip) poses.push_back(p);
@@ -234,7 +238,14 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
   ClothColliders colliders;
   colliders.response = scene_->response;
   colliders.hulls = has_hull_set_ ? &hulls_ : nullptr;
-  if (has_maps_) {
+  if (renders_maps_) {
+    const auto render_start = std::chrono::steady_clock::now();
+    if (Status s = RenderMaps(frame); !s.ok()) return s;
+    stats->maps_render_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - render_start)
+            .count();
+    colliders.body_map = &rendered_maps_;
+  } else if (has_maps_) {
     const float map_time = clip_ >= 0 ? ClipTimeOf(asset_->clips[static_cast<size_t>(clip_)], t1,
                                                    scene_->animation.loop)
                                       : 0.f;
@@ -269,6 +280,60 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
           .count();
   stats->rss_bytes = ResidentSetBytes();
   return result;
+}
+
+// The rest pose's maps give the texel size, epsilon and grid; the mesh is the asset's.
+Status SceneSimulation::InitRenderedMaps(const CharacterAsset& asset) {
+  const std::string where = scene_->source + ": ";
+  if (asset.body_maps.poses.empty()) {
+    return Status(StatusCode::kInvalidArgument,
+                  where +
+                      "/collision/methods: uses maps, but the asset holds no body-map pose "
+                      "(rendered maps take the texel size of its rest pose's)");
+  }
+  const BodyMapPose& rest = asset.body_maps.poses.front();
+  BodyMapRenderOptions options;
+  options.texel_size = rest.texel_size;
+  options.epsilon = asset.body_maps.epsilon;
+  options.grid_x = rest.origin_x;
+  options.grid_y = rest.origin_y;
+  options.sampling = scene_->maps_sampling;
+  if (Status s = renderer_.Init(asset.mesh, options); !s.ok())
+    return Status(s.code(), where + "rendered maps: " + s.message());
+  renders_maps_ = true;
+  return Status::Ok();
+}
+
+// The end pose's maps over the box the garments can reach this frame: their particles' box,
+// padded by twice the fastest particle's motion in a frame and the scene's reach margin.
+Status SceneSimulation::RenderMaps(int64_t frame) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  RenderRegion region;
+  region.min = {kInf, kInf, kInf};
+  region.max = {-kInf, -kInf, -kInf};
+  float fastest = 0.f;  // metres per second
+  for (const auto& g : garments_) {
+    for (size_t i = 0; i < g->state.positions.size(); ++i) {
+      const Float3 p = g->state.positions[i];
+      if (!Finite(p)) continue;
+      region.min = {std::min(region.min.x, p.x), std::min(region.min.y, p.y),
+                    std::min(region.min.z, p.z)};
+      region.max = {std::max(region.max.x, p.x), std::max(region.max.y, p.y),
+                    std::max(region.max.z, p.z)};
+      if (Finite(g->state.velocities[i])) {
+        fastest = std::max(fastest, Length(g->state.velocities[i]));
+      }
+    }
+  }
+  const float pad = scene_->reach_margin + 2.f * std::min(fastest, 100.f) * scene_->dt;
+  const bool any = region.min.x <= region.max.x;
+  region.min = any ? region.min - Float3{pad, pad, pad} : Float3{-kInf, -kInf, -kInf};
+  region.max = any ? region.max + Float3{pad, pad, pad} : Float3{kInf, kInf, kInf};
+  if (Status s = renderer_.Render(skin_end_, &rendered_maps_, &region); !s.ok()) {
+    return Status(s.code(), scene_->source + ": frame " + std::to_string(frame) +
+                                ", rendered maps: " + s.message());
+  }
+  return Status::Ok();
 }
 
 void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats) {

@@ -14,6 +14,7 @@
 #include "drape/formats/character_asset.h"
 #include "drape/formats/status.h"
 #include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/body_map_sequence.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
@@ -34,10 +35,11 @@ struct FrameStats {
   // particle's position (a point query).
   uint32_t inside_particles = 0;
   float max_penetration = 0.f;
-  float max_stretch = 0.f;  // max over stretch springs of L / R - 1
-  bool finite = true;       // every position and velocity finite
-  uint64_t rss_bytes = 0;   // the process's resident set size after the frame (0: unknown)
-  double measure_ms = 0.0;  // wall time of the point queries above (not part of step_ms)
+  float max_stretch = 0.f;      // max over stretch springs of L / R - 1
+  bool finite = true;           // every position and velocity finite
+  uint64_t rss_bytes = 0;       // the process's resident set size after the frame (0: unknown)
+  double measure_ms = 0.0;      // wall time of the point queries above (not part of step_ms)
+  double maps_render_ms = 0.0;  // wall time of rendering the frame's maps (not part of step_ms)
 };
 
 // The process's memory, for long runs (Linux /proc; 0 when the file cannot be read or parsed).
@@ -56,6 +58,7 @@ struct RunSummary {
   std::vector<double> step_ms_tenths;
   double step_ms_mean = 0.0, step_ms_median = 0.0, step_ms_p99 = 0.0, step_ms_max = 0.0;
   double measure_ms_mean = 0.0;        // the per-frame point queries, ms
+  double maps_render_ms_mean = 0.0;    // rendering each frame's maps (rendered maps only), ms
   uint32_t nan_frames = 0;             // frames with a non-finite position or velocity
   uint32_t frames_with_inside = 0;     // frames ending with a particle inside a collider
   uint32_t inside_particles_max = 0;   // most particles inside at the end of one frame
@@ -129,6 +132,12 @@ class SceneSimulation {
   BodyMapSequence maps_;
   BodyMapCollider map_scratch_;
   bool has_maps_ = false;
+  // Rendered maps (MapSource::kRendered): each frame's end pose over the garments' reach.
+  Status InitRenderedMaps(const CharacterAsset& asset);
+  Status RenderMaps(int64_t frame);
+  BodyMapRenderer renderer_;
+  BodyMapCollider rendered_maps_;
+  bool renders_maps_ = false;
   std::vector<std::unique_ptr<Garment>> garments_;
 };
 

@@ -185,10 +185,11 @@ TEST(SceneParse, BadFieldsNameTheirPath) {
          j["garments"][0]["color"] = {1, 2, 0};
        },
        "/garments/0/color/1: ", "out of range"},
-      {"maps of the bind pose",
+      {"baked maps of the bind pose",
        [](json& j) {
          j["animation"] = {{"pose", "bind"}};
          j["collision"]["methods"] = {"maps"};
+         j["collision"]["maps_source"] = "baked";
        },
        "/animation/pose: ", "rest pose"},
       {"not an object", [](json& j) { j = json::array(); }, "", "must be a JSON object"},
@@ -265,8 +266,17 @@ TEST(SceneParse, BakeConfigFollowsTheScene) {
   EXPECT_TRUE(config.maps_enabled);
   EXPECT_FALSE(config.hulls_enabled);
   EXPECT_FALSE(config.spheres_enabled);
-  EXPECT_EQ(config.maps_clip, "walk");
+  EXPECT_EQ(config.maps_clip, "");  // rendered maps (the default) need the rest pose's alone
+  j["collision"]["maps_source"] = "baked";
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  config = BakeConfig{};
+  ASSERT_TRUE(ApplySceneToBakeConfig(scene, &config).ok());
+  EXPECT_EQ(config.maps_clip, "walk");  // baked maps: every pose of the clip
   EXPECT_FLOAT_EQ(config.maps_clip_rate, 15.f);
+  // Rendered maps follow any pose, the bind pose too.
+  j["animation"] = {{"pose", "bind"}};
+  j["collision"]["maps_source"] = "rendered";
+  EXPECT_TRUE(Parse(j, &scene).ok());
 }
 
 TEST_F(SceneTest, ResolutionErrorsNameTheirPath) {

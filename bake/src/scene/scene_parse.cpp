@@ -26,12 +26,12 @@ Status ParseScene(const json& value, const std::string& source, const std::strin
   const JsonAt root(value, "", document);
   DRAPE_RETURN_IF_ERROR(SceneSchema().Read(root, &result));
 
-  // The maps of a static scene are baked of the rest pose (drape-bake's pose without a clip).
-  if (result.use_maps && result.animation.clip.empty() &&
+  // Baked maps of a static scene are of the rest pose (drape-bake's pose without a clip).
+  if (result.use_maps && result.maps_source == MapSource::kBaked && result.animation.clip.empty() &&
       result.animation.pose == ScenePose::kBind) {
     return root.Member("animation")
         .Member("pose")
-        .Error("maps are baked of the rest pose: use \"rest\" or a clip with maps");
+        .Error("baked maps are of the rest pose: use \"rest\", a clip, or rendered maps");
   }
   if (result.animation.clip.empty() && result.animation.duration < 0.f)
     result.animation.duration = 1.f;  // a static scene: one second unless told
@@ -64,8 +64,10 @@ Status ApplySceneToBakeConfig(const Scene& scene, BakeConfig* config) {
   result.maps_enabled = scene.use_maps;
   result.hulls_enabled = scene.use_hulls;
   result.spheres_enabled = scene.use_spheres;
-  // Maps of the poses the scene plays: its clip (at maps.clip_rate), or the rest pose.
-  result.maps_clip = scene.use_maps ? scene.animation.clip : std::string();
+  // Baked maps of the poses the scene plays: its clip (at maps.clip_rate), or the rest pose.
+  // Rendered maps need the rest pose's alone (their texel size, epsilon and grid).
+  result.maps_clip = scene.use_maps && scene.maps_source == MapSource::kBaked ? scene.animation.clip
+                                                                              : std::string();
   result.maps_clip_origin = scene.source + ": /animation/clip";
   *config = result;
   return Status::Ok();

@@ -58,7 +58,7 @@ const JsonSchema<Scene>& CollisionSchema() {
                   "methods", "array of `maps` \\| `hulls` \\| `spheres`",
                   "an array of maps | hulls | spheres",
                   "any combination (empty: no collision). `maps`: paper A's front/back depth and "
-                  "normal maps of every pose of the clip (baked at `/bake/maps/clip_rate`); "
+                  "normal maps of the pose of every frame (see `maps_source`); "
                   "`hulls`: paper B's per-bone convex hulls; `spheres`: paper B's joint "
                   "spheres. The bake builds only these"),
               [](const JsonAt& at, Scene& scene) {
@@ -100,10 +100,16 @@ const JsonSchema<Scene>& CollisionSchema() {
               {{"nearest", DepthSampling::kNearest}, {"bilinear", DepthSampling::kBilinear}},
               "depth between texel centres",
               [](Scene& s) -> DepthSampling& { return s.maps_sampling; })
+          .Enum<MapSource>("maps_source",
+                           {{"rendered", MapSource::kRendered}, {"baked", MapSource::kBaked}},
+                           "`rendered`: the maps of each frame's pose, rendered at run time over "
+                           "the garments' reach (the asset holds the rest pose's alone); "
+                           "`baked`: every pose of the clip baked at `/bake/maps/clip_rate`",
+                           [](Scene& s) -> MapSource& { return s.maps_source; })
           .Enum<PoseBlend>("maps_blend",
                            {{"nearest", PoseBlend::kNearest}, {"bracket", PoseBlend::kBracket}},
-                           "the map for a time between baked poses: the nearest pose, or a "
-                           "per-texel blend of the two around it",
+                           "baked maps, for a time between baked poses: the nearest pose, or "
+                           "a per-texel blend of the two around it",
                            [](Scene& s) -> PoseBlend& { return s.maps_blend; })
           .Enum<InsideTest>(
               "inside_test",

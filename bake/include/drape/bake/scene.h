@@ -103,6 +103,12 @@ struct SceneOutput {
   float camera_zoom = 1.f;        // > 0; 1 fits the body's bounds over the clip
 };
 
+// Where a scene's body maps come from.
+//  kRendered: rendered from the skinned mesh for every frame's pose (BodyMapRenderer), over the
+//    garments' reach; the bake keeps the rest pose's maps alone (their texel size and grid).
+//  kBaked: baked of every pose of the clip at /bake/maps/clip_rate, read nearest or blended.
+enum class MapSource : uint8_t { kRendered = 0, kBaked = 1 };
+
 struct Scene {
   std::string source;     // the scene file as named by the caller: prefix of every message
   std::string directory;  // relative paths resolve against it
@@ -115,7 +121,8 @@ struct Scene {
   // Collision: any combination of the three methods.
   bool use_maps = false, use_hulls = true, use_spheres = true;
   DepthSampling maps_sampling = DepthSampling::kNearest;
-  PoseBlend maps_blend = PoseBlend::kBracket;
+  MapSource maps_source = MapSource::kRendered;
+  PoseBlend maps_blend = PoseBlend::kBracket;  // kBaked only
   HullColliderOptions hull_options;
   float reach_margin = 0.05f;   // metres added to each garment's reach radius, >= 0
   float reach_stretch = 0.15f;  // fraction the cloth may stretch beyond its rest lengths, >= 0

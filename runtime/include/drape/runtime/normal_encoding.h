@@ -33,9 +33,15 @@ inline std::array<uint16_t, 2> EncodeOct16(Float3 n) {
     a = folded_a;
     b = folded_b;
   }
+  // c is finite here. Compares and a truncation instead of fmin/fmax/lround (library calls
+  // without -ffast-math; the body-map renderer encodes two normals per texel every frame), with
+  // the same results: in double, x + 0.5 is exact for 0 <= x <= 65535 and its truncation is
+  // lround(x).
   const auto quantise = [](float c) {
-    const float unit = std::fmin(std::fmax(c * 0.5f + 0.5f, 0.f), 1.f);
-    return static_cast<uint16_t>(std::lround(unit * 65535.f));
+    float unit = c * 0.5f + 0.5f;
+    unit = unit < 0.f ? 0.f : unit;
+    unit = unit > 1.f ? 1.f : unit;
+    return static_cast<uint16_t>(static_cast<double>(unit * 65535.f) + 0.5);
   };
   return {quantise(a), quantise(b)};
 }
