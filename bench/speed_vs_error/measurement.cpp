@@ -106,7 +106,7 @@ void Measurement::RunCharacter(const CharacterSpec& spec) {
 
   if (spec.label == "mannequin" && !options_.quick) ResolutionIndependence(spec, context);
   if (spec.label == "mannequin") ClothSolvers(spec, import);
-  if (!options_.quick) RunPosed(spec, character, for_posed);
+  if (!options_.quick || options_.posed) RunPosed(spec, character, for_posed);
 }
 
 std::unique_ptr<Method> Measurement::MeasureRestMaps(const Context& context,
@@ -269,6 +269,7 @@ void Measurement::RunPosedAt(const CharacterSpec& spec, const bake::Character& c
     }
     Measure(context, *MakeBodyMapMethod(map, m.sampling, Describe(m), stats.bytes));
   }
+  MeasureFollowingMaps(context, character, skinning);
   for (const auto& [setting, a] : hull_assets) {
     const std::string counts = " (" + std::to_string(a.hulls.size()) + " hulls, " +
                                std::to_string(a.joint_spheres.size()) + " spheres)";

@@ -71,6 +71,10 @@ class Measurement {
                 const HullAssets& hull_assets);
   void RunPosedAt(const CharacterSpec& spec, const bake::Character& character,
                   const HullAssets& hull_assets, const ClipData& clip, float fraction);
+  // At a posed body: maps rendered from the skinned mesh, per-bone local maps, and the rest
+  // pose's maps, which do not follow (following_maps.cpp).
+  void MeasureFollowingMaps(const Context& context, const bake::Character& character,
+                            std::span<const Mat34> skinning);
 
   // Report sections (measurement_sections.cpp).
   void ResolutionIndependence(const CharacterSpec& spec, const Context& base);

@@ -25,6 +25,7 @@ class BodyMapMethod final : public Method {
     collider_.LimitInstructionSet(lanes);
     DieOnError(collider_.Build(pose, sampling), "body maps");
   }
+  explicit BodyMapMethod(BodyMapCollider&& collider) : collider_(std::move(collider)) {}
   void Collide(std::span<const Float3> previous, std::span<Float3> positions,
                std::span<Float3> velocities, std::span<uint8_t> flags) const override {
     DieOnError(collider_.CollideBatch(previous, positions, velocities, flags, BenchResponse()),
@@ -49,6 +50,24 @@ class BodyMapMethod final : public Method {
 
  private:
   BodyMapCollider collider_;
+};
+
+class BoneMapMethod final : public Method {
+ public:
+  BoneMapMethod(const BoneMapSet& maps, uint32_t joint_count, std::span<const Mat34> skinning) {
+    DieOnError(collider_.Build(maps, joint_count), "bone maps");
+    DieOnError(collider_.SetPose(skinning, skinning), "bone maps pose");
+  }
+  void Collide(std::span<const Float3> previous, std::span<Float3> positions,
+               std::span<Float3> velocities, std::span<uint8_t> flags) const override {
+    DieOnError(collider_.CollideBatch(previous, positions, velocities, flags, BenchResponse()),
+               setting);
+  }
+  ContactQuery Query(Float3 p0, Float3 p1) const override { return collider_.Query(p0, p1); }
+  const BoneMapCollider& collider() const { return collider_; }
+
+ private:
+  BoneMapCollider collider_;
 };
 
 class HullMethod final : public Method {
@@ -285,6 +304,27 @@ std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling
                                           InstructionSet lanes) {
   auto method = std::make_unique<BodyMapMethod>(pose, sampling, lanes);
   method->family = "maps";
+  method->setting = std::move(setting);
+  method->baked_bytes = baked_bytes;
+  method->runtime_bytes = method->collider().memory_bytes();
+  return method;
+}
+
+std::unique_ptr<Method> MakeBodyMapMethod(BodyMapCollider&& collider, std::string setting,
+                                          size_t baked_bytes) {
+  auto method = std::make_unique<BodyMapMethod>(std::move(collider));
+  method->family = "maps";
+  method->setting = std::move(setting);
+  method->baked_bytes = baked_bytes;
+  method->runtime_bytes = method->collider().memory_bytes();
+  return method;
+}
+
+std::unique_ptr<Method> MakeBoneMapMethod(const BoneMapSet& maps, uint32_t joint_count,
+                                          std::span<const Mat34> skinning, std::string setting,
+                                          size_t baked_bytes) {
+  auto method = std::make_unique<BoneMapMethod>(maps, joint_count, skinning);
+  method->family = "bone maps";
   method->setting = std::move(setting);
   method->baked_bytes = baked_bytes;
   method->runtime_bytes = method->collider().memory_bytes();

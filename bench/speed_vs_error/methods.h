@@ -12,6 +12,7 @@
 
 #include "drape/bake/mesh_reference.h"
 #include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
@@ -64,6 +65,15 @@ class Method {
 std::unique_ptr<Method> MakeBodyMapMethod(const BodyMapPose& pose, DepthSampling sampling,
                                           std::string setting, size_t baked_bytes,
                                           InstructionSet lanes = InstructionSet::kAvx2);
+
+// Body maps already built (rendered at run time, or decoded), taken over.
+std::unique_ptr<Method> MakeBodyMapMethod(BodyMapCollider&& collider, std::string setting,
+                                          size_t baked_bytes);
+
+// Per-bone local maps posed by `skinning` (at both ends of the step).
+std::unique_ptr<Method> MakeBoneMapMethod(const BoneMapSet& maps, uint32_t joint_count,
+                                          std::span<const Mat34> skinning, std::string setting,
+                                          size_t baked_bytes);
 
 // Paper B's colliders at one pose (skinning applied at the start and the end of the step).
 // Either list may be empty (hulls alone, joint spheres alone).

@@ -31,6 +31,8 @@ Options ParseOptions(int argc, char** argv) {
       o.queries = static_cast<uint32_t>(n);
     } else if (arg == "--quick") {
       o.quick = true;
+    } else if (arg == "--posed") {
+      o.posed = true;
     } else if (arg == "--check") {
       o.check = true;
     } else if (arg == "--dump-maps") {
@@ -38,7 +40,8 @@ Options ParseOptions(int argc, char** argv) {
     } else if (arg == "--help" || arg == "-h") {
       std::printf(
           "drape-speed-vs-error --out DIR [--character builtin|all|PATH]... [--queries N] "
-          "[--quick] [--check] [--dump-maps]\n"
+          "[--quick] [--posed] [--check] [--dump-maps]\n"
+          "  --posed      the posed bodies (two clip times) in a --quick run too\n"
           "  --dump-maps  also write DIR/replay/<character>_mix.motions and, per rest-pose "
           "body-map\n"
           "               setting, <character>_<setting>.drape: drape-replay-maps runs them "

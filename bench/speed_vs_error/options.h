@@ -2,7 +2,7 @@
 // The command line of drape-speed-vs-error:
 //
 //   drape-speed-vs-error --out DIR [--character builtin|all|PATH]... [--queries N] [--quick]
-//                        [--check] [--dump-maps]
+//                        [--posed] [--check] [--dump-maps]
 
 #include <cstdint>
 #include <string>
@@ -16,6 +16,7 @@ struct Options {
   uint32_t queries = 4000;
   bool quick = false;
   bool check = false;
+  bool posed = false;      // --posed: the posed bodies in a --quick run too
   bool dump_maps = false;  // --dump-maps: each rest-pose body-map setting and the mix, for replays
 };
 

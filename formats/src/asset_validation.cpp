@@ -235,13 +235,9 @@ bool CheckGapLayers(const BodyMapPose& p, size_t texels, const std::string& pref
   return true;
 }
 
-void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
-  if (!c.Require(std::isfinite(set.epsilon) && set.epsilon >= 0.f, "body_maps.epsilon",
-                 "is negative or not finite"))
-    return;
-  for (size_t p = 0; p < set.poses.size(); ++p) {
-    const BodyMapPose& pose = set.poses[p];
-    const std::string at = "body_maps.poses[" + std::to_string(p) + "]";
+// One pose (of the poses or of a bone map) named `at`; false when it fails.
+bool CheckBodyMapPose(const BodyMapPose& pose, const std::string& at, size_t clips, Checker& c) {
+  {
     if (!c.Require(pose.clip >= -1 && pose.clip < static_cast<int64_t>(clips), at + ".clip",
                    "is not -1 or a clip index") ||
         !c.Require(
@@ -261,11 +257,11 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
         !c.Require(pose.layers >= 1 && pose.layers <= kMaxBodyMapLayers, at + ".layers",
                    "= " + std::to_string(pose.layers) + " is not in [1, " +
                        std::to_string(kMaxBodyMapLayers) + "]"))
-      return;
+      return false;
     // The span table before any array size that depends on it (row spans: the spans' total).
     if (const std::string problem = CheckBodyMapLayout(pose); !problem.empty()) {
       c.Fail(at + "." + problem);
-      return;
+      return false;
     }
     const size_t texels = BodyMapStoredTexels(pose);   // of layer 0
     const size_t entries = BodyMapArrayEntries(pose);  // values of one component, all layers
@@ -283,19 +279,62 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
           !c.Size(pose.normal_rgb8[view].size(),
                   pose.normal_encoding == NormalEncoding::kRgb8 ? 3 * entries : 0,
                   at + ".normal_rgb8_" + v))
-        return;
+        return false;
       for (size_t i = 0; i < pose.depth_f32[view].size(); ++i)
         if (!(pose.depth_f32[view][i] >= 0.f) &&
             !c.Require(false, at + ".depth_f32_" + v + "[" + std::to_string(i) + "]",
                        "is NaN or negative"))
-          return;
+          return false;
       for (size_t i = 0; i < pose.normal_f32[view].size(); ++i)
         if (!std::isfinite(pose.normal_f32[view][i]) &&
             !c.Finite(pose.normal_f32[view][i],
                       at + ".normal_f32_" + v + "[" + std::to_string(i) + "]"))
-          return;
+          return false;
     }
-    if (!CheckGapLayers(pose, texels, at + ".", c)) return;
+    return CheckGapLayers(pose, texels, at + ".", c);
+  }
+}
+
+// A rigid transform: finite, its 3x3 part a rotation within 1e-3.
+bool IsRigid(const Mat34& m) {
+  for (float v : m.m)
+    if (!std::isfinite(v)) return false;
+  for (int r = 0; r < 3; ++r) {
+    for (int q = 0; q < 3; ++q) {
+      const double dot = double(m.m[4 * r]) * m.m[4 * q] + double(m.m[4 * r + 1]) * m.m[4 * q + 1] +
+                         double(m.m[4 * r + 2]) * m.m[4 * q + 2];
+      if (std::fabs(dot - (r == q ? 1.0 : 0.0)) > 1e-3) return false;
+    }
+  }
+  const double det = double(m.m[0]) * (double(m.m[5]) * m.m[10] - double(m.m[6]) * m.m[9]) -
+                     double(m.m[1]) * (double(m.m[4]) * m.m[10] - double(m.m[6]) * m.m[8]) +
+                     double(m.m[2]) * (double(m.m[4]) * m.m[9] - double(m.m[5]) * m.m[8]);
+  return det > 0.0;
+}
+
+void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
+  if (!c.Require(std::isfinite(set.epsilon) && set.epsilon >= 0.f, "body_maps.epsilon",
+                 "is negative or not finite"))
+    return;
+  for (size_t p = 0; p < set.poses.size(); ++p) {
+    if (!CheckBodyMapPose(set.poses[p], "body_maps.poses[" + std::to_string(p) + "]", clips, c))
+      return;
+  }
+}
+
+void CheckBoneMaps(const BoneMapSet& set, size_t clips, size_t joints, Checker& c) {
+  if (!c.Require(std::isfinite(set.epsilon) && set.epsilon >= 0.f, "bone_maps.epsilon",
+                 "is negative or not finite"))
+    return;
+  for (size_t b = 0; b < set.maps.size(); ++b) {
+    const BoneMapData& bone = set.maps[b];
+    const std::string at = "bone_maps.maps[" + std::to_string(b) + "]";
+    if (!c.Index(bone.joint, static_cast<int64_t>(joints), at + ".joint") ||
+        !c.Require(IsRigid(bone.view_from_bind), at + ".view_from_bind",
+                   "is not a finite rigid transform") ||
+        !c.Require(bone.pose.clip == -1, at + ".pose.clip", "is not -1") ||
+        !CheckBodyMapPose(bone.pose, at + ".pose", clips, c))
+      return;
   }
 }
 
@@ -409,6 +448,7 @@ Status ValidateAsset(const CharacterAsset& asset) {
     CheckClip(asset.clips[i], i, joints, c);
   if (!c.failed()) CheckMesh(asset.mesh, joints, c);
   if (!c.failed()) CheckBodyMaps(asset.body_maps, asset.clips.size(), c);
+  if (!c.failed()) CheckBoneMaps(asset.bone_maps, asset.clips.size(), joints, c);
   for (size_t i = 0; i < asset.hulls.size() && !c.failed(); ++i)
     CheckHull(asset.hulls[i], i, joints, c);
   for (size_t i = 0; i < asset.joint_spheres.size() && !c.failed(); ++i) {

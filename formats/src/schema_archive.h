@@ -290,11 +290,25 @@ void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
 }
 
 template <class Archive>
+void serialize(Archive& ar, BoneMapData& b, const uint32_t version) {
+  detail::CheckVersion(version, 1, "BoneMapData");
+  ar(cereal::make_nvp("joint", b.joint), cereal::make_nvp("view_from_bind", b.view_from_bind),
+     cereal::make_nvp("pose", b.pose));
+}
+
+template <class Archive>
 void serialize(Archive& ar, BodyMapSet& s, const uint32_t version) {
   detail::CheckVersion(version, 1, "BodyMapSet");
   ar(cereal::make_nvp("epsilon", s.epsilon), cereal::make_nvp("resolution", s.resolution),
      cereal::make_nvp("fitted_window", s.fitted_window));
   Array(ar, "poses", s.poses);
+}
+
+template <class Archive>
+void serialize(Archive& ar, BoneMapSet& s, const uint32_t version) {
+  detail::CheckVersion(version, 1, "BoneMapSet");
+  ar(cereal::make_nvp("epsilon", s.epsilon));
+  Array(ar, "maps", s.maps);
 }
 
 template <class Archive>
@@ -351,12 +365,22 @@ void serialize(Archive& ar, JointSphereData& s, const uint32_t version) {
 
 template <class Archive>
 void serialize(Archive& ar, CharacterAsset& a, const uint32_t version) {
-  detail::CheckVersion(version, 1, "CharacterAsset");
+  detail::CheckVersionRange(version, 1, 2, "CharacterAsset");
   ar(cereal::make_nvp("info", a.info), cereal::make_nvp("skeleton", a.skeleton));
   Array(ar, "clips", a.clips);
   ar(cereal::make_nvp("mesh", a.mesh), cereal::make_nvp("body_maps", a.body_maps));
   Array(ar, "hulls", a.hulls);
   Array(ar, "joint_spheres", a.joint_spheres);
+  if (version < 2) return;
+  // Version 2 (bone maps, at the end) from format version 5 on. Checked here rather than first,
+  // so that a file of an older format with a newer field inside names that field.
+  if constexpr (Archive::is_loading::value) {
+    if (detail::g_format_version != 0 && detail::g_format_version < 5) {
+      throw DecodeError("CharacterAsset version 2 in a format version " +
+                        std::to_string(detail::g_format_version) + " file");
+    }
+  }
+  ar(cereal::make_nvp("bone_maps", a.bone_maps));
 }
 
 }  // namespace drape
@@ -367,8 +391,10 @@ CEREAL_CLASS_VERSION(drape::ClipData, 1)
 CEREAL_CLASS_VERSION(drape::MeshData, 1)
 CEREAL_CLASS_VERSION(drape::BodyMapPose, 3)  // 2: layout, spans (format 2); 3: layers (format 3)
 CEREAL_CLASS_VERSION(drape::BodyMapSet, 1)
+CEREAL_CLASS_VERSION(drape::BoneMapData, 1)
+CEREAL_CLASS_VERSION(drape::BoneMapSet, 1)
 CEREAL_CLASS_VERSION(drape::KirkpatrickHierarchy, 1)
 CEREAL_CLASS_VERSION(drape::MapTableData, 1)
 CEREAL_CLASS_VERSION(drape::HullColliderData, 2)
 CEREAL_CLASS_VERSION(drape::JointSphereData, 1)
-CEREAL_CLASS_VERSION(drape::CharacterAsset, 1)
+CEREAL_CLASS_VERSION(drape::CharacterAsset, 2)  // 2: bone_maps (format 5)

@@ -39,14 +39,37 @@ TEST(AssetFile, NewerAndOlderFormatVersionsAreRefusedByName) {
 TEST(AssetFile, UnknownTypeVersionIsRefusedByTypeName) {
   std::vector<uint8_t> bytes = Encode(SmallAsset());
   // Payload: 1 byte of cereal endianness, then CharacterAsset's uint32 class version.
-  ASSERT_EQ(bytes[kAssetHeaderSize + 1], 1);
-  bytes[kAssetHeaderSize + 1] = 2;
+  ASSERT_EQ(bytes[kAssetHeaderSize + 1], 2);
+  bytes[kAssetHeaderSize + 1] = 3;
   FixChecksums(bytes);
   CharacterAsset out;
   const Status s = DecodeAsset(bytes, "t.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_NE(s.message().find("unsupported version 2 of CharacterAsset"), std::string::npos)
+  EXPECT_NE(s.message().find("unsupported version 3 of CharacterAsset"), std::string::npos)
       << s.message();
+}
+
+// Bone maps arrived with format version 5 (CharacterAsset class version 2): a version 2 asset
+// under an older header is refused naming both, and the older class version reads without them.
+TEST(AssetFile, BoneMapsNeedFormatVersion5) {
+  CharacterAsset small = SmallAsset();
+  std::vector<uint8_t> bytes = Encode(small);
+  bytes[8] = 4;
+  FixChecksums(bytes);
+  CharacterAsset out;
+  Status s = DecodeAsset(bytes, "v4.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(), "v4.drape: CharacterAsset version 2 in a format version 4 file");
+  // As format 4 wrote it: class version 1, no bone-map set at the end (epsilon and an empty
+  // array: 4 + 4 + 8 bytes).
+  bytes[kAssetHeaderSize + 1] = 1;
+  bytes.resize(bytes.size() - 16);
+  const uint64_t payload = bytes.size() - kAssetHeaderSize;
+  for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
+  FixChecksums(bytes);
+  s = DecodeAsset(bytes, "v4.drape", &out);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(AssetToJson(out), AssetToJson(small));
 }
 
 // A format version 1 file holds only class version 1: a version 2 or 3 pose under a version 1
@@ -141,6 +164,10 @@ TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
   for (size_t i = 0; i < 8; ++i) ASSERT_EQ(bytes[gap_count_at + i], 0) << i;
   bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at),
               bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at + 8));
+  // As format 2 wrote it: CharacterAsset class version 1, without the bone-map set at the end
+  // (its class version, epsilon and an empty array: 16 bytes).
+  bytes[kAssetHeaderSize + 1] = 1;
+  bytes.resize(bytes.size() - 16);
   const uint64_t payload = bytes.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   bytes[8] = 2;
@@ -151,6 +178,50 @@ TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
   EXPECT_EQ(v2.body_maps.poses[0].layers, 1);
   EXPECT_EQ(AssetToJson(v2), AssetToJson(small));
   ExpectPoseVersionRefused(bytes, 3, 2);
+}
+
+// Bone maps round-trip, and the loader (and the writer) refuse a bone map naming a joint the
+// skeleton lacks, a view frame that is not rigid, or a pose of a clip, naming the field.
+TEST(AssetFile, BoneMapsRoundTripAndAreValidated) {
+  CharacterAsset a = SmallAsset();
+  a.bone_maps.epsilon = 0.004f;
+  BoneMapData bone;
+  bone.joint = 2;
+  bone.view_from_bind.m[3] = 0.25f;  // a translation: rigid
+  bone.pose = a.body_maps.poses[0];
+  bone.pose.clip = -1;
+  a.bone_maps.maps = {bone, bone};
+  a.bone_maps.maps[1].joint = 1;
+  CharacterAsset out;
+  ASSERT_TRUE(DecodeAsset(Encode(a), "b.drape", &out).ok());
+  EXPECT_EQ(AssetToJson(out), AssetToJson(a));
+  ASSERT_EQ(out.bone_maps.maps.size(), 2u);
+  EXPECT_EQ(out.bone_maps.maps[1].joint, 1);
+
+  // The checks the loader and the writer share.
+  const auto refused = [&](const CharacterAsset& bad, const std::string& expected) {
+    const Status s = ValidateAsset(bad);
+    EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+    EXPECT_NE(s.message().find(expected), std::string::npos) << s.message();
+  };
+  CharacterAsset bad = a;
+  bad.bone_maps.maps[1].joint = 3;
+  refused(bad, "bone_maps.maps[1].joint");
+  bad = a;
+  bad.bone_maps.maps[0].view_from_bind.m[0] = 2.f;  // a scale
+  refused(bad, "bone_maps.maps[0].view_from_bind is not a finite rigid transform");
+  bad = a;
+  bad.bone_maps.maps[0].view_from_bind.m[0] = -1.f;  // a reflection
+  refused(bad, "bone_maps.maps[0].view_from_bind");
+  bad = a;
+  bad.bone_maps.maps[1].pose.clip = 0;
+  refused(bad, "bone_maps.maps[1].pose.clip is not -1");
+  bad = a;
+  bad.bone_maps.maps[1].pose.depth_u16[0].pop_back();
+  refused(bad, "bone_maps.maps[1].pose.depth_u16_front");
+  bad = a;
+  bad.bone_maps.epsilon = -1.f;
+  refused(bad, "bone_maps.epsilon");
 }
 
 }  // namespace

@@ -89,6 +89,30 @@ const JsonSchema<BakeConfig>& MapsSection() {
   return schema;
 }
 
+const JsonSchema<BakeConfig>& BoneMapsSection() {
+  static const JsonSchema<BakeConfig> schema =
+      JsonSchema<BakeConfig>()
+          .Bool("enabled",
+                "bake per-bone local maps: each bone's part of the body in a frame fixed to the "
+                "bone, so the maps follow any pose without rendering",
+                [](BakeConfig& c) -> bool& { return c.bone_maps_enabled; })
+          .Float("texel_size", "m", Closed(0, 1),
+                 "the bone maps' texel; 0: the rest pose's longest side / 600 (3 mm on a 1.8 m "
+                 "person)",
+                 [](BakeConfig& c) -> float& { return c.bone_maps.texel_size; })
+          .Float("epsilon", "m", Closed(0, 0.1),
+                 "offset of the surface along its normals before rendering",
+                 [](BakeConfig& c) -> float& { return c.bone_maps.epsilon; })
+          .Float("min_weight", "", Closed(0.001, 1),
+                 "a triangle joins a bone's part when the bone carries most of it or one of its "
+                 "corners weighs this much on it (the overlap around joints)",
+                 [](BakeConfig& c) -> float& { return c.bone_maps.min_weight; })
+          .Unsigned<uint8_t>("layers", "", 1, kMaxBodyMapLayers,
+                             "depth layers per texel: 1 the slab, more adds air gaps inside it",
+                             [](BakeConfig& c) -> uint8_t& { return c.bone_maps.layers; });
+  return schema;
+}
+
 const JsonSchema<BakeConfig>& HullsSection() {
   static const JsonSchema<BakeConfig> schema =
       JsonSchema<BakeConfig>()
@@ -206,15 +230,18 @@ const JsonSchema<BakeConfig>& BakeConfigSchema() {
                   [](BakeConfig& c) -> BakeConfig& { return c; })
           .Object("maps", MapsSection(), "paper A's body maps",
                   [](BakeConfig& c) -> BakeConfig& { return c; })
+          .Object("bone_maps", BoneMapsSection(), "per-bone local maps",
+                  [](BakeConfig& c) -> BakeConfig& { return c; })
           .Object("hulls", HullsSection(), "paper B's per-bone convex colliders",
                   [](BakeConfig& c) -> BakeConfig& { return c; })
           .Object("spheres", SpheresSection(), "paper B's joint spheres",
                   [](BakeConfig& c) -> BakeConfig& { return c; })
           .Rule([](const JsonAt& at, BakeConfig& c) {
-            if (c.maps_enabled || c.hulls_enabled || c.spheres_enabled) return Status::Ok();
+            if (c.maps_enabled || c.bone_maps_enabled || c.hulls_enabled || c.spheres_enabled)
+              return Status::Ok();
             return at.Error(
-                "maps.enabled, hulls.enabled and spheres.enabled are all false: the asset would "
-                "hold no collider");
+                "maps.enabled, bone_maps.enabled, hulls.enabled and spheres.enabled are all "
+                "false: the asset would hold no collider");
           });
   return schema;
 }

@@ -12,6 +12,7 @@
 
 #include "config/clip_lookup.h"
 #include "drape/bake/body_map_baker.h"
+#include "drape/bake/bone_map_baker.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
 #include "drape/bake/kirkpatrick_builder.h"
@@ -639,6 +640,35 @@ Status CheckRuntimeAccepts(const std::string& input, const CharacterAsset& asset
   return Status::Ok();
 }
 
+// Per-bone local maps, and per bone what the report lists: its part, axis choice, size.
+Status BakeBoneMapStage(const BakeConfig& config, const Regions& regions,
+                        const Character& character, CharacterAsset* asset, json* report) {
+  std::vector<BoneMapStats> stats;
+  BoneMapOptions options = config.bone_maps;
+  if (options.texel_size == 0.f) options.texel_size = AutomaticBoneMapTexel(regions.rest_positions);
+  if (Status s = BakeBoneMaps(character.mesh, character.skeleton, regions.rest_skinning, options,
+                              &asset->bone_maps, &stats);
+      !s.ok()) {
+    return s;
+  }
+  json bones = json::array();
+  size_t bytes = 0;
+  for (const BoneMapStats& b : stats) {
+    bones.push_back({{"bone", character.skeleton.joint_names[b.joint]},
+                     {"triangles", b.triangles},
+                     {"facing", b.facing},
+                     {"width", b.width},
+                     {"height", b.height},
+                     {"bytes", b.bytes}});
+    bytes += b.bytes;
+  }
+  *report = {{"count", stats.size()},
+             {"bytes", bytes},
+             {"texel_size_mm", options.texel_size * 1000.f},
+             {"bones", bones}};
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeResult* result,
@@ -676,6 +706,14 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
       return failed(s);
     report["body_maps"] = maps;
     timings["maps_ms"] = MillisecondsSince(start);
+  }
+  if (config.bone_maps_enabled) {
+    start = Clock::now();
+    json bone_maps;
+    if (Status s = BakeBoneMapStage(config, regions, character, &asset, &bone_maps); !s.ok())
+      return failed(s);
+    report["bone_maps"] = bone_maps;
+    timings["bone_maps_ms"] = MillisecondsSince(start);
   }
   if (config.hulls_enabled) {
     start = Clock::now();

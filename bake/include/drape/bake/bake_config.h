@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "drape/bake/body_map_baker.h"
+#include "drape/bake/bone_map_baker.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
 #include "drape/bake/kirkpatrick_builder.h"
@@ -39,6 +40,15 @@ struct BakeConfig {
   // Where maps_clip was named ("config.json: /maps/clip", a scene's "/animation/clip"; empty:
   // "/maps/clip"): the refusal of a clip the character lacks names it. Not a config key.
   std::string maps_clip_origin;
+
+  // Per-bone local maps (BakeBoneMaps): maps that follow any pose without rendering. Off by
+  // default: the rest pose's maps render any pose at run time (BodyMapRenderer).
+  bool bone_maps_enabled = false;
+  BoneMapOptions bone_maps = [] {
+    BoneMapOptions o;
+    o.texel_size = 0.f;  // automatic: the rest pose's longest side / 600
+    return o;
+  }();
 
   bool hulls_enabled = true;      // paper B: a convex collider per bone
   float rigid_threshold = 0.99f;  // a vertex is rigid to its heaviest bone at this weight, (0.5, 1]

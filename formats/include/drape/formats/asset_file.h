@@ -16,7 +16,9 @@ namespace drape {
 
 // The version the writer writes. 2: BodyMapPose class version 2 (layout and row spans).
 // 3: BodyMapPose class version 3 (depth layers: the slab and up to three air gaps per texel).
-inline constexpr uint32_t kAssetFormatVersion = 4;
+// 4: HullColliderData class version 2 (internal planes). 5: CharacterAsset class version 2
+// (per-bone local maps).
+inline constexpr uint32_t kAssetFormatVersion = 5;
 // The oldest version the loader still reads (1: every class at version 1, body maps dense; the
 // loader reads every version from this one to kAssetFormatVersion).
 inline constexpr uint32_t kOldestAssetFormatVersion = 1;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drape/formats/status.h"
+#include "drape/formats/types.h"
 
 namespace drape {
 
@@ -90,12 +91,28 @@ struct BodyMapPose {
   std::vector<uint8_t> normal_rgb8[2];    // 3 per texel
 };
 
+// Per-bone local maps (CharacterAsset class version 2, format 5): one bone's part of the body (what
+// it carries and the blended skin it shares with its neighbours) baked once, in a view frame
+// fixed to the bone whose z is the view axis chosen for that part. At run time a point maps into
+// the view frame through the bone's skinning matrix, so the maps follow any pose the skeleton
+// takes; the blended skin near a joint is taken as rigid to each bone holding it.
+struct BoneMapData {
+  uint16_t joint = 0;    // the bone (skeleton joint index)
+  Mat34 view_from_bind;  // rigid: bind-pose asset frame -> the view frame the pose is baked in
+  BodyMapPose pose;      // front/back maps in the view frame; clip -1, time 0
+};
+
 struct BodyMapSet {
   float epsilon = 0.f;      // metres the surface was offset along its normals before rendering
   uint32_t resolution = 0;  // N of the N x N window the maps were rendered in
   bool fitted_window =
       false;  // true: the window was fitted to the body's L x H (not the paper's square)
   std::vector<BodyMapPose> poses;
+};
+
+struct BoneMapSet {
+  float epsilon = 0.f;  // metres the surface was offset along its normals before rendering
+  std::vector<BoneMapData> maps;
 };
 
 // Texels layer 0 of the per-texel arrays holds: width * height (dense) or the spans' total

@@ -30,6 +30,7 @@ struct CharacterAsset {
   BodyMapSet body_maps;
   std::vector<HullColliderData> hulls;
   std::vector<JointSphereData> joint_spheres;
+  BoneMapSet bone_maps;  // per-bone local maps; empty unless the bake was asked for them
 };
 
 }  // namespace drape
