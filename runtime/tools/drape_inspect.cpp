@@ -12,6 +12,7 @@
 
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
+#include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
@@ -168,6 +169,14 @@ std::string JsonSummary(const drape::CharacterAsset& a, const Placement& place,
       << ", \"map\": \"" << (hull.map.kind == drape::MapTableKind::kSphere ? "sphere" : "cylinder")
       << "\", \"map_cells\": " << hull.map.rows * hull.map.cols << "}";
   }
+  o << "],\n  \"bone_maps\": [";
+  for (size_t b = 0; b < a.bone_maps.maps.size(); ++b) {
+    const auto& bone = a.bone_maps.maps[b];
+    o << (b ? ", " : "") << "{\"joint\": " << Quote(a.skeleton.joint_names[bone.joint])
+      << ", \"width\": " << bone.pose.width << ", \"height\": " << bone.pose.height
+      << ", \"layers\": " << int(bone.pose.layers) << ", \"bytes\": " << PoseBytes(bone.pose)
+      << "}";
+  }
   o << "],\n  \"joint_spheres\": [";
   for (size_t s = 0; s < a.joint_spheres.size(); ++s) {
     const auto& sphere = a.joint_spheres[s];
@@ -215,6 +224,13 @@ void PrintText(const drape::CharacterAsset& a, const Placement& place, const std
         pose.clip, pose.time, pose.width, pose.height, pose.texel_size * 1000.f,
         DepthName(pose.depth_encoding), NormalName(pose.normal_encoding), int(pose.layers),
         PoseBytes(pose));
+  }
+  std::printf("  bone maps: %zu (epsilon %.1f mm)\n", a.bone_maps.maps.size(),
+              a.bone_maps.epsilon * 1000.f);
+  for (const auto& bone : a.bone_maps.maps) {
+    std::printf("    %-28s %ux%u texels of %.2f mm (bind frame), %d layer(s), %zu bytes\n",
+                a.skeleton.joint_names[bone.joint].c_str(), bone.pose.width, bone.pose.height,
+                bone.pose.texel_size * 1000.f, int(bone.pose.layers), PoseBytes(bone.pose));
   }
   std::printf("  hulls: %zu\n", a.hulls.size());
   for (const auto& hull : a.hulls) {
@@ -277,6 +293,12 @@ int main(int argc, char** argv) {
                    status.message().c_str());
       return 1;
     }
+  }
+  drape::BoneMapCollider bone_maps;
+  if (drape::Status status = bone_maps.Build(asset.bone_maps, asset.skeleton.joint_count());
+      !status.ok()) {
+    std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
+    return 1;
   }
   drape::HullColliderSet hulls;
   if (drape::Status status =

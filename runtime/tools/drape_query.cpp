@@ -1,5 +1,5 @@
 // drape-query FILE.drape [--clip NAME --time T | --joint-matrices F] (--points F | --segments F)
-//             [--method maps|hulls|spheres|all] [--mesh F.obj] [--write-joint-matrices F]
+//             [--method maps|bone_maps|hulls|spheres|all] [--mesh F.obj] [--write-joint-matrices F]
 // The runtime's collision answers from the command line, for pipeline checks and debugging.
 // Input rows: "x y z" (points) or "x0 y0 z0 x1 y1 z1" (previous and current position), asset
 // frame, metres; '#' starts a comment; "nan" and "inf" are read as such. Output: CSV on stdout,
@@ -26,6 +26,7 @@
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/body_map_renderer.h"
+#include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
@@ -38,7 +39,7 @@ int Usage() {
   std::fprintf(stderr,
                "usage: drape-query FILE.drape [--clip NAME --time T | --joint-matrices F]\n"
                "                   (--points F | --segments F)\n"
-               "                   [--method maps|hulls|spheres|all] [--mesh F.obj]\n"
+               "                   [--method maps|bone_maps|hulls|spheres|all] [--mesh F.obj]\n"
                "                   [--write-joint-matrices F]\n");
   return 2;
 }
@@ -245,8 +246,9 @@ int main(int argc, char** argv) {
                        write_matrices_path.empty())) {
     return Usage();
   }
-  if (method != "maps" && method != "hulls" && method != "spheres" && method != "all") {
-    return Fail("--method '" + method + "' is not maps, hulls, spheres or all");
+  if (method != "maps" && method != "bone_maps" && method != "hulls" && method != "spheres" &&
+      method != "all") {
+    return Fail("--method '" + method + "' is not maps, bone_maps, hulls, spheres or all");
   }
   if (time_given && clip_name.empty()) return Fail("--time needs --clip");
   if (!matrices_path.empty() && !clip_name.empty()) {
@@ -337,6 +339,20 @@ int main(int argc, char** argv) {
                    maps.width(), maps.height());
     }
   }
+  // Per-bone local maps, posed like the hulls; "all" includes them when the asset has them.
+  drape::BoneMapCollider bone_maps;
+  const bool want_bone_maps =
+      method == "bone_maps" || (method == "all" && !asset.bone_maps.maps.empty());
+  if (want_bone_maps) {
+    if (asset.bone_maps.maps.empty()) {
+      return Fail(path + ": no bone maps baked (drape-bake with bone_maps.enabled)");
+    }
+    if (drape::Status s = bone_maps.Build(asset.bone_maps, asset.skeleton.joint_count()); !s.ok()) {
+      return Fail(path + ": " + s.message());
+    }
+    if (drape::Status s = bone_maps.SetPose(pose.skinning(), pose.skinning()); !s.ok())
+      return Fail(path + ": " + s.message());
+  }
   drape::HullColliderSet hulls;
   if (want_hulls || want_spheres) {
     if (drape::Status s =
@@ -354,6 +370,8 @@ int main(int argc, char** argv) {
     const Segment& s = rows[r];
     if (want_maps && !maps.empty())
       PrintRow(r, "maps", Answer(s, [&] { return maps.Query(s.p0, s.p1); }), s);
+    if (want_bone_maps)
+      PrintRow(r, "bone_maps", Answer(s, [&] { return bone_maps.Query(s.p0, s.p1); }), s);
     if (want_hulls)
       PrintRow(r, "hulls",
                Answer(s, [&] { return hulls.Query(s.p0, s.p1, drape::kColliderHulls); }), s);

@@ -234,6 +234,19 @@ if [ -e "$WORK/mannequin.drape" ]; then
   if "$QUERY" "$WORK/mannequin.drape" --joint-matrices "$WORK/projective.txt" --points "$WORK/points.txt" >/dev/null 2>"$WORK/q.err"; then
     fail "query accepted a projective matrix"
   elif grep -q "projective.txt:1: the last row is not 0 0 0 1" "$WORK/q.err"; then passed=$((passed + 1)); else fail "query message: $(cat "$WORK/q.err")"; fi
+  # Per-bone local maps: baked on request, answered by --method bone_maps (and all) for a clip
+  # time; an asset without them says so.
+  printf '{"bone_maps": {"enabled": true}}' >"$WORK/bone_maps.json"
+  if "$BAKE" "$MANNEQUIN" -o "$WORK/bone_maps.drape" --config "$WORK/bone_maps.json" 2>/dev/null &&
+    "$QUERY" "$WORK/bone_maps.drape" --clip walk --time 0.37 --points "$WORK/points.txt" --method all >"$WORK/bones.csv" 2>/dev/null; then
+    check_flag 0 bone_maps "$WORK/bones.csv" 1
+    check_flag 1 bone_maps "$WORK/bones.csv" 0
+  else
+    fail "query: bone maps of the mannequin"
+  fi
+  if "$QUERY" "$WORK/mannequin.drape" --method bone_maps --points "$WORK/points.txt" >/dev/null 2>"$WORK/q.err"; then
+    fail "query answered bone_maps for an asset without them"
+  elif grep -q "mannequin.drape: no bone maps baked" "$WORK/q.err"; then passed=$((passed + 1)); else fail "query message: $(cat "$WORK/q.err")"; fi
   printf '0 1 zero\n' >"$WORK/word.txt"
   if "$QUERY" "$WORK/mannequin.drape" --points "$WORK/word.txt" >/dev/null 2>"$WORK/q.err"; then
     fail "query accepted a word as a coordinate"
