@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <random>
 #include <vector>
 
 #include "body_map/body_map_collider_access.h"
@@ -255,6 +256,72 @@ TEST(BodyMapRenderer, HostileInputIsAnErrorAndAnEmptyCollider) {
   broken = mesh;
   broken.triangles.pop_back();
   EXPECT_FALSE(renderer.Init(broken, Options()).ok());
+}
+
+// Maps an engine rendered on its GPU, loaded from the caller's arrays, answer as the maps they
+// were read from; bad arrays are refused naming the reason, and the collider is left empty.
+TEST(BodyMapRenderer, LoadsMapsTheEngineRendered) {
+  const MeshData mesh = TwoSpheres();
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  const Mat34 identity[2] = {Mat34{}, Mat34{}};
+  BodyMapCollider rendered;
+  ASSERT_TRUE(renderer.Render(identity, &rendered).ok());
+  // The engine's buffers: z of both surfaces (NaN on background) and outward normals.
+  const uint32_t w = rendered.width(), h = rendered.height();
+  std::vector<float> front_z(size_t{w} * h), back_z(front_z.size());
+  std::vector<Float3> front_n(front_z.size()), back_n(front_z.size());
+  for (uint32_t j = 0; j < h; ++j) {
+    for (uint32_t i = 0; i < w; ++i) {
+      const size_t k = size_t{j} * w + i;
+      float top = 0.f, bottom = 0.f;
+      const bool body = BodyMapColliderAccess::TexelSlab(rendered, i, j, &top, &bottom);
+      front_z[k] = body ? top : std::nanf("");
+      back_z[k] = body ? bottom : std::nanf("");
+      front_n[k] = BodyMapColliderAccess::TexelNormal(rendered, i, j, false) * 3.f;  // any length
+      back_n[k] = BodyMapColliderAccess::TexelNormal(rendered, i, j, true);
+    }
+  }
+  RenderedMapsView view;
+  view.width = w;
+  view.height = h;
+  view.origin_x = rendered.origin_x();
+  view.origin_y = rendered.origin_y();
+  view.texel_size = rendered.texel_size();
+  view.front_z = front_z;
+  view.back_z = back_z;
+  view.front_normals = front_n;
+  view.back_normals = back_n;
+  BodyMapCollider loaded;
+  ASSERT_TRUE(BodyMapRenderer::Load(view, &loaded).ok());
+  EXPECT_EQ(loaded.stats().valid_texels, rendered.stats().valid_texels);
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> x(-0.2f, 0.7f), yz(-0.15f, 0.15f);
+  for (int n = 0; n < 2000; ++n) {
+    const Float3 p0{x(random), yz(random), yz(random)}, p1{x(random), yz(random), yz(random)};
+    EXPECT_EQ(loaded.IsInside(p1), rendered.IsInside(p1));
+    const ContactQuery a = loaded.Query(p0, p1), b = rendered.Query(p0, p1);
+    ASSERT_EQ(a.contact, b.contact);
+    EXPECT_EQ(a.t, b.t);
+    if (a.contact) {
+      EXPECT_GT(Dot(a.normal, b.normal), 0.9999f);
+    }
+  }
+  const size_t capacity = loaded.memory_bytes();
+  ASSERT_TRUE(BodyMapRenderer::Load(view, &loaded).ok());  // the same grid again: no allocation
+  EXPECT_EQ(loaded.memory_bytes(), capacity);
+
+  RenderedMapsView bad = view;
+  bad.back_z = std::span<const float>(back_z).first(back_z.size() - 1);
+  Status s = BodyMapRenderer::Load(bad, &loaded);
+  EXPECT_NE(s.message().find("width * height"), std::string::npos) << s.message();
+  EXPECT_TRUE(loaded.empty());
+  bad = view;
+  bad.texel_size = std::nanf("");
+  EXPECT_NE(BodyMapRenderer::Load(bad, &loaded).message().find("texel size"), std::string::npos);
+  bad = view;
+  bad.width = 0;
+  EXPECT_FALSE(BodyMapRenderer::Load(bad, &loaded).ok());
 }
 
 }  // namespace

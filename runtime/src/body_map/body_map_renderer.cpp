@@ -514,6 +514,57 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
   }
 }
 
+Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps,
+                             DepthSampling sampling) {
+  if (maps == nullptr) return Invalid("Load: no collider to load into");
+  maps->Clear();
+  const size_t texels = static_cast<size_t>(view.width) * view.height;
+  if (view.width < 1 || view.height < 1 || view.width > 16384 || view.height > 16384) {
+    return Invalid("Load: " + std::to_string(view.width) + " x " + std::to_string(view.height) +
+                   " texels is outside [1, 16384] per side");
+  }
+  if (!std::isfinite(view.origin_x) || !std::isfinite(view.origin_y) ||
+      !(view.texel_size >= 1e-6f && view.texel_size <= 1e3f)) {
+    return Invalid("Load: the origin is not finite or the texel size is outside [1e-6, 1e3] m");
+  }
+  if (view.front_z.size() != texels || view.back_z.size() != texels ||
+      view.front_normals.size() != texels || view.back_normals.size() != texels) {
+    return Invalid("Load: every array must hold width * height = " + std::to_string(texels) +
+                   " entries (front_z " + std::to_string(view.front_z.size()) + ", back_z " +
+                   std::to_string(view.back_z.size()) + ", normals " +
+                   std::to_string(view.front_normals.size()) + " and " +
+                   std::to_string(view.back_normals.size()) + ")");
+  }
+  if (sampling != DepthSampling::kNearest && sampling != DepthSampling::kBilinear) {
+    return Invalid("Load: unknown depth sampling");
+  }
+  maps->slabs_.resize(texels);  // capacity kept from earlier grids
+  maps->normals_.resize(texels);
+  const int64_t count = static_cast<int64_t>(texels);
+#pragma omp parallel for schedule(static) if (count > 65536)
+  for (int64_t k = 0; k < count; ++k) {
+    const float top = view.front_z[k], bottom = view.back_z[k];
+    const bool body = std::isfinite(top) && std::isfinite(bottom) && top >= bottom;
+    maps->slabs_[k] =
+        body ? BodyMapCollider::Slab{top, bottom} : BodyMapCollider::Slab{-kInf, kInf};
+    const std::array<uint16_t, 2> front = EncodeOct16(view.front_normals[k]);
+    const std::array<uint16_t, 2> back =
+        EncodeOct16(IsFinite(view.back_normals[k]) ? view.back_normals[k] : Float3{0.f, 0.f, -1.f});
+    maps->normals_[k] = {{front[0], front[1]}, {back[0], back[1]}};
+  }
+  maps->width_ = view.width;
+  maps->height_ = view.height;
+  maps->width_f_ = static_cast<float>(view.width);
+  maps->height_f_ = static_cast<float>(view.height);
+  maps->origin_x_ = view.origin_x;
+  maps->origin_y_ = view.origin_y;
+  maps->texel_size_ = view.texel_size;
+  maps->inv_texel_size_ = 1.f / view.texel_size;
+  maps->sampling_ = sampling;
+  maps->Finish();
+  return Status::Ok();
+}
+
 size_t BodyMapRenderer::memory_bytes() const {
   return sizeof(*this) +
          (vertex_triangle_offsets_.capacity() + vertex_triangles_.capacity() + drawn_.capacity() +

@@ -45,6 +45,22 @@ struct RenderRegion {
   Float3 max{kInf, kInf, kInf};
 };
 
+// Maps the engine rendered itself (on its GPU, say): both views over one texel grid, in the
+// caller's row-major arrays; texel (i, j) is entry j * width + i and covers x in
+// [origin_x + i * texel_size, + texel_size), y alike (asset frame). z values are asset-frame z
+// of the surfaces offset by epsilon: the front surface is the one nearest +z (a GPU depth buffer
+// read back and mapped through the camera's near/far planes). A texel is body where both z are
+// finite and front_z >= back_z; NaN or an infinity marks background.
+struct RenderedMapsView {
+  uint32_t width = 0, height = 0;         // texels, [1, 16384] each
+  float origin_x = 0.f, origin_y = 0.f;   // metres, finite
+  float texel_size = 0.f;                 // metres, [1e-6, 1e3]
+  std::span<const float> front_z;         // width * height
+  std::span<const float> back_z;          // width * height
+  std::span<const Float3> front_normals;  // width * height, outward; length is ignored
+  std::span<const Float3> back_normals;   // width * height, outward (mostly -z)
+};
+
 // What the last Render drew.
 struct BodyMapRenderStats {
   uint32_t width = 0, height = 0;  // texels of the window
@@ -68,6 +84,12 @@ class BodyMapRenderer {
   // region, or a window over max_side: kInvalidArgument naming the reason, and *maps empty.
   Status Render(std::span<const Mat34> skinning, BodyMapCollider* maps,
                 const RenderRegion* region = nullptr);
+
+  // Copies maps the engine rendered into *maps (the layout above): no allocation when *maps held
+  // a grid at least as large before. A size, an origin or a texel size out of range is
+  // kInvalidArgument naming it, and *maps empty.
+  static Status Load(const RenderedMapsView& view, BodyMapCollider* maps,
+                     DepthSampling sampling = DepthSampling::kNearest);
 
   bool empty() const { return mesh_ == nullptr; }
   const BodyMapRenderOptions& options() const { return options_; }
