@@ -26,7 +26,7 @@ sys.dont_write_bytecode = True  # no __pycache__ beside the scripts
 from performance_doc_format import (Doc, file_safe, mm, ns, number, pair,  # noqa: E402
                                     pct, size, span)
 from performance_doc_gbench import (body_map_bake, body_map_queries, cloth,  # noqa: E402
-                                    hull_bake, hull_queries, read_gbench)
+                                    following_maps, hull_bake, hull_queries, read_gbench)
 
 # A run that starts with a 1-minute load average at or above this shares the machine.
 LOADED = 1.0
@@ -501,6 +501,7 @@ def main():
         doc.add("")
         speed_vs_error(doc, rows, sections)
     body_map_queries(doc, gb)
+    following_maps(doc, gb, rows)
     hull_queries(doc, gb)
     cloth(doc, gb, sections)
     body_map_bake(doc, gb)

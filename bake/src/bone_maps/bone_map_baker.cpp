@@ -1,5 +1,5 @@
 // BakeBoneMaps: per bone, its part of the body, the view axis with the least air, and the maps of
-// the part in that view frame (docs/ALGORITHMS.md §7.7).
+// the part in that view frame (docs/ALGORITHMS.md §7.10).
 #include "drape/bake/bone_map_baker.h"
 
 #include <Eigen/Dense>

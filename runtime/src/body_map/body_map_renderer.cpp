@@ -1,7 +1,7 @@
 // BodyMapRenderer: the maps of a pose rendered at run time. Render is a recipe of stages:
 // skin and offset the mesh, cull the triangles to the region, place the window on the texel
 // lattice, rasterize both surfaces in row bands, shade the normals, and let the collider derive
-// its bounds and blocks (docs/ALGORITHMS.md §7.6).
+// its bounds and blocks (docs/ALGORITHMS.md §7.9).
 #include "drape/runtime/body_map_renderer.h"
 
 #include <algorithm>

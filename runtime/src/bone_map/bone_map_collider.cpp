@@ -1,5 +1,5 @@
 // BoneMapCollider: per-bone maps posed by the skinning matrices; each motion tested in the view
-// frames of the bones whose posed bounds it reaches (docs/ALGORITHMS.md §7.7).
+// frames of the bones whose posed bounds it reaches (docs/ALGORITHMS.md §7.10).
 #include "drape/runtime/bone_map_collider.h"
 
 #include <algorithm>

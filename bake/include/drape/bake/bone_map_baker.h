@@ -3,7 +3,7 @@
 // body, the front/back maps of that part baked once in a view frame fixed to the bone, along the
 // axis most of the part's surface faces. The runtime (drape/runtime/bone_map_collider.h)
 // maps each point into the frames of the bones whose bounds it reaches, so the maps follow any
-// pose. How the parts and the axes are chosen: docs/ALGORITHMS.md §7.7.
+// pose. How the parts and the axes are chosen: docs/ALGORITHMS.md §7.10.
 
 #include <cstdint>
 #include <span>

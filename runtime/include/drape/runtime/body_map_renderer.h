@@ -2,7 +2,7 @@
 // Paper A's body maps for any pose the engine drives: skins the stored bind mesh with the frame's
 // skinning matrices, offsets it by epsilon along its vertex normals and rasterizes the front and
 // back surfaces (z-view, slab only) straight into a BodyMapCollider, over the window a region
-// box allows. How it works and what it costs: docs/ALGORITHMS.md §7.6, docs/PERFORMANCE.md.
+// box allows. How it works and what it costs: docs/ALGORITHMS.md §7.9, docs/PERFORMANCE.md.
 //
 //   BodyMapRenderer renderer;
 //   renderer.Init(asset.mesh, {.texel_size = 0.002f, .epsilon = asset.body_maps.epsilon});

@@ -2,7 +2,7 @@
 // Per-bone local maps at run time (drape/formats/body_map_data.h, BoneMapSet): each bone's part
 // of the body as front/back maps baked once in a view frame fixed to the bone, posed by the
 // skinning matrices, so the collider follows any pose the engine drives without rendering. How
-// it works and what it costs: docs/ALGORITHMS.md §7.7, docs/PERFORMANCE.md.
+// it works and what it costs: docs/ALGORITHMS.md §7.10, docs/PERFORMANCE.md.
 //
 //   BoneMapCollider bones;
 //   bones.Build(asset.bone_maps, asset.skeleton.joint_count());            // once: allocates
