@@ -13,6 +13,7 @@
 #include "checks.h"
 #include "drape/bake/bake_pipeline.h"
 #include "drape/bake/body_map_baker.h"
+#include "drape/bake/scene.h"
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
@@ -225,23 +226,38 @@ void Measurement::RunPosed(const CharacterSpec& spec, const bake::Character& cha
       [](const ClipData& a, const ClipData& b) { return a.duration < b.duration; });
   for (const float fraction : {0.4f, 0.8f})
     RunPosedAt(spec, character, hull_assets, clip, fraction);
+  // A pose no clip holds: the clip at 60 % with every joint turned by up to 30 degrees.
+  RunPosedAt(spec, character, hull_assets, clip, 0.6f, 30.f);
 }
 
 void Measurement::RunPosedAt(const CharacterSpec& spec, const bake::Character& character,
-                             const HullAssets& hull_assets, const ClipData& clip, float fraction) {
+                             const HullAssets& hull_assets, const ClipData& clip, float fraction,
+                             float perturb_degrees) {
   const float time = fraction * clip.duration;
   SkeletonPose pose;
   std::vector<Float3> positions(character.mesh.vertex_count());
-  if (!pose.Init(character.skeleton).ok() || !pose.SampleClip(clip, time, false).ok() ||
-      !SkinMesh(character.mesh, pose.skinning(), positions).ok()) {
+  if (!pose.Init(character.skeleton).ok() || !pose.SampleClip(clip, time, false).ok()) {
     Fail(spec.label + ": cannot pose its longest clip");
+  }
+  if (perturb_degrees > 0.f) {
+    std::vector<Transform> local(pose.local().begin(), pose.local().end());
+    bake::PerturbJointRotations(local, perturb_degrees, 1);
+    if (!pose.SetLocalTransforms(local).ok()) Fail(spec.label + ": cannot perturb the pose");
+  }
+  if (!SkinMesh(character.mesh, pose.skinning(), positions).ok()) {
+    Fail(spec.label + ": cannot skin the pose");
   }
   const std::vector<Mat34> skinning(pose.skinning().begin(), pose.skinning().end());
   const std::vector<uint32_t>& triangles = character.mesh.triangles;
   CharacterSpec posed = spec;
   char label[96];
-  std::snprintf(label, sizeof(label), " posed (%s t=%.2f s)",
-                clip.name.empty() ? "unnamed clip" : clip.name.c_str(), time);
+  char turned[48] = "";
+  if (perturb_degrees > 0.f) {
+    std::snprintf(turned, sizeof(turned), ", joints turned up to %.0f deg",
+                  static_cast<double>(perturb_degrees));
+  }
+  std::snprintf(label, sizeof(label), " posed (%s t=%.2f s%s)",
+                clip.name.empty() ? "unnamed clip" : clip.name.c_str(), time, turned);
   posed.label += label;
   std::printf("%s\n", posed.label.c_str());
   const bake::MeshReference reference(positions, triangles);

@@ -69,8 +69,10 @@ class Measurement {
                                   const std::string& label, std::unique_ptr<Method> default_maps);
   void RunPosed(const CharacterSpec& spec, const bake::Character& character,
                 const HullAssets& hull_assets);
+  // At `fraction` of the clip, every joint turned by up to perturb_degrees on top (0: none).
   void RunPosedAt(const CharacterSpec& spec, const bake::Character& character,
-                  const HullAssets& hull_assets, const ClipData& clip, float fraction);
+                  const HullAssets& hull_assets, const ClipData& clip, float fraction,
+                  float perturb_degrees = 0.f);
   // At a posed body: maps rendered from the skinned mesh, per-bone local maps, and the rest
   // pose's maps, which do not follow (following_maps.cpp).
   void MeasureFollowingMaps(const Context& context, const bake::Character& character,

@@ -55,18 +55,14 @@ Status FrameRenderer::Frame(const bake::Scene& scene, const CharacterAsset& asse
   };
   SkeletonPose pose;
   if (Status s = pose.Init(asset.skeleton); !s.ok()) return s;
+  bake::ScenePoser poser;
+  if (Status s = poser.Init(scene, asset, clip); !s.ok()) return s;
   std::vector<Float3> posed(asset.mesh.vertex_count());
   constexpr int kSamples = 8;
   for (int k = 0; k < kSamples; ++k) {
     const float t = scene.animation.start + static_cast<float>(scene.frame_count) * scene.dt *
                                                 static_cast<float>(k) / (kSamples - 1);
-    if (clip >= 0) {
-      (void)pose.SampleClip(asset.clips[static_cast<size_t>(clip)], t, scene.animation.loop);
-    } else if (scene.animation.pose == bake::ScenePose::kRest) {
-      pose.SetRest();
-    } else {
-      pose.SetBind();
-    }
+    (void)poser.Pose(t, &pose);
     (void)SkinMesh(asset.mesh, pose.skinning(), posed);
     grow(posed);
   }

@@ -128,6 +128,7 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
   settle_frames_ = static_cast<int64_t>(std::lround(scene.animation.settle / scene.dt));
   const std::string where = scene.source + ": ";
   if (Status s = pose_.Init(asset.skeleton); !s.ok()) return Status(s.code(), where + s.message());
+  if (Status s = poser_.Init(scene, asset, clip); !s.ok()) return s;
 
   // Hulls and joint spheres: one set holding the kinds the scene uses.
   std::vector<HullColliderData> hulls;
@@ -212,16 +213,8 @@ float SceneSimulation::FrameStartTime(int64_t frame) const {
 }
 
 Status SceneSimulation::Pose(float time, std::vector<Mat34>* skinning) {
-  if (clip_ >= 0) {
-    if (Status s = pose_.SampleClip(asset_->clips[static_cast<size_t>(clip_)], time,
-                                    scene_->animation.loop);
-        !s.ok())
-      return Status(s.code(), scene_->source + ": " + s.message());
-  } else if (scene_->animation.pose == bake::ScenePose::kRest) {
-    pose_.SetRest();
-  } else {
-    pose_.SetBind();
-  }
+  if (Status s = poser_.Pose(time, &pose_); !s.ok())
+    return Status(s.code(), scene_->source + ": " + s.message());
   skinning->assign(pose_.skinning().begin(), pose_.skinning().end());
   return Status::Ok();
 }

@@ -125,6 +125,7 @@ class SceneSimulation {
   int32_t clip_ = -1;
   int64_t settle_frames_ = 0;
   SkeletonPose pose_;
+  bake::ScenePoser poser_;
   std::vector<Mat34> skin_start_, skin_end_;
   HullColliderSet hulls_;
   bool has_hull_set_ = false;

@@ -6,8 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -492,6 +494,68 @@ TEST_F(SceneTest, PlayedMapPosesAreThoseOfThePlayedTimes) {
 
 // docs/SCENES.md is generated from the schema the parser reads with; a changed field, range or
 // default changes the document.
+// Poses no bake saw: a blend with a second clip and fixed random joint rotations. The
+// perturbation is the same for a seed, turns every joint by at most its angle, and the poser
+// plays it on top of the clip; the scene refuses a blend without a clip, baked maps with a
+// perturbation, and a blend clip the character lacks, naming the path.
+TEST_F(SceneTest, PosesBeyondTheClip) {
+  const SkeletonData& skeleton = asset().skeleton;
+  std::vector<Transform> a(skeleton.rest_local.begin(), skeleton.rest_local.end()), b = a;
+  PerturbJointRotations(a, 30.f, 7);
+  PerturbJointRotations(b, 30.f, 7);
+  double largest = 0.0;
+  for (size_t j = 0; j < a.size(); ++j) {
+    EXPECT_EQ(std::memcmp(&a[j], &b[j], sizeof(Transform)), 0) << j;
+    const Quat r = skeleton.rest_local[j].rotation, p = a[j].rotation;
+    const double dot =
+        std::fabs(double(r.x) * p.x + double(r.y) * p.y + double(r.z) * p.z + double(r.w) * p.w);
+    const double angle = 2.0 * std::acos(std::min(dot, 1.0)) * 180.0 / 3.14159265358979;
+    EXPECT_LE(angle, 30.01) << j;
+    largest = std::max(largest, angle);
+  }
+  EXPECT_GT(largest, 15.0);  // not the identity
+
+  json j = MiniSkirt();
+  j["collision"]["methods"] = {"maps", "hulls"};
+  j["animation"]["perturb_degrees"] = 20;
+  j["animation"]["blend_clip"] = "walk";
+  j["animation"]["blend_weight"] = 0.25;
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  int32_t clip = -1;
+  ASSERT_TRUE(ResolveSceneClip(asset(), &scene, &clip).ok());
+  ScenePoser poser;
+  ASSERT_TRUE(poser.Init(scene, asset(), clip).ok());
+  SkeletonPose perturbed, plain;
+  ASSERT_TRUE(perturbed.Init(skeleton).ok() && plain.Init(skeleton).ok());
+  ASSERT_TRUE(poser.Pose(0.3f, &perturbed).ok());
+  ASSERT_TRUE(plain.SampleClip(asset().clips[0], 0.3f, true).ok());
+  float moved = 0.f;
+  for (size_t k = 0; k < plain.world().size(); ++k) {
+    const Mat34 &p = plain.world()[k], &q = perturbed.world()[k];
+    moved = std::max(moved, Length(Float3{p.m[3] - q.m[3], p.m[7] - q.m[7], p.m[11] - q.m[11]}));
+  }
+  EXPECT_GT(moved, 0.05f);  // metres: the joints moved off the clip's pose
+
+  j["animation"]["blend_clip"] = "run";
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  ASSERT_TRUE(ResolveSceneClip(asset(), &scene, &clip).ok());
+  const Status unknown = poser.Init(scene, asset(), clip);
+  EXPECT_EQ(unknown.message().rfind("scene.json: /animation/blend_clip: no clip named 'run'", 0),
+            0u)
+      << unknown.message();
+  j["animation"]["blend_clip"] = "walk";
+  j["collision"]["maps_source"] = "baked";
+  Status s = Parse(j, &scene);
+  EXPECT_EQ(s.message().rfind("scene.json: /collision/maps_source: baked maps hold", 0), 0u)
+      << s.message();
+  json still = DemoJson();
+  still["animation"] = {{"blend_clip", "walk"}};
+  s = Parse(still, &scene);
+  EXPECT_EQ(s.message().rfind("scene.json: /animation/blend_clip: blends with `clip`", 0), 0u)
+      << s.message();
+}
+
 TEST(SceneReference, DocumentIsTheGeneratedOne) {
   const std::string path = test::SourceDir() + "/docs/SCENES.md";
   std::ifstream in(path);

@@ -40,6 +40,31 @@ ClipData Turn(uint32_t joints, float end_angle) {
   return clip;
 }
 
+// Local transforms from the caller give what a clip giving them gives; a blend of two poses is
+// halfway on the shorter arc; bad input is refused naming the joint.
+TEST(SkeletonPose, LocalTransformsAndBlends) {
+  const SkeletonData s = TwoBones();
+  const ClipData clip = Turn(2, 1.5f);
+  SkeletonPose sampled, local, rest;
+  ASSERT_TRUE(sampled.Init(s).ok() && local.Init(s).ok() && rest.Init(s).ok());
+  ASSERT_TRUE(sampled.SampleClip(clip, 1.f, false).ok());  // 1.5 rad about Y
+  ASSERT_TRUE(local.SetLocalTransforms(sampled.local()).ok());
+  for (size_t j = 0; j < 2; ++j)
+    for (int k = 0; k < 12; ++k) EXPECT_EQ(local.skinning()[j].m[k], sampled.skinning()[j].m[k]);
+  // Halfway between the rest pose (0 rad) and 1.5 rad: 0.75 rad.
+  ASSERT_TRUE(rest.SampleClip(clip, 0.f, false).ok());
+  ASSERT_TRUE(rest.BlendWith(sampled, 0.5f).ok());
+  const Float3 child = {rest.world()[1].m[3], rest.world()[1].m[7], rest.world()[1].m[11]};
+  EXPECT_NEAR(child.x, std::cos(0.75f), 1e-5f);
+  EXPECT_NEAR(child.z, -std::sin(0.75f), 1e-5f);
+  EXPECT_FALSE(rest.BlendWith(sampled, 1.5f).ok());
+  std::vector<Transform> bad(sampled.local().begin(), sampled.local().end());
+  bad[1].rotation.y = std::nanf("");
+  const Status status = local.SetLocalTransforms(bad);
+  EXPECT_EQ(status.message(), "local transform 1 is not finite");
+  EXPECT_FALSE(local.SetLocalTransforms(std::span<const Transform>(bad).first(1)).ok());
+}
+
 TEST(SkeletonPose, RestAndBindPoses) {
   const SkeletonData s = TwoBones();
   SkeletonPose pose;

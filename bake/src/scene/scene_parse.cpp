@@ -33,6 +33,15 @@ Status ParseScene(const json& value, const std::string& source, const std::strin
         .Member("pose")
         .Error("baked maps are of the rest pose: use \"rest\", a clip, or rendered maps");
   }
+  const SceneAnimation& anim = result.animation;
+  if (result.use_maps && result.maps_source == MapSource::kBaked &&
+      (!anim.blend_clip.empty() || anim.perturb_degrees > 0.f)) {
+    return root.Member("collision")
+        .Member("maps_source")
+        .Error(
+            "baked maps hold the clip's own poses: a blend or a perturbation needs "
+            "\"rendered\" maps");
+  }
   if (result.animation.clip.empty() && result.animation.duration < 0.f)
     result.animation.duration = 1.f;  // a static scene: one second unless told
   if (result.animation.duration > 0.f)

@@ -156,6 +156,10 @@ Status SweepPlayedPoses(const Scene& resolved, const CharacterAsset& asset,
   const SceneAnimation& anim = resolved.animation;
   SkeletonPose pose;
   DRAPE_RETURN_IF_ERROR(pose.Init(asset.skeleton));
+  ScenePoser poser;
+  const int32_t clip =
+      clip_data != nullptr ? static_cast<int32_t>(clip_data - asset.clips.data()) : -1;
+  DRAPE_RETURN_IF_ERROR(poser.Init(resolved, asset, clip));
   const int32_t root = 0;
   const Float3 root_bind = RootBindPosition(asset.skeleton);
   Float3 root_start;
@@ -165,15 +169,11 @@ Status SweepPlayedPoses(const Scene& resolved, const CharacterAsset& asset,
     out->clip_time_max = -kInf;
   }
   for (size_t t = 0; t < times.size(); ++t) {
+    DRAPE_RETURN_IF_ERROR(poser.Pose(times[t], &pose));
     if (clip_data != nullptr) {
-      DRAPE_RETURN_IF_ERROR(pose.SampleClip(*clip_data, times[t], anim.loop));
       const float ct = ClipTime(*clip_data, times[t], anim.loop);
       out->clip_time_min = std::min(out->clip_time_min, ct);
       out->clip_time_max = std::max(out->clip_time_max, ct);
-    } else if (anim.pose == ScenePose::kRest) {
-      pose.SetRest();
-    } else {
-      pose.SetBind();
     }
     const std::span<const Mat34> skinning = pose.skinning();
     if (!bounded) continue;

@@ -41,9 +41,23 @@ const JsonSchema<SceneAnimation>& AnimationSchema() {
                  "seconds simulated with the body held at the start pose before frame 0 (not "
                  "output), so garments hang before the motion starts",
                  [](SceneAnimation& a) -> float& { return a.settle; })
+          .String("blend_clip", StringRule::kNonEmpty,
+                  "a second clip played at the same time and blended with `clip` (a pose no "
+                  "bake saw)",
+                  [](SceneAnimation& a) -> std::string& { return a.blend_clip; })
+          .Float("blend_weight", "", Closed(0, 1), "0: `clip` alone, 1: `blend_clip` alone",
+                 [](SceneAnimation& a) -> float& { return a.blend_weight; })
+          .Float("perturb_degrees", "deg", Closed(0, 90),
+                 "every joint turned by a fixed random rotation of up to this angle on top of the "
+                 "clip or pose (0: none)",
+                 [](SceneAnimation& a) -> float& { return a.perturb_degrees; })
+          .Unsigned<uint32_t>("perturb_seed", "", 0, 4294967295u, "the perturbation's random seed",
+                              [](SceneAnimation& a) -> uint32_t& { return a.perturb_seed; })
           .Rule([](const JsonAt& at, SceneAnimation& a) {
             if (at.Find("pose") != nullptr && !a.clip.empty())
               return at.Member("pose").Error("give either a clip or a static pose, not both");
+            if (!a.blend_clip.empty() && a.clip.empty())
+              return at.Member("blend_clip").Error("blends with `clip`: give a clip too");
             return Status::Ok();
           });
   return schema;

@@ -92,6 +92,41 @@ Status SkeletonPose::SetJointWorldMatrices(std::span<const Mat34> world) {
   return Status::Ok();
 }
 
+Status SkeletonPose::SetLocalTransforms(std::span<const Transform> local) {
+  if (local.size() != local_.size()) {
+    return Status(StatusCode::kInvalidArgument, "expected " + std::to_string(local_.size()) +
+                                                    " local transforms, got " +
+                                                    std::to_string(local.size()));
+  }
+  for (size_t j = 0; j < local.size(); ++j) {
+    const Transform& t = local[j];
+    const bool finite = IsFinite(t.translation) && IsFinite(t.scale) &&
+                        std::isfinite(t.rotation.x) && std::isfinite(t.rotation.y) &&
+                        std::isfinite(t.rotation.z) && std::isfinite(t.rotation.w);
+    if (!finite) {
+      return Status(StatusCode::kInvalidArgument,
+                    "local transform " + std::to_string(j) + " is not finite");
+    }
+  }
+  for (size_t j = 0; j < local.size(); ++j) local_[j] = local[j];
+  UpdateFromLocal();
+  return Status::Ok();
+}
+
+Status SkeletonPose::BlendWith(const SkeletonPose& other, float weight) {
+  if (other.skeleton_ != skeleton_ || other.local_.size() != local_.size()) {
+    return Status(StatusCode::kInvalidArgument, "BlendWith: a pose of another skeleton");
+  }
+  if (!(weight >= 0.f && weight <= 1.f)) {
+    return Status(StatusCode::kInvalidArgument, "BlendWith: weight is not in [0, 1]");
+  }
+  for (size_t j = 0; j < local_.size(); ++j) {
+    local_[j] = Interpolate(local_[j], other.local_[j], weight);
+  }
+  UpdateFromLocal();
+  return Status::Ok();
+}
+
 void SkeletonPose::UpdateFromLocal() {
   for (size_t j = 0; j < local_.size(); ++j) {
     const Mat34 local = ToMatrix(local_[j]);

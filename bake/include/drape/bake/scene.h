@@ -26,6 +26,7 @@
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/garments.h"
 #include "drape/runtime/hull_collider_set.h"
+#include "drape/runtime/skeleton_pose.h"
 
 namespace drape::bake {
 
@@ -88,6 +89,12 @@ struct SceneAnimation {
   float duration = -1.f;  // seconds of scene time, > 0; -1: the clip's duration (1 s static)
   bool loop = true;
   float settle = 0.5f;  // seconds simulated at the start pose before frame 0, >= 0
+  // Poses no bake saw: the clip blended with another at the same time (empty: none) ...
+  std::string blend_clip;
+  float blend_weight = 0.5f;  // [0, 1]: 0 the clip alone, 1 blend_clip alone
+  // ... and a fixed random rotation of up to this many degrees on every joint, [0, 90].
+  float perturb_degrees = 0.f;
+  uint32_t perturb_seed = 1;
 };
 
 enum class SceneAnimationOutput : uint8_t { kAuto, kMp4, kGif, kContactSheet, kNone };
@@ -147,6 +154,31 @@ struct Scene {
   // computed by the parser as ceil(duration / dt) once the duration is known (ResolveSceneClip
   // fills it for a clip's default duration). 0 until then.
   uint32_t frame_count = 0;
+};
+
+// Rotates every joint's local rotation by a fixed random rotation (a uniform random axis, an
+// angle uniform in [-max_degrees, max_degrees]), the same for a seed on every machine
+// (splitmix64, no library distributions).
+void PerturbJointRotations(std::span<Transform> local, float max_degrees, uint32_t seed);
+
+// The skeleton pose a scene plays at a scene time: its clip (or static pose), blended with
+// animation.blend_clip, perturbed by animation.perturb_degrees. drape-sim, the reach analysis and
+// the camera all pose the body through it.
+class ScenePoser {
+ public:
+  // `scene` and `asset` must outlive the poser; `clip` as ResolveSceneClip gave it. Allocates.
+  // Error: "<scene>: /animation/blend_clip: no clip named 'x' (clips: ...)".
+  Status Init(const Scene& scene, const CharacterAsset& asset, int32_t clip);
+  // The pose at scene time `time` into *pose (initialised on the asset's skeleton). No
+  // allocation.
+  Status Pose(float time, SkeletonPose* pose);
+
+ private:
+  const Scene* scene_ = nullptr;
+  const CharacterAsset* asset_ = nullptr;
+  int32_t clip_ = -1, blend_clip_ = -1;
+  SkeletonPose blend_pose_;
+  std::vector<Transform> local_;  // scratch for the perturbation
 };
 
 // Reads and parses a scene file. Relative paths in it resolve against its directory.

@@ -27,6 +27,14 @@ class SkeletonPose {
   void SetBind();
   // The engine path: joint world matrices in the asset frame, one per joint, from the caller.
   Status SetJointWorldMatrices(std::span<const Mat34> world);
+  // Local transforms (parent space) from the caller, one per joint: an engine's animation graph,
+  // IK, or a clip edited on top. Non-finite values are refused naming the joint.
+  Status SetLocalTransforms(std::span<const Transform> local);
+  // Moves this pose's local transforms toward `other`'s (a pose of the same skeleton) by
+  // `weight` in [0, 1]: translations and scales lerped, rotations nlerped on the shorter arc
+  // (a blend of two clips: sample each into a pose, blend one with the other). Both poses' local
+  // transforms come from SetRest, SampleClip or SetLocalTransforms (not the matrix paths).
+  Status BlendWith(const SkeletonPose& other, float weight);
 
   uint32_t joint_count() const { return static_cast<uint32_t>(world_.size()); }
   std::span<const Transform> local() const { return local_; }
