@@ -19,13 +19,16 @@ struct SampleScene {
 constexpr SampleScene kSampleScenes[] = {
     {"demo.json", "the built-in mannequin",
      "3 s of the walk in a skirt held at the hips, hulls + joint spheres"},
+    {"pose_following_maps.json", "the built-in mannequin",
+     "the walk with every joint turned up to 20 degrees (poses no bake saw) in a skirt, body maps "
+     "rendered for every frame"},
     {"cesium_man_cape.json", "`CesiumMan.glb` (shared assets)",
-     "a cape held at the upper torso, body maps of the clip + hulls"},
+     "a cape held at the upper torso, body maps rendered per frame + hulls"},
     {"robot_expressive_cape.json", "`RobotExpressive.glb` (shared assets)",
      "a cape on a rigid-part robot (4.4 m tall as authored), 18 hulls"},
     {"animated_human_skirt.json", "`Animated_Human.fbx` (shared assets)",
      "a skirt on Quaternius' Animated Human walking, written in the rest frame (its bind pose is "
-     "scaled 100x against the rest pose), body maps + hulls"},
+     "scaled 100x against the rest pose), body maps rendered per frame + hulls"},
     {"soak.json", "the built-in mannequin",
      "the soak scene: 10 000 frames of the walk in a 100 000-particle long skirt, hulls + joint "
      "spheres, no pictures but frame 0 (see [The soak scene](#the-soak-scene))"},
