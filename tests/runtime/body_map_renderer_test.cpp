@@ -13,7 +13,7 @@
 #include "body_map/body_map_collider_access.h"
 #include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/math.h"
-#include "octahedron_sphere.h"
+#include "skinned_spheres.h"
 
 namespace drape {
 namespace {
@@ -22,30 +22,7 @@ constexpr float kRadius = 0.1f;     // metres
 constexpr float kEpsilon = 0.005f;  // metres
 constexpr float kTexel = 0.001f;    // metres
 
-// Two spheres of radius kRadius, the first at the origin bound to joint 0, the second at
-// (0.5, 0, 0) bound to joint 1. 4 subdivisions: the facets lie within 1.2 mm of the sphere.
-MeshData TwoSpheres() {
-  const test::UnitSphereMesh unit = test::OctahedronSphere(4);
-  MeshData mesh;
-  for (int sphere = 0; sphere < 2; ++sphere) {
-    const uint32_t base = static_cast<uint32_t>(mesh.positions.size());
-    for (const auto& p : unit.positions) {
-      mesh.positions.push_back(
-          {static_cast<float>(p[0] * kRadius) + 0.5f * static_cast<float>(sphere),
-           static_cast<float>(p[1] * kRadius), static_cast<float>(p[2] * kRadius)});
-    }
-    for (const auto& t : unit.triangles) {
-      for (uint32_t k : t) mesh.triangles.push_back(base + k);
-    }
-  }
-  mesh.influence_offsets.push_back(0);
-  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-    mesh.influence_joints.push_back(v < mesh.vertex_count() / 2 ? 0 : 1);
-    mesh.influence_weights.push_back(1.f);
-    mesh.influence_offsets.push_back(v + 1);
-  }
-  return mesh;
-}
+MeshData TwoSpheres() { return test::TwoSkinnedSpheres(kRadius); }
 
 Mat34 Translation(float x, float y, float z) { return TranslationMatrix({x, y, z}); }
 

@@ -1,12 +1,14 @@
-// Per-bone local maps: baked once at the bind pose, they follow the joints; a rig bound in
-// centimetres gets the texel and epsilon of its posed metres; the batch gives the same bits at
-// any thread count; a bad pose is refused and keeps the previous one; and on the mannequin and
-// the shared characters at a pose between a clip's keys, the points just inside the posed body
-// are inside and the points clearly outside are mostly outside.
+// The body maps that follow any pose. Per-bone local maps: baked once at the bind pose, they
+// follow the joints; a rig bound in centimetres gets the texel and epsilon of its posed metres;
+// the batch gives the same bits at any thread count; a bad pose is refused and keeps the previous
+// one; and on the mannequin and the shared characters at a pose between a clip's keys, the
+// points just inside the posed body are inside and the points clearly outside mostly outside.
+// Maps rendered at run time (BodyMapRenderer) agree with the bake's reference rasterizer there.
 
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -14,14 +16,17 @@
 #include <string>
 #include <vector>
 
+#include "body_map/body_map_collider_access.h"
+#include "drape/bake/body_map_baker.h"
 #include "drape/bake/bone_map_baker.h"
 #include "drape/bake/importer.h"
 #include "drape/bake/mesh_reference.h"
+#include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
-#include "octahedron_sphere.h"
+#include "skinned_spheres.h"
 #include "test_support.h"
 
 namespace drape::bake {
@@ -29,29 +34,7 @@ namespace {
 
 constexpr float kRadius = 0.1f;  // metres
 
-// Two spheres (radius kRadius * scale), the first at the origin on joint 0, the second at
-// (0.5, 0, 0) * scale on joint 1, rigidly weighted.
-MeshData TwoSpheres(float scale = 1.f) {
-  const test::UnitSphereMesh unit = test::OctahedronSphere(4);
-  MeshData mesh;
-  for (int sphere = 0; sphere < 2; ++sphere) {
-    const uint32_t base = static_cast<uint32_t>(mesh.positions.size());
-    for (const auto& p : unit.positions) {
-      mesh.positions.push_back(
-          {(static_cast<float>(p[0]) * kRadius + 0.5f * static_cast<float>(sphere)) * scale,
-           static_cast<float>(p[1]) * kRadius * scale, static_cast<float>(p[2]) * kRadius * scale});
-    }
-    for (const auto& t : unit.triangles)
-      for (uint32_t k : t) mesh.triangles.push_back(base + k);
-  }
-  mesh.influence_offsets.push_back(0);
-  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-    mesh.influence_joints.push_back(v < mesh.vertex_count() / 2 ? 0 : 1);
-    mesh.influence_weights.push_back(1.f);
-    mesh.influence_offsets.push_back(v + 1);
-  }
-  return mesh;
-}
+MeshData TwoSpheres(float scale = 1.f) { return test::TwoSkinnedSpheres(kRadius, scale); }
 
 SkeletonData TwoJoints() {
   SkeletonData s;
@@ -191,24 +174,48 @@ struct Case {
   const char* path;  // under ../shared/assets/characters; empty: the mannequin sample
 };
 
-class BoneMapsOnCharacters : public ::testing::TestWithParam<Case> {};
+// A character imported, its rest pose, and its skeleton posed between a clip's keys (a pose the
+// clip's resampled frames do not hold).
+struct PosedCharacter {
+  Character character;
+  SkeletonPose pose;
+  std::vector<Float3> rest;          // the rest pose's vertices
+  std::vector<Mat34> rest_skinning;  // bind -> rest
+};
+
+void PoseBetweenKeys(const Case& c, PosedCharacter* out) {
+  const std::string path = *c.path ? test::CharacterPath(c.path) : test::MannequinPath();
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent (../shared/assets)";
+  Character& character = out->character;
+  ASSERT_TRUE(ImportCharacter(path, ImportOptions{}, &character).ok());
+  SkeletonPose& pose = out->pose;
+  ASSERT_TRUE(pose.Init(character.skeleton).ok());
+  pose.SetRest();
+  out->rest.resize(character.mesh.vertex_count());
+  ASSERT_TRUE(SkinMesh(character.mesh, pose.skinning(), out->rest).ok());
+  out->rest_skinning.assign(pose.skinning().begin(), pose.skinning().end());
+  if (!character.clips.empty()) {
+    const ClipData& clip = character.clips.front();
+    const float time =
+        (std::floor(0.37f * static_cast<float>(clip.frame_count)) + 0.43f) / clip.sample_rate;
+    ASSERT_TRUE(pose.SampleClip(clip, std::min(time, clip.duration), false).ok());
+  }
+}
+
+class OnCharacters : public ::testing::TestWithParam<Case> {};
 
 // At a pose between a clip's keys: points 3 mm inside the posed surface (along the vertex
 // normals) are inside, points 20 mm outside mostly outside. The misses are the blended skin at
 // bent joints, which each bone's maps take as rigid; the false insides are air a neighbouring
 // part's slab covers in a concave corner (an armpit, the crotch).
-TEST_P(BoneMapsOnCharacters, HoldThePosedBody) {
-  const std::string path =
-      *GetParam().path ? test::CharacterPath(GetParam().path) : test::MannequinPath();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is absent (../shared/assets)";
-  Character character;
-  ASSERT_TRUE(ImportCharacter(path, ImportOptions{}, &character).ok());
-  SkeletonPose pose;
-  ASSERT_TRUE(pose.Init(character.skeleton).ok());
-  pose.SetRest();
-  std::vector<Float3> rest(character.mesh.vertex_count());
-  ASSERT_TRUE(SkinMesh(character.mesh, pose.skinning(), rest).ok());
-  const std::vector<Mat34> rest_skinning(pose.skinning().begin(), pose.skinning().end());
+TEST_P(OnCharacters, BoneMapsHoldThePosedBody) {
+  PosedCharacter posed_character;
+  PoseBetweenKeys(GetParam(), &posed_character);
+  if (IsSkipped() || HasFatalFailure()) return;
+  const Character& character = posed_character.character;
+  const SkeletonPose& pose = posed_character.pose;
+  const std::vector<Float3>& rest = posed_character.rest;
+  const std::vector<Mat34>& rest_skinning = posed_character.rest_skinning;
   BoneMapOptions options;
   options.texel_size = AutomaticBoneMapTexel(rest);
   BoneMapSet set;
@@ -216,12 +223,6 @@ TEST_P(BoneMapsOnCharacters, HoldThePosedBody) {
   BoneMapCollider bones;
   ASSERT_TRUE(bones.Build(set, character.skeleton.joint_count()).ok());
 
-  if (!character.clips.empty()) {
-    const ClipData& clip = character.clips.front();
-    const float time =
-        (std::floor(0.37f * static_cast<float>(clip.frame_count)) + 0.43f) / clip.sample_rate;
-    ASSERT_TRUE(pose.SampleClip(clip, std::min(time, clip.duration), false).ok());
-  }
   ASSERT_TRUE(bones.SetPose(pose.skinning(), pose.skinning()).ok());
   std::vector<Float3> posed(character.mesh.vertex_count());
   ASSERT_TRUE(SkinMesh(character.mesh, pose.skinning(), posed).ok());
@@ -264,7 +265,72 @@ TEST_P(BoneMapsOnCharacters, HoldThePosedBody) {
       << outside_called_inside << " of " << outside_tested;
 }
 
-INSTANTIATE_TEST_SUITE_P(Characters, BoneMapsOnCharacters,
+// The runtime's BodyMapRenderer against the bake's reference rasterizer at the same pose: maps
+// rendered on the baked grid hold the same texels, the same depths (float against double
+// arithmetic) and the same normals as the maps the bake makes of the posed mesh.
+TEST_P(OnCharacters, RenderedMapsAgreeWithTheBake) {
+  PosedCharacter posed_character;
+  PoseBetweenKeys(GetParam(), &posed_character);
+  if (IsSkipped() || HasFatalFailure()) return;
+  const Character& character = posed_character.character;
+  const SkeletonPose& pose = posed_character.pose;
+  std::vector<Float3> posed(character.mesh.vertex_count());
+  ASSERT_TRUE(SkinMesh(character.mesh, pose.skinning(), posed).ok());
+
+  BodyMapOptions bake_options;
+  bake_options.resolution = 512;
+  bake_options.layout = BodyMapLayout::kDense;
+  BodyMapPose baked_pose;
+  ASSERT_TRUE(BakeBodyMapPose(posed, character.mesh.triangles, bake_options, &baked_pose).ok());
+  BodyMapCollider baked;
+  ASSERT_TRUE(baked.Build(baked_pose).ok());
+
+  BodyMapRenderOptions options;
+  options.texel_size = baked_pose.texel_size;
+  options.epsilon = bake_options.epsilon;
+  options.grid_x = baked_pose.origin_x;
+  options.grid_y = baked_pose.origin_y;
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(character.mesh, options).ok());
+  BodyMapCollider rendered;
+  ASSERT_TRUE(renderer.Render(pose.skinning(), &rendered).ok());
+
+  // Texel (i, j) of the bake is texel (i + di, j + dj) of the render: one lattice.
+  const long di =
+      std::lround((double(baked.origin_x()) - rendered.origin_x()) / baked.texel_size());
+  const long dj =
+      std::lround((double(baked.origin_y()) - rendered.origin_y()) / baked.texel_size());
+  size_t mismatched = 0, valid = 0;
+  double max_depth = 0.0, max_angle = 0.0;
+  for (uint32_t j = 0; j < baked.height(); ++j) {
+    for (uint32_t i = 0; i < baked.width(); ++i) {
+      float bt = 0.f, bb = 0.f, rt = 0.f, rb = 0.f;
+      const bool in_bake = BodyMapColliderAccess::TexelSlab(baked, i, j, &bt, &bb);
+      const long ri = long(i) + di, rj = long(j) + dj;
+      const bool in_render =
+          ri >= 0 && rj >= 0 &&
+          BodyMapColliderAccess::TexelSlab(rendered, uint32_t(ri), uint32_t(rj), &rt, &rb);
+      if (in_bake != in_render) ++mismatched;
+      if (!(in_bake && in_render)) continue;
+      ++valid;
+      max_depth = std::max({max_depth, std::fabs(double(bt) - rt), std::fabs(double(bb) - rb)});
+      for (bool back : {false, true}) {
+        const Float3 a = BodyMapColliderAccess::TexelNormal(baked, i, j, back);
+        const Float3 b =
+            BodyMapColliderAccess::TexelNormal(rendered, uint32_t(ri), uint32_t(rj), back);
+        const double cosine = std::clamp(double(Dot(a, b)), -1.0, 1.0);
+        max_angle = std::max(max_angle, std::acos(cosine) * 180.0 / 3.14159265358979);
+      }
+    }
+  }
+  EXPECT_GT(valid, 10000u);
+  // Texel centres exactly on a silhouette edge: the bake's top-left rule against inclusive edges.
+  EXPECT_LE(mismatched, valid / 5000) << mismatched << " of " << valid;
+  EXPECT_LT(max_depth, 2e-5) << "metres";  // float against double: 3 um measured
+  EXPECT_LT(max_angle, 0.5) << "degrees";
+}
+
+INSTANTIATE_TEST_SUITE_P(Characters, OnCharacters,
                          ::testing::Values(Case{"mannequin", ""},
                                            Case{"CesiumMan", "CesiumMan/CesiumMan.glb"},
                                            Case{"Fox", "Fox/Fox.glb"},
