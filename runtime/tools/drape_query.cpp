@@ -76,40 +76,14 @@ bool ParseNumbers(const std::string& line, std::vector<double>* values, std::str
   return true;
 }
 
-bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows,
-              std::string* error) {
-  std::ifstream in(path);
-  if (!in) {
-    *error = path + ": cannot open";
-    return false;
-  }
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    std::vector<double> values;
-    std::string bad;
-    if (!ParseNumbers(line, &values, &bad)) {
-      *error = path + ":" + std::to_string(number) + ": '" + bad + "' is not a number";
-      return false;
-    }
-    if (values.empty()) continue;
-    const size_t expected = segments ? 6 : 3;
-    if (values.size() != expected) {
-      *error = path + ":" + std::to_string(number) + ": expected " + std::to_string(expected) +
-               " numbers, got " + std::to_string(values.size());
-      return false;
-    }
-    auto f = [&](size_t k) { return static_cast<float>(values[k]); };
-    Segment s{{f(0), f(1), f(2)}, {f(0), f(1), f(2)}};
-    if (segments) s.p1 = {f(3), f(4), f(5)};
-    rows->push_back(s);
-  }
-  return true;
-}
-
-// One affine 4x4 per line (row-major), exactly `joints` of them.
-bool ReadJointMatrices(const std::string& path, uint32_t joints, std::vector<drape::Mat34>* out,
-                       std::string* error) {
+// Every row of numbers in a text file with its line number ('#' starts a comment, blank rows
+// skipped), each row exactly `count` numbers; false names the file, the line and the reason.
+struct NumberRow {
+  int line;
+  std::vector<double> values;
+};
+bool ReadNumberRows(const std::string& path, size_t count, const char* what,
+                    std::vector<NumberRow>* rows, std::string* error) {
   std::ifstream in(path);
   if (!in) {
     *error = path + ": cannot open";
@@ -126,10 +100,37 @@ bool ReadJointMatrices(const std::string& path, uint32_t joints, std::vector<dra
       return false;
     }
     if (values.empty()) continue;
-    if (values.size() != 16) {
-      *error = where + "expected 16 numbers (a 4x4 matrix), got " + std::to_string(values.size());
+    if (values.size() != count) {
+      *error = where + "expected " + std::to_string(count) + " numbers" + what + ", got " +
+               std::to_string(values.size());
       return false;
     }
+    rows->push_back({number, std::move(values)});
+  }
+  return true;
+}
+
+bool ReadRows(const std::string& path, bool segments, std::vector<Segment>* rows,
+              std::string* error) {
+  std::vector<NumberRow> numbers;
+  if (!ReadNumberRows(path, segments ? 6 : 3, "", &numbers, error)) return false;
+  for (const NumberRow& row : numbers) {
+    auto f = [&](size_t k) { return static_cast<float>(row.values[k]); };
+    Segment s{{f(0), f(1), f(2)}, {f(0), f(1), f(2)}};
+    if (segments) s.p1 = {f(3), f(4), f(5)};
+    rows->push_back(s);
+  }
+  return true;
+}
+
+// One affine 4x4 per line (row-major), exactly `joints` of them.
+bool ReadJointMatrices(const std::string& path, uint32_t joints, std::vector<drape::Mat34>* out,
+                       std::string* error) {
+  std::vector<NumberRow> numbers;
+  if (!ReadNumberRows(path, 16, " (a 4x4 matrix)", &numbers, error)) return false;
+  for (const NumberRow& row : numbers) {
+    const std::vector<double>& values = row.values;
+    const std::string where = path + ":" + std::to_string(row.line) + ": ";
     drape::Mat34 m;
     for (int k = 0; k < 12; ++k) {
       if (!(std::fabs(values[k]) <= kMaxCoordinate)) {
