@@ -386,32 +386,27 @@ def lanes(doc, characters):
 
 
 def key_rows(rs):
-    """The rows of one character and pose that matter, each with why it is shown. A posed body
-    shows what changes with the pose: the cheapest passing maps and the defaults."""
+    """The rows of one character at rest that matter, each with why it is shown."""
     tags = {}
 
     def tag(r, text):
         if r:
             tags.setdefault(id(r), (r, []))[1].append(text)
 
-    posed = bool(rs[0]["posed"])
     # The fastest point that misses under half the contacts (joint spheres alone are always the
     # fastest and miss 90 % of them) and the most accurate point of the fronts.
     front = sorted((r for r in rs if r["pareto"] and not lane_variant(r)
                     and r["missed_rate"] is not None and r["missed_rate"] < 0.5),
                    key=lambda r: r["ns_per_particle_1t"])
-    if front and not posed:
+    if front:
         tag(front[0], "P")
         best = min(front, key=lambda r: (r["missed_rate"], r["penetration_p99_mm"]))
         if best is not front[0]:
             tag(best, "P")
     for r in rs:
-        # Posed, the default maps only add their cost (the cheapest passing maps show the pose).
-        if (default_maps(r) and not posed) or default_hulls(r):
+        if default_maps(r) or default_hulls(r):
             tag(r, "default")
     tag(cheapest(rs, passes), "cheapest passing")
-    if not posed:
-        tag(cheapest(rs, lambda r: r["family"] == "maps+hulls"), "maps + hulls")
     return sorted(tags.values(), key=lambda t: t[0]["ns_per_particle_1t"] or 0)
 
 
@@ -444,15 +439,15 @@ def proxy_targets(doc, proxies):
 
 def characters_table(doc, characters):
     doc.add("### Every character", "",
-            "Per character and pose: the fastest point of the Pareto fronts missing under half "
-            "the contacts and the most accurate one (P), the bake's defaults, the cheapest setting meeting the body-map target and maps "
-            "with hulls. People posed 40 % into their longest clip (full sweep): the cheapest "
-            "passing maps and the default hulls.", "",
+            "Per character at rest: the fastest point of the Pareto fronts missing under half the "
+            "contacts and the most accurate one (P), the bake's defaults and the cheapest setting "
+            "meeting the body-map target; maps with hulls and the posed bodies are in "
+            "speed_vs_error.csv.", "",
             "| character | method | setting | ns 1t / 2t | missed % | p99 mm | false % | normal "
             "p50 ° | baked | why |", "|---|---|---|---|---|---|---|---|---|---|")
     for c, rs in characters.items():
-        if rs[0]["posed"] and not rs[0]["human"]:
-            continue  # in speed_vs_error.csv
+        if rs[0]["posed"]:
+            continue  # posed bodies: "Maps that follow any pose" and speed_vs_error.csv
         name = c.replace(" posed (", ", posed (") if rs[0]["posed"] else c
         for r, why in key_rows(rs):
             doc.add(f"| {name} | {r['family']} | {r['setting']} | {ns(r['ns_per_particle_1t'])} / "

@@ -259,13 +259,27 @@ def following_maps(doc, gb, rows):
         for prefix, label in kinds:
             if r["setting"].startswith(prefix):
                 table.setdefault(r["base"], {})[label] = r
-    if not table and "bench_following_maps" not in gb:
+    p = "bench_following_maps"
+    if not table and p not in gb:
         return
+    costs = ""
+    if p in gb:
+        render = {(region, t): value(gb, p, "BM_RenderMaps", (region, t), "real_time")
+                  for region in (0, 1) for t in (1, 2)}
+        ms = lambda v: "–" if v is None else f"{v:.1f}"  # noqa: E731
+        costs = (f" `{p}` on the mannequin walking: rendering one pose's maps at 1.7 mm texels "
+                 f"takes {ms(render[(0, 1)])} / {ms(render[(0, 2)])} ms for the whole body and "
+                 f"{ms(render[(1, 1)])} / {ms(render[(1, 2)])} ms for a skirt's reach (1 / 2 "
+                 "threads); the batch of 10k particles near the body costs "
+                 f"{ns(value(gb, p, 'BM_RenderedMapsBatch', (1,)))} / "
+                 f"{ns(value(gb, p, 'BM_RenderedMapsBatch', (2,)))} ns per particle on the "
+                 f"rendered maps and {ns(value(gb, p, 'BM_BoneMapsBatch', (1,)))} / "
+                 f"{ns(value(gb, p, 'BM_BoneMapsBatch', (2,)))} on the bone maps.")
     doc.add("## Maps that follow any pose", "",
             "At each character's first measured pose (a clip time between keys, which no default "
             "bake holds): missed % / penetration p99 mm / ns per particle (1 thread). Rendered: "
             "`BodyMapRenderer` at the rest maps' texel, whole body; bone maps: `BoneMapCollider` "
-            "at the automatic texel (the rest pose's size / 600), 3 layers.", "",
+            "at the automatic texel (the rest pose's size / 600), 3 layers." + costs, "",
             "| character | " + " | ".join(label for _, label in kinds) + " |",
             "|---|---|---|---|")
     for character, by_kind in table.items():
@@ -276,20 +290,4 @@ def following_maps(doc, gb, rows):
                          f"{100 * r['missed_rate']:.2f} / {r['penetration_p99_mm']:.1f} / "
                          f"{ns(r['ns_per_particle_1t'])}")
         doc.add(f"| {character} | " + " | ".join(cells) + " |")
-    if table:
-        doc.source("speed against error, posed bodies")
-    p = "bench_following_maps"
-    if p not in gb:
-        return
-    render = {(region, t): value(gb, p, "BM_RenderMaps", (region, t), "real_time")
-              for region in (0, 1) for t in (1, 2)}
-    ms = lambda v: "–" if v is None else f"{v:.1f}"  # noqa: E731
-    doc.add("", "`bench_following_maps` on the mannequin walking: rendering one pose's maps at "
-            f"1.7 mm texels takes {ms(render[(0, 1)])} / {ms(render[(0, 2)])} ms for the whole "
-            f"body and {ms(render[(1, 1)])} / {ms(render[(1, 2)])} ms for a skirt's reach (1 / 2 "
-            "threads); the batch of 10k particles near the body costs "
-            f"{ns(value(gb, p, 'BM_RenderedMapsBatch', (1,)))} / "
-            f"{ns(value(gb, p, 'BM_RenderedMapsBatch', (2,)))} ns per particle on the rendered "
-            f"maps and {ns(value(gb, p, 'BM_BoneMapsBatch', (1,)))} / "
-            f"{ns(value(gb, p, 'BM_BoneMapsBatch', (2,)))} on the bone maps.")
-    doc.source(p)
+    doc.source("speed against error, posed bodies" + (f"; {p}" if costs else ""))
