@@ -10,6 +10,7 @@
 #include <string>
 
 #include "drape/bake/regions.h"
+#include "drape/runtime/math.h"
 
 namespace drape::bake {
 namespace {
@@ -146,15 +147,6 @@ Mat34 ToMat34(const Eigen::Matrix3d& frame, const Eigen::Vector3d& centre) {
   return m;
 }
 
-// The uniform scale of a skinning matrix: the cube root of its linear part's |determinant|.
-double UniformScale(const Mat34& m) {
-  const double det = double(m.m[0]) * (double(m.m[5]) * m.m[10] - double(m.m[6]) * m.m[9]) -
-                     double(m.m[1]) * (double(m.m[4]) * m.m[10] - double(m.m[6]) * m.m[8]) +
-                     double(m.m[2]) * (double(m.m[4]) * m.m[9] - double(m.m[5]) * m.m[8]);
-  const double scale = std::cbrt(std::fabs(det));
-  return std::isfinite(scale) && scale > 1e-6 && scale < 1e6 ? scale : 1.0;
-}
-
 }  // namespace
 
 float AutomaticBoneMapTexel(std::span<const Float3> rest_positions) {
@@ -190,7 +182,8 @@ Status BakeBoneMaps(const MeshData& mesh, const SkeletonData& skeleton,
     ViewFrame(mesh, part, &centre, &frame, &facing);
     // Texel and epsilon in the bind frame, so that they are the options' on the posed body.
     BoneMapOptions bind_options = options;
-    const double scale = j < rest_skinning.size() ? UniformScale(rest_skinning[j]) : 1.0;
+    double scale = j < rest_skinning.size() ? UniformScale(rest_skinning[j]) : 1.0;
+    if (!(scale > 1e-6 && scale < 1e6)) scale = 1.0;  // a degenerate or hostile matrix
     bind_options.texel_size = static_cast<float>(options.texel_size / scale);
     bind_options.epsilon = static_cast<float>(options.epsilon / scale);
     PartMesh(mesh, part, frame, centre, &positions, &triangles);

@@ -24,15 +24,6 @@ Float3 Max(Float3 a, Float3 b) {
   return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
 
-// The cube root of the linear part's |determinant|: 1 for the rigid motion of a bone, 100 for a
-// rig bound in centimetres and posed in metres.
-float UniformScale(const Mat34& m) {
-  const double det = double(m.m[0]) * (double(m.m[5]) * m.m[10] - double(m.m[6]) * m.m[9]) -
-                     double(m.m[1]) * (double(m.m[4]) * m.m[10] - double(m.m[6]) * m.m[8]) +
-                     double(m.m[2]) * (double(m.m[4]) * m.m[9] - double(m.m[5]) * m.m[8]);
-  return static_cast<float>(std::cbrt(std::fabs(det)));
-}
-
 bool Finite(const Mat34& m) {
   for (float v : m.m)
     if (!std::isfinite(v)) return false;

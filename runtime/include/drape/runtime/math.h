@@ -72,6 +72,14 @@ inline Float3 TransformVectorTransposed(const Mat34& m, Float3 v) {
   return {m.m[0] * v.x + m.m[4] * v.y + m.m[8] * v.z, m.m[1] * v.x + m.m[5] * v.y + m.m[9] * v.z,
           m.m[2] * v.x + m.m[6] * v.y + m.m[10] * v.z};
 }
+// The cube root of the linear part's |determinant|: 1 for a rigid motion, 100 for a rig bound
+// in centimetres and posed in metres.
+inline float UniformScale(const Mat34& m) {
+  const double det = double(m.m[0]) * (double(m.m[5]) * m.m[10] - double(m.m[6]) * m.m[9]) -
+                     double(m.m[1]) * (double(m.m[4]) * m.m[10] - double(m.m[6]) * m.m[8]) +
+                     double(m.m[2]) * (double(m.m[4]) * m.m[9] - double(m.m[5]) * m.m[8]);
+  return static_cast<float>(std::cbrt(std::fabs(det)));
+}
 inline Mat34 Multiply(const Mat34& a, const Mat34& b) {
   Mat34 r;
   for (int row = 0; row < 3; ++row) {
