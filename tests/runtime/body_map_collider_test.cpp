@@ -255,6 +255,7 @@ TEST(BodyMapCollider, ResponseFollowsPaperEquation5) {
   params.friction = 0.3f;
   params.restitution = 0.5f;
   params.separation = 1e-4f;
+  params.friction_model = FrictionModel::kPaperA;
   // 0: falls onto the top. 1: same motion but a separating velocity (+z). 2: free, untouched.
   // 3: NaN position. 4: infinite velocity.
   const float nan = std::numeric_limits<float>::quiet_NaN();

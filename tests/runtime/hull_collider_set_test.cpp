@@ -299,6 +299,7 @@ TEST(HullColliderTest, FastParticleCrossingAThinBoxIsCaught) {
     ResponseParams params;
     params.friction = 0.f;
     params.separation = 1e-4f;
+    params.friction_model = FrictionModel::kPaperA;  // frictionless: the tangential part kept
     uint32_t contacts = 0;
     ASSERT_TRUE(
         set.CollideBatch(previous, positions, velocities, flags, params, 0.f, 1.f, &contacts).ok());
@@ -371,6 +372,7 @@ TEST(HullColliderTest, JointSpherePushOutAndContinuousSegment) {
   const JointSphereData sphere{0, -1, {0.f, 1.f, 0.f}, 0.1f};
   HullColliderSet set = BuildSet({}, {sphere}, 1);
   ResponseParams params;
+  params.friction_model = FrictionModel::kPaperA;  // frictionless: the tangential velocity kept
   params.separation = 1e-4f;
   params.friction = 0.f;
   // Resting particle inside: radial push-out.
@@ -694,6 +696,7 @@ TEST(HullColliderTest, ResponseAppliesFrictionAndRestitutionOnlyWhenApproaching)
   params.friction = 0.25f;
   params.restitution = 0.5f;
   params.separation = 0.f;
+  params.friction_model = FrictionModel::kPaperA;
   std::vector<Float3> previous = {{0.f, 0.2f, 0.f}, {0.05f, 0.05f, 0.f}};
   std::vector<Float3> positions = {{0.02f, 0.09f, 0.f}, {0.05f, 0.09f, 0.f}};
   std::vector<Float3> velocities = {{1.f, -2.f, 0.f}, {1.f, 2.f, 0.f}};  // approaching, separating

@@ -114,10 +114,11 @@ Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span
                       ", velocities " + std::to_string(velocities.size()) + ", flags " +
                       std::to_string(flags.size()) + ")");
   }
-  if (!std::isfinite(params.friction) || !std::isfinite(params.restitution) ||
-      !std::isfinite(params.separation)) {
+  if (!ValidResponse(params)) {
     return Status(StatusCode::kInvalidArgument,
-                  "BodyMapCollider::CollideBatch: response parameters must be finite");
+                  "BodyMapCollider::CollideBatch: response parameters out of range"
+                  " (friction in [0, 1], static_friction in [0, 4], restitution in [0, 1], "
+                  "separation finite and >= 0)");
   }
   if (empty()) {
     return Status(StatusCode::kInvalidState, "BodyMapCollider::CollideBatch: collider not built");

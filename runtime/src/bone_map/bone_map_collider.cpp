@@ -184,10 +184,11 @@ Status BoneMapCollider::CollideBatch(std::span<const Float3> previous, std::span
     return Status(StatusCode::kInvalidArgument,
                   "BoneMapCollider::CollideBatch: spans of different sizes");
   }
-  if (!std::isfinite(params.friction) || !std::isfinite(params.restitution) ||
-      !std::isfinite(params.separation)) {
+  if (!ValidResponse(params)) {
     return Status(StatusCode::kInvalidArgument,
-                  "BoneMapCollider::CollideBatch: response parameters not finite");
+                  "BoneMapCollider::CollideBatch: response parameters out of range"
+                  " (friction in [0, 1], static_friction in [0, 4], restitution in [0, 1], "
+                  "separation finite and >= 0)");
   }
   uint32_t contacts = 0;
   const int64_t count = static_cast<int64_t>(n);

@@ -54,12 +54,11 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
     return Status(
         StatusCode::kInvalidArgument,
         "HullColliderSet::CollideBatch: previous, positions, velocities and flags differ in size");
-  if (!(std::isfinite(params.friction) && params.friction >= 0.f && params.friction <= 1.f &&
-        std::isfinite(params.restitution) && params.restitution >= 0.f &&
-        params.restitution <= 1.f && std::isfinite(params.separation) && params.separation >= 0.f))
-    return Status(
-        StatusCode::kInvalidArgument,
-        "HullColliderSet::CollideBatch: friction/restitution not in [0, 1] or separation < 0");
+  if (!ValidResponse(params))
+    return Status(StatusCode::kInvalidArgument,
+                  "HullColliderSet::CollideBatch: response parameters out of range"
+                  " (friction in [0, 1], static_friction in [0, 4], restitution in [0, 1], "
+                  "separation finite and >= 0)");
   if (!(substep_start >= 0.f && substep_start <= substep_end && substep_end <= 1.f))
     return Status(StatusCode::kInvalidArgument,
                   "HullColliderSet::CollideBatch: substep fractions are not 0 <= s0 <= s1 <= 1");

@@ -196,15 +196,29 @@ template <class P>
   const Lanes3<P> position = {place(point.x, normal.x, p.x), place(point.y, normal.y, p.y),
                               place(point.z, normal.z, p.z)};
   const F vn = Add(Add(Mul(v.x, normal.x), Mul(v.y, normal.y)), Mul(v.z, normal.z));
-  const F keep = P::Splat(1.f - params.friction);
   const F restitution = P::Splat(params.restitution);
   const F into = And(in_contact, Less(vn, zero));
-  const auto respond = [&](F velocity, F n) {
-    const F normal_part = Mul(n, vn);
-    const F changed = Sub(Mul(Sub(velocity, normal_part), keep), Mul(normal_part, restitution));
+  const Lanes3<P> tangential = {Sub(v.x, Mul(normal.x, vn)), Sub(v.y, Mul(normal.y, vn)),
+                                Sub(v.z, Mul(normal.z, vn))};
+  // TangentialKeep lane by lane, in the same operations (the scalar path gives the same bits).
+  F keep = P::Splat(1.f - params.friction);
+  if (params.friction_model == FrictionModel::kCoulomb) {
+    const F speed_into = Sub(zero, vn);
+    const F squared = Add(Add(Mul(tangential.x, tangential.x), Mul(tangential.y, tangential.y)),
+                          Mul(tangential.z, tangential.z));
+    const F stick_speed = Mul(P::Splat(params.static_friction), speed_into);
+    const F sticks = GreaterEq(Mul(stick_speed, stick_speed), squared);
+    const F slide =
+        Sub(P::Splat(1.f), Div(Mul(P::Splat(params.friction), speed_into), Sqrt(squared)));
+    keep = SelectLanes(sticks, zero, SelectLanes(Greater(slide, zero), slide, zero));
+  }
+  const auto respond = [&](F velocity, F t, F n) {
+    const F changed = Sub(Mul(t, keep), Mul(Mul(n, vn), restitution));
     return SelectLanes(into, changed, velocity);
   };
-  return {position, {respond(v.x, normal.x), respond(v.y, normal.y), respond(v.z, normal.z)}};
+  return {position,
+          {respond(v.x, tangential.x, normal.x), respond(v.y, tangential.y, normal.y),
+           respond(v.z, tangential.z, normal.z)}};
 }
 
 // Byte l of the result is bit l of `bits` (l < 8): a copy of the eight bits in every byte
