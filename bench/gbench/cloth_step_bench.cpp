@@ -2,7 +2,9 @@
 // the hips) on a walking pair of legs made of 20 colliders (4 box hulls: thighs and shins; 16
 // joint spheres: hips, belly, thighs, knees, shins), with continuous collision and friction.
 // Arguments: OpenMP threads, substeps, colliders on (1) or off (0: the solver alone, the skirt
-// then falls freely below its waistband); 5 spring-correction iterations per substep (Verlet).
+// then falls freely below its waistband), engine defaults (1: long-range tethers and the 10 %
+// strain limit; 0: paper B's solver); 5 spring-correction iterations per substep (Verlet).
+// max_stretch_pct: the worst stretch spring over the timed frames.
 // BM_BulletSkirt is the peer: Bullet's soft body (bench/peers) on the same skirt
 // mesh, masses and waistband, against the same 4 boxes (btConvexHullShape of their 8 corners)
 // and 16 spheres posed by the same walk, 5 position iterations per substep, single-threaded.
@@ -24,6 +26,7 @@
 #include <vector>
 
 #include "bullet_cloth_peer.h"
+#include "walking_legs.h"
 
 #include "drape/formats/hull_collider_data.h"
 #include "drape/runtime/cloth.h"
@@ -35,122 +38,26 @@
 namespace drape {
 namespace {
 
+using test::kJoints;
+using test::Penetration;
+using test::WalkPose;
 constexpr float kFrame = 1.f / 60.f;
-constexpr int kJoints = 5;  // 0 hips, 1 left thigh, 2 right thigh, 3 left shin, 4 right shin
-constexpr float kHipY = 0.95f, kKneeY = 0.52f, kLegX = 0.09f;
-
-// An axis-aligned box hull (bind frame = asset frame) carried by `joint`.
-HullColliderData BoxHull(int32_t joint, Float3 center, Float3 half) {
-  HullColliderData h;
-  h.joint = joint;
-  for (int k = 0; k < 8; ++k) {
-    h.vertices.push_back({center.x + ((k & 1) ? half.x : -half.x),
-                          center.y + ((k & 2) ? half.y : -half.y),
-                          center.z + ((k & 4) ? half.z : -half.z)});
-  }
-  // Faces (-x, +x, -y, +y, -z, +z) as quads counter-clockwise seen from outside.
-  const uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
-  const Float3 normals[6] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
-  for (uint32_t f = 0; f < 6; ++f) {
-    const uint32_t* q = quads[f];
-    h.triangles.insert(h.triangles.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-    h.triangle_planes.insert(h.triangle_planes.end(), {f, f});
-    Plane plane;
-    plane.normal = normals[f];
-    plane.offset = Dot(plane.normal, h.vertices[q[0]]);
-    h.planes.push_back(plane);
-  }
-  h.obb.center = center;
-  h.obb.axes[0] = {1.f, 0.f, 0.f};
-  h.obb.axes[1] = {0.f, 1.f, 0.f};
-  h.obb.axes[2] = {0.f, 0.f, 1.f};
-  h.obb.half_extents = half;
-  h.projection_axis = {0.f, 1.f, 0.f};
-  h.projection_u = {0.f, 0.f, 1.f};
-  h.projection_v = {1.f, 0.f, 0.f};
-  return h;
-}
-
-// Rotation about +x by `angle` radians about the point `pivot`.
-Mat34 RotateXAbout(float angle, Float3 pivot) {
-  Mat34 r;
-  const float c = std::cos(angle), s = std::sin(angle);
-  r.m[5] = c;
-  r.m[6] = -s;
-  r.m[9] = s;
-  r.m[10] = c;
-  const Float3 moved = TransformVector(r, pivot);
-  r.m[3] = pivot.x - moved.x;
-  r.m[7] = pivot.y - moved.y;
-  r.m[11] = pivot.z - moved.z;
-  return r;
-}
-
-// A walk cycle at 1 Hz: the thighs swing +-0.45 rad in antiphase, the shins bend back up to
-// 0.6 rad; the hips move forward at 1.2 m/s and bob by 1 cm.
-void WalkPose(float t, Mat34 skinning[kJoints]) {
-  const float phase = 2.f * std::numbers::pi_v<float> * t;
-  Mat34 hips;
-  hips.m[7] = 0.01f * std::sin(2.f * phase);
-  hips.m[11] = 1.2f * t;
-  skinning[0] = hips;
-  for (int side = 0; side < 2; ++side) {
-    const float sign = side == 0 ? 1.f : -1.f;
-    const float swing = 0.45f * sign * std::sin(phase);
-    const float bend =
-        0.3f * (1.f - std::cos(phase + (side == 0 ? 0.f : std::numbers::pi_v<float>)));
-    const Float3 hip{sign * kLegX, kHipY, 0.f}, knee{sign * kLegX, kKneeY, 0.f};
-    const Mat34 thigh = Multiply(hips, RotateXAbout(-swing, hip));
-    skinning[1 + side] = thigh;
-    skinning[3 + side] = Multiply(thigh, RotateXAbout(bend, knee));
-  }
-}
-
 struct Scene {
   Cloth cloth;
   HullColliderSet hulls;
   size_t collider_count = 0;
-  GarmentMesh mesh;                      // the skirt the cloth was built from (for the peer)
-  std::vector<HullColliderData> boxes;   // the colliders in their bind frame (for the peer and
-  std::vector<JointSphereData> spheres;  // the penetration measure)
+  GarmentMesh mesh;  // the skirt the cloth was built from (for the peer)
+  // The colliders in their bind frame (for the peer and the penetration measure).
+  test::WalkingLegs legs = test::MakeWalkingLegs();
 
   Scene() {
-    const auto sphere = [&](int32_t joint, Float3 c, float r) {
-      JointSphereData s;
-      s.joint = joint;
-      s.center = c;
-      s.radius = r;
-      spheres.push_back(s);
-    };
-    sphere(0, {0.f, kHipY, 0.f}, 0.15f);
-    sphere(0, {0.f, kHipY + 0.12f, 0.03f}, 0.14f);
-    for (int side = 0; side < 2; ++side) {
-      const float x = (side == 0 ? 1.f : -1.f) * kLegX;
-      boxes.push_back(BoxHull(1 + side, {x, (kHipY + kKneeY) * 0.5f, 0.f}, {0.06f, 0.2f, 0.06f}));
-      boxes.push_back(BoxHull(3 + side, {x, kKneeY - 0.22f, 0.f}, {0.045f, 0.2f, 0.045f}));
-      for (int k = 0; k < 3; ++k) {
-        const float kf = static_cast<float>(k);
-        const float f = (kf + 1.f) / 4.f;
-        sphere(1 + side, {x, kHipY + (kKneeY - kHipY) * f, 0.f}, 0.085f - 0.01f * kf);
-        sphere(3 + side, {x, kKneeY - 0.4f * f, 0.f}, 0.06f - 0.005f * kf);
-      }
-      sphere(3 + side, {x, kKneeY, 0.f}, 0.065f);
-    }
-    collider_count = boxes.size() + spheres.size();
-    Status s = hulls.Build(boxes, spheres, kJoints);
+    collider_count = legs.size();
+    Status s = hulls.Build(legs.boxes, legs.spheres, kJoints);
     if (!s.ok()) {
       std::fprintf(stderr, "hulls: %s\n", s.message().c_str());
       std::abort();
     }
-    SkirtShape shape;
-    shape.top_center = {0.f, kHipY + 0.05f, 0.f};
-    shape.top_radius = 0.17f;
-    shape.bottom_radius = 0.36f;
-    shape.length = 0.6f;
-    shape.segments = 100;
-    shape.rings = 100;
-    if (!MakeSkirt(shape, &mesh).ok()) std::abort();
+    if (!MakeSkirt(test::WalkingSkirt(0.6f, 100, 100), &mesh).ok()) std::abort();
     ClothDescription d = DescribeAttachedGarment(mesh, 0);
     s = BuildCloth(d, &cloth);
     if (!s.ok()) {
@@ -163,42 +70,6 @@ struct Scene {
 Scene& GetScene() {
   static Scene scene;
   return scene;
-}
-
-// Penetration of the particles into the posed boxes and spheres (the colliders themselves, not
-// the solvers' margins): the deepest particle (metres, 0 when none is inside) and how many are
-// inside any collider. Brute force over particles x colliders (about 1 ms for the skirt).
-struct Penetration {
-  float max_depth = 0.f;
-  uint32_t inside = 0;
-};
-Penetration MeasurePenetration(const Scene& scene, const Mat34 skinning[kJoints],
-                               std::span<const Float3> positions) {
-  std::vector<Mat34> box_inverse;  // world -> box frame
-  for (const HullColliderData& box : scene.boxes)
-    box_inverse.push_back(InverseRigid(Multiply(skinning[box.joint], box.bind_frame)));
-  std::vector<Float3> sphere_centres;
-  for (const JointSphereData& sphere : scene.spheres)
-    sphere_centres.push_back(TransformPoint(skinning[sphere.joint], sphere.center));
-  Penetration result;
-  for (const Float3 p : positions) {
-    float depth = 0.f;  // deepest over the colliders containing p
-    for (size_t b = 0; b < scene.boxes.size(); ++b) {
-      const Obb& obb = scene.boxes[b].obb;  // axis-aligned in the box frame (BoxHull)
-      const Float3 q = TransformPoint(box_inverse[b], p) - obb.center;
-      const float inside_by =
-          std::min({obb.half_extents.x - std::abs(q.x), obb.half_extents.y - std::abs(q.y),
-                    obb.half_extents.z - std::abs(q.z)});
-      depth = std::max(depth, inside_by);
-    }
-    for (size_t s = 0; s < scene.spheres.size(); ++s)
-      depth = std::max(depth, scene.spheres[s].radius - Length(p - sphere_centres[s]));
-    if (depth > 0.f) {
-      ++result.inside;
-      result.max_depth = std::max(result.max_depth, depth);
-    }
-  }
-  return result;
 }
 
 // Accumulates Penetration over the timed frames and writes the counters.
@@ -228,6 +99,11 @@ void BM_ClothStep(benchmark::State& state) {
   settings.iterations = 5;
   settings.substeps = static_cast<uint32_t>(state.range(1));
   settings.damping = 0.2f;
+  if (state.range(3) != 0) {
+    const ClothSolverSettings engine;
+    settings.tethers = engine.tethers;
+    settings.max_stretch = engine.max_stretch;
+  }
   ClothSolver solver;
   if (!solver.Init(scene.cloth, settings).ok()) std::abort();
   ClothState cloth_state;
@@ -242,6 +118,7 @@ void BM_ClothStep(benchmark::State& state) {
   frame.skinning_end = end;
   int step = 0;
   uint64_t contacts = 0;
+  float worst_stretch = 0.f;
   const auto advance = [&]() {
     WalkPose(static_cast<float>(step) * kFrame, start);
     WalkPose(static_cast<float>(step + 1) * kFrame, end);
@@ -252,35 +129,41 @@ void BM_ClothStep(benchmark::State& state) {
       return false;
     }
     contacts += stats.contacts;
+    worst_stretch = std::max(worst_stretch, stats.max_stretch);
     ++step;
     return true;
   };
   for (int warm = 0; warm < 60; ++warm)
     if (!advance()) return;  // one second: the skirt settles onto the legs
   contacts = 0;
+  worst_stretch = 0.f;
   int timed = 0;
   PenetrationCounters penetration;
   for (auto _ : state) {
     if (!advance()) return;
     ++timed;
     state.PauseTiming();
-    penetration.Add(MeasurePenetration(scene, end, cloth_state.positions));
+    penetration.Add(test::MeasurePenetration(scene.legs, end, cloth_state.positions));
     state.ResumeTiming();
   }
   state.counters["particles"] = static_cast<double>(scene.cloth.particle_count());
   state.counters["springs"] = static_cast<double>(scene.cloth.springs().size());
   state.counters["colliders"] = static_cast<double>(scene.collider_count);
   state.counters["contacts_per_frame"] = timed > 0 ? static_cast<double>(contacts) / timed : 0.0;
+  state.counters["max_stretch_pct"] = 100.0 * worst_stretch;
   penetration.Report(state);
 }
 BENCHMARK(BM_ClothStep)
-    ->ArgNames({"omp_threads", "substeps", "colliders"})
-    ->Args({1, 1, 1})
-    ->Args({2, 1, 1})
-    ->Args({1, 2, 1})
-    ->Args({2, 2, 1})
-    ->Args({1, 1, 0})
-    ->Args({2, 1, 0})
+    ->ArgNames({"omp_threads", "substeps", "colliders", "engine"})
+    ->Args({1, 1, 1, 0})
+    ->Args({2, 1, 1, 0})
+    ->Args({1, 2, 1, 0})
+    ->Args({2, 2, 1, 0})
+    ->Args({1, 1, 0, 0})
+    ->Args({2, 1, 0, 0})
+    ->Args({1, 1, 1, 1})
+    ->Args({2, 1, 1, 1})
+    ->Args({1, 1, 0, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -305,9 +188,9 @@ void BM_BulletSkirt(benchmark::State& state) {
   setup.stretch_stiffness = scene.cloth.material(SpringKind::kStretch).correction;
   setup.bend_stiffness = scene.cloth.material(SpringKind::kBend).correction;
   std::vector<peers::BulletHullShape> hulls;
-  for (const HullColliderData& box : scene.boxes) hulls.push_back({box.vertices});
+  for (const HullColliderData& box : scene.legs.boxes) hulls.push_back({box.vertices});
   std::vector<float> radii;
-  for (const JointSphereData& sphere : scene.spheres) radii.push_back(sphere.radius);
+  for (const JointSphereData& sphere : scene.legs.spheres) radii.push_back(sphere.radius);
   peers::BulletClothPeer peer;
   Status s = peer.Build(setup, hulls, radii);
   if (!s.ok()) {
@@ -322,15 +205,16 @@ void BM_BulletSkirt(benchmark::State& state) {
     return;
   }
   Mat34 skinning[kJoints];
-  std::vector<Mat34> hull_world(scene.boxes.size());
-  std::vector<Float3> sphere_centres(scene.spheres.size()), targets(attachments.size());
+  std::vector<Mat34> hull_world(scene.legs.boxes.size());
+  std::vector<Float3> sphere_centres(scene.legs.spheres.size()), targets(attachments.size());
   std::vector<Float3> positions(peer.particle_count());
   const auto pose = [&](int frame) {
     WalkPose(static_cast<float>(frame) * kFrame, skinning);
-    for (size_t b = 0; b < scene.boxes.size(); ++b)
-      hull_world[b] = Multiply(skinning[scene.boxes[b].joint], scene.boxes[b].bind_frame);
-    for (size_t c = 0; c < scene.spheres.size(); ++c)
-      sphere_centres[c] = TransformPoint(skinning[scene.spheres[c].joint], scene.spheres[c].center);
+    for (size_t b = 0; b < scene.legs.boxes.size(); ++b)
+      hull_world[b] = Multiply(skinning[scene.legs.boxes[b].joint], scene.legs.boxes[b].bind_frame);
+    for (size_t c = 0; c < scene.legs.spheres.size(); ++c)
+      sphere_centres[c] =
+          TransformPoint(skinning[scene.legs.spheres[c].joint], scene.legs.spheres[c].center);
     for (size_t a = 0; a < attachments.size(); ++a)
       targets[a] = TransformPoint(skinning[attachments[a].joint], attachments[a].bind_position);
   };
@@ -363,7 +247,7 @@ void BM_BulletSkirt(benchmark::State& state) {
     ++timed;
     state.PauseTiming();
     peer.CopyPositions(positions);
-    penetration.Add(MeasurePenetration(scene, skinning, positions));
+    penetration.Add(test::MeasurePenetration(scene.legs, skinning, positions));
     state.ResumeTiming();
   }
   state.counters["particles"] = static_cast<double>(peer.particle_count());

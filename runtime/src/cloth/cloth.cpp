@@ -1,5 +1,6 @@
 #include "drape/runtime/cloth.h"
 
+#include "cloth/cloth_setup.h"
 #include "cloth/spring_colouring.h"
 
 #include <algorithm>
@@ -97,10 +98,74 @@ size_t Cloth::memory_bytes() const {
          (masses_.capacity() + inverse_masses_.capacity() + areas_.capacity()) * sizeof(float) +
          triangles_.capacity() * sizeof(uint32_t) + springs_.capacity() * sizeof(ClothSpring) +
          colours_.capacity() * sizeof(SpringColour) + kinematic_.capacity() * sizeof(uint32_t) +
-         attachments_.capacity() * sizeof(ClothAttachment);
+         attachments_.capacity() * sizeof(ClothAttachment) +
+         tethers_.capacity() * sizeof(ClothTether) + skin_.capacity() * sizeof(ClothSkinWeights) +
+         (rest_normals_.capacity() + skin_bind_.capacity()) * sizeof(Float3) +
+         (max_distance_.capacity() + backstop_.capacity()) * sizeof(float) +
+         constrained_.capacity() * sizeof(uint32_t);
 }
 
 namespace {
+
+// A per-particle array: empty or n values, each not NaN and >= 0 (finite unless allow_inf).
+Status ValidatePerParticle(const std::vector<float>& values, uint32_t n, const char* name,
+                           const char* unit, bool allow_inf) {
+  if (values.empty()) return Status::Ok();
+  if (values.size() != n)
+    return Invalid(std::string(name) + " has " + std::to_string(values.size()) + " entries for " +
+                   std::to_string(n) + " particles");
+  for (uint32_t i = 0; i < n; ++i) {
+    const float v = values[i];
+    if (!(v >= 0.f) || (!allow_inf && !std::isfinite(v)))
+      return Invalid(std::string(name) + "[" + std::to_string(i) + "] = " + std::to_string(v) +
+                     unit + ": must be " + (allow_inf ? ">= 0" : "finite and >= 0"));
+  }
+  return Status::Ok();
+}
+
+Status ValidateTethers(const ClothDescription& d, uint32_t n) {
+  if (!std::isfinite(d.tether_stretch) || d.tether_stretch < 0.f)
+    return Invalid("tether_stretch = " + std::to_string(d.tether_stretch) +
+                   ": must be finite and >= 0");
+  return ValidatePerParticle(d.tether_stretch_per_particle, n, "tether_stretch_per_particle", "",
+                             false);
+}
+
+Status ValidateSkin(const ClothDescription& d, uint32_t n) {
+  if (d.skin.empty()) {
+    if (!d.max_distance.empty() || !d.backstop.empty())
+      return Invalid("max_distance and backstop need skin weights (skin is empty)");
+    return Status::Ok();
+  }
+  if (d.skin.size() != n)
+    return Invalid("skin has " + std::to_string(d.skin.size()) + " entries for " +
+                   std::to_string(n) + " particles");
+  for (uint32_t i = 0; i < n; ++i) {
+    float sum = 0.f;
+    for (int k = 0; k < 4; ++k) {
+      const float w = d.skin[i].weights[k];
+      if (!std::isfinite(w) || w < 0.f)
+        return Invalid("skin[" + std::to_string(i) + "].weights[" + std::to_string(k) +
+                       "] = " + std::to_string(w) + ": must be finite and >= 0");
+      if (w > 0.f && d.skin[i].joints[k] >= (1u << 16))
+        return Invalid("skin[" + std::to_string(i) + "].joints[" + std::to_string(k) +
+                       "] = " + std::to_string(d.skin[i].joints[k]) + ": at most 65535");
+      sum += w;
+    }
+    if (!(sum > 0.f)) return Invalid("skin[" + std::to_string(i) + "]: the weights sum to 0");
+  }
+  if (!d.skin_bind_positions.empty()) {
+    if (d.skin_bind_positions.size() != n)
+      return Invalid("skin_bind_positions has " + std::to_string(d.skin_bind_positions.size()) +
+                     " entries for " + std::to_string(n) + " particles");
+    for (uint32_t i = 0; i < n; ++i)
+      if (!IsFinite(d.skin_bind_positions[i]))
+        return Invalid("skin_bind_positions[" + std::to_string(i) + "] is not finite");
+  }
+  if (Status s = ValidatePerParticle(d.max_distance, n, "max_distance", " m", true); !s.ok())
+    return s;
+  return ValidatePerParticle(d.backstop, n, "backstop", " m", true);
+}
 
 // Every count, index and value of the description (the messages name the field).
 Status ValidateDescription(const ClothDescription& d) {
@@ -159,7 +224,8 @@ Status ValidateDescription(const ClothDescription& d) {
   }
   if (Status s = ValidateMaterial(d.stretch, "stretch"); !s.ok()) return s;
   if (Status s = ValidateMaterial(d.bend, "bend"); !s.ok()) return s;
-  return Status::Ok();
+  if (Status s = ValidateTethers(d, n); !s.ok()) return s;
+  return ValidateSkin(d, n);
 }
 
 }  // namespace
@@ -217,6 +283,9 @@ struct Cloth::Builder {
       kinematic[a.particle] = 1;
       c.required_joints_ = std::max(c.required_joints_, static_cast<uint32_t>(a.joint) + 1);
     }
+    // A skinned particle with max distance 0 is placed at its skinned position.
+    for (size_t i = 0; i < d.max_distance.size(); ++i)
+      if (d.max_distance[i] == 0.f) kinematic[i] = 1;
 
     return Status::Ok();
   }
@@ -326,6 +395,43 @@ struct Cloth::Builder {
     report.bend_colours = ColourSprings(bend, SpringKind::kBend, n, &c.springs_, &c.colours_);
   }
 
+  // Skin weights (renormalised, zero weights' joints set to 0), rest normals, max distances and
+  // backstops (+inf where not given), the particles they constrain, and the joints they need.
+  static void Skin(const ClothDescription& d, uint32_t n, const std::vector<uint8_t>& kinematic,
+                   Cloth* cloth) {
+    Cloth& c = *cloth;
+    if (d.skin.empty()) return;
+    c.skin_ = d.skin;
+    for (ClothSkinWeights& w : c.skin_) {
+      const float sum = w.weights[0] + w.weights[1] + w.weights[2] + w.weights[3];
+      for (int k = 0; k < 4; ++k) {
+        w.weights[k] /= sum;
+        if (w.weights[k] == 0.f) w.joints[k] = 0;
+        c.required_joints_ = std::max(c.required_joints_, w.joints[k] + 1);
+      }
+    }
+    c.skin_bind_ = d.skin_bind_positions.empty() ? d.positions : d.skin_bind_positions;
+    c.rest_normals_ = detail::VertexNormals(c.skin_bind_, c.triangles_);
+    constexpr float kUnlimited = std::numeric_limits<float>::infinity();
+    c.max_distance_ = d.max_distance.empty() ? std::vector<float>(n, kUnlimited) : d.max_distance;
+    c.backstop_ = d.backstop.empty() ? std::vector<float>(n, kUnlimited) : d.backstop;
+    for (uint32_t i = 0; i < n; ++i) {
+      if (kinematic[i]) continue;
+      if (std::isfinite(c.max_distance_[i]) || std::isfinite(c.backstop_[i]))
+        c.constrained_.push_back(i);
+    }
+  }
+
+  static void Tethers(const ClothDescription& d, const std::vector<uint8_t>& kinematic,
+                      Cloth* cloth) {
+    Cloth& c = *cloth;
+    if (!d.tethers) return;
+    c.tethers_ =
+        detail::BuildTethers(d.positions, c.triangles_, kinematic, d.tether_stretch_per_particle,
+                             d.tether_stretch, &c.report_.untethered_particles);
+    c.report_.tethers = static_cast<uint32_t>(c.tethers_.size());
+  }
+
   // Explicit Euler stability rates (Gershgorin rows of M^-1 K and M^-1 C).
   static void EulerRates(uint32_t n, Cloth* cloth) {
     Cloth& c = *cloth;
@@ -365,6 +471,8 @@ Status BuildCloth(const ClothDescription& d, Cloth* cloth) {
   if (Status s = Cloth::Builder::Masses(d, n, area, kinematic, cloth); !s.ok()) return s;
   Cloth::Builder::Springs(d, n, cloth);
   Cloth::Builder::EulerRates(n, cloth);
+  Cloth::Builder::Skin(d, n, kinematic, cloth);
+  Cloth::Builder::Tethers(d, kinematic, cloth);
   return Status::Ok();
 }
 

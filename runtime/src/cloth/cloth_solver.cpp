@@ -1,5 +1,6 @@
 #include "drape/runtime/cloth_solver.h"
 
+#include "cloth/cloth_setup.h"
 #include "cloth/spring_colouring.h"
 
 #include <algorithm>
@@ -10,6 +11,9 @@
 #include <string>
 
 #include "drape/runtime/math.h"
+#include "drape/runtime/shape_collider_set.h"
+
+#include "common/rigid_transform.h"
 
 #include "common/lanes/scalar_lanes.h"
 #include "common/lanes/sse2_lanes.h"
@@ -61,8 +65,11 @@ inline float ActiveError(float error) {
 // does not overlap): each end moves by its share of correction * (L - R) along the spring. One
 // kernel over a four-lane pack (common/lanes/): the scalar reference and SSE2 give the same bits.
 // The particles' (x, y, z, w) rows are transposed to x/y/z lanes and back.
+// rest_scale multiplies the rest lengths (1 exactly for the spring iterations; 1 + max_stretch for
+// the strain limit's pass, whose stretched-only springs act beyond that length).
 template <class P, SpringSide side>
-inline void CorrectBlock(const SpringBlock& block, float correction, Particle4* p) {
+inline void CorrectBlock(const SpringBlock& block, float correction, float rest_scale,
+                         Particle4* p) {
   using F = typename P::F;
   using namespace detail::lanes;
   float* a[4];
@@ -76,7 +83,7 @@ inline void CorrectBlock(const SpringBlock& block, float correction, Particle4* 
   P::LoadRows4(b, &bx, &by, &bz, &bw);
   const F dx = Sub(bx, ax), dy = Sub(by, ay), dz = Sub(bz, az);
   const F length = Sqrt(Add(Add(Mul(dx, dx), Mul(dy, dy)), Mul(dz, dz)));
-  F error = Sub(length, P::Load(block.rest_length));
+  F error = Sub(length, Mul(P::Load(block.rest_length), P::Splat(rest_scale)));
   // Paper A's buckling model: stretch springs act only when stretched, bend springs only when
   // compressed (NaN and +-0 ties give 0, maxps / minps's second operand).
   if constexpr (side == SpringSide::kStretched) error = detail::StdMax(P::Zero(), error);
@@ -96,32 +103,37 @@ inline void CorrectBlock(const SpringBlock& block, float correction, Particle4* 
   P::StoreRows4(b, bx, by, bz, bw);
 }
 
+// How a run's blocks are corrected: the material's correction and the rest-length scale.
+struct Correction {
+  float fraction = 1.f;    // of the length error removed, in [0, 1]
+  float rest_scale = 1.f;  // of the rest lengths
+  InstructionSet set = InstructionSet::kScalar;
+};
+
 template <SpringSide side>
-inline void CorrectFour(const SpringBlock& block, float correction, InstructionSet set,
-                        Particle4* p) {
+inline void CorrectFour(const SpringBlock& block, const Correction& c, Particle4* p) {
 #if defined(__SSE2__)
-  if (set != InstructionSet::kScalar) {
-    CorrectBlock<detail::Sse2Lanes, side>(block, correction, p);
+  if (c.set != InstructionSet::kScalar) {
+    CorrectBlock<detail::Sse2Lanes, side>(block, c.fraction, c.rest_scale, p);
     return;
   }
 #endif
-  (void)set;
-  CorrectBlock<detail::ScalarLanes, side>(block, correction, p);
+  CorrectBlock<detail::ScalarLanes, side>(block, c.fraction, c.rest_scale, p);
 }
 
 template <SpringSide side>
-void CorrectRunSequential(const SpringBlock* blocks, const SpringRun& run, float correction,
-                          InstructionSet set, Particle4* p) {
-  for (uint32_t k = run.begin; k < run.end; ++k) CorrectFour<side>(blocks[k], correction, set, p);
+void CorrectRunSequential(const SpringBlock* blocks, const SpringRun& run, const Correction& c,
+                          Particle4* p) {
+  for (uint32_t k = run.begin; k < run.end; ++k) CorrectFour<side>(blocks[k], c, p);
 }
 
 // The blocks of one run shared among the threads of the enclosing parallel region.
 template <SpringSide side>
-void CorrectRunShared(const SpringBlock* blocks, const SpringRun& run, float correction,
-                      InstructionSet set, Particle4* p) {
+void CorrectRunShared(const SpringBlock* blocks, const SpringRun& run, const Correction& c,
+                      Particle4* p) {
   const int64_t begin = run.begin, end = run.end;
 #pragma omp for schedule(static)
-  for (int64_t k = begin; k < end; ++k) CorrectFour<side>(blocks[k], correction, set, p);
+  for (int64_t k = begin; k < end; ++k) CorrectFour<side>(blocks[k], c, p);
 }
 
 // Appends `springs` (pairwise disjoint: one colour) as blocks of four, in order. The lanes of the
@@ -188,6 +200,8 @@ ClothSolverSettings ClothSolverSettings::PaperA(uint32_t substeps) {
   s.integrator = ClothIntegrator::kExplicitEuler;
   s.substeps = substeps;
   s.buckling = true;
+  s.tethers = false;
+  s.max_stretch = std::numeric_limits<float>::infinity();
   return s;
 }
 
@@ -196,6 +210,8 @@ ClothSolverSettings ClothSolverSettings::PaperB() {
   s.integrator = ClothIntegrator::kVerlet;
   s.iterations = 3;
   s.buckling = false;
+  s.tethers = false;
+  s.max_stretch = std::numeric_limits<float>::infinity();
   return s;
 }
 
@@ -222,6 +238,18 @@ Status ClothSolver::SetSettings(const ClothSolverSettings& s) {
   if (s.root_joint < -1)
     return InvalidArgument("root_joint = " + std::to_string(s.root_joint) + ": must be >= -1");
   if (!IsFinite(s.root_bind_position)) return InvalidArgument("root_bind_position is not finite");
+  for (const auto& [value, name] : {std::pair{s.linear_inertia, "linear_inertia"},
+                                    std::pair{s.angular_inertia, "angular_inertia"},
+                                    std::pair{s.centrifugal_inertia, "centrifugal_inertia"}}) {
+    if (!(value >= 0.f && value <= 1.f))
+      return InvalidArgument(std::string(name) + " = " + std::to_string(value) +
+                             ": must be in [0, 1]");
+  }
+  if ((s.linear_inertia < 1.f || s.angular_inertia < 1.f) && s.root_joint < 0)
+    return InvalidArgument("linear_inertia or angular_inertia below 1 needs a root_joint");
+  if (!(s.max_stretch >= 0.f))
+    return InvalidArgument("max_stretch = " + std::to_string(s.max_stretch) +
+                           ": must be >= 0 (+inf: no strain limit)");
   if (s.integrator != ClothIntegrator::kVerlet && s.integrator != ClothIntegrator::kExplicitEuler)
     return InvalidArgument("unknown integrator");
   settings_ = s;
@@ -328,6 +356,24 @@ Status ClothSolver::Init(const Cloth& cloth, const ClothSolverSettings& settings
   kinematic_velocities_.assign(k, Float3{});
   flags_.assign(n, 0);
   body_map_flags_.assign(n, 0);
+  shape_flags_.assign(n, 0);
+  // Skinned kinematic particles first (ApplyAttachments places them), then the constrained ones.
+  skin_targets_.clear();
+  skin_kinematic_count_ = 0;
+  if (cloth.skinned()) {
+    std::vector<uint8_t> attached(n, 0);
+    for (const ClothAttachment& a : cloth.attachments()) attached[a.particle] = 1;
+    for (const uint32_t i : cloth.kinematic_particles())
+      if (!attached[i] && cloth.max_distances()[i] == 0.f) skin_targets_.push_back(i);
+    skin_kinematic_count_ = static_cast<uint32_t>(skin_targets_.size());
+    const std::span<const uint32_t> constrained = cloth.constrained_particles();
+    skin_targets_.insert(skin_targets_.end(), constrained.begin(), constrained.end());
+  }
+  const size_t targets = skin_targets_.size();
+  skin_start_.assign(targets, Float3{});
+  skin_end_.assign(targets, Float3{});
+  skin_normal_start_.assign(targets, Float3{});
+  skin_normal_end_.assign(targets, Float3{});
   BuildSpringGroups(cloth);
   return Status::Ok();
 }
@@ -348,33 +394,29 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
     if (Status s = colliders.hulls->SetPose(frame.skinning_start, frame.skinning_end); !s.ok())
       return s;
   }
-  Float3 root_delta;  // metres over the whole frame
-  if (settings_.root_joint >= 0) {
-    const size_t r = static_cast<size_t>(settings_.root_joint);
-    root_delta = TransformPoint(frame.skinning_end[r], settings_.root_bind_position) -
-                 TransformPoint(frame.skinning_start[r], settings_.root_bind_position);
-  }
+  const RootMotion root = ComputeRootMotion(frame);
+  ComputeSkinnedTargets(frame);
 
   const uint32_t count = settings_.substeps;
   const bool verlet = settings_.integrator == ClothIntegrator::kVerlet;
-  const bool relative = settings_.root_joint >= 0;
   const bool parallel = static_cast<int64_t>(state->positions.size()) >= kParallelParticles;
   for (uint32_t k = 0; k < count; ++k) {
     Substep sub;
     sub.s0 = static_cast<float>(k) / static_cast<float>(count);
     sub.s1 = static_cast<float>(k + 1) / static_cast<float>(count);  // exactly 1 at the end
     sub.h = frame.dt / static_cast<float>(count);
-    const Float3 shift = root_delta * (sub.s1 - sub.s0);
 
     // The solver's own stages share one parallel region: each holds `omp for` loops bound to it.
 #pragma omp parallel if (parallel)
     {
       BeginSubstep(state);
-      if (relative) ApplyRootMotion(state, shift);
+      if (root.carry) CarryWithRoot(state, root, sub);
       if (!verlet) AccumulateSpringForces(*state);
-      Integrate(state, sub);
+      Integrate(state, sub, root);
       ApplyAttachments(state, frame, sub);
       if (verlet) SolveSprings(state);
+      ApplyTethers(state, sub);
+      ApplySkinConstraints(state, sub);
       UpdateVelocities(state, sub);
     }
     // The colliders parallelise their batches themselves.
@@ -422,12 +464,10 @@ Status ClothSolver::ValidateFrame(const ClothState& state, const ClothColliders&
       return InvalidArgument("Step: skinning matrix of joint " + std::to_string(j) +
                              " is not finite");
   }
-  const ResponseParams& r = colliders.response;
-  if (!(std::isfinite(r.friction) && r.friction >= 0.f && r.friction <= 1.f &&
-        std::isfinite(r.restitution) && r.restitution >= 0.f && r.restitution <= 1.f &&
-        std::isfinite(r.separation) && r.separation >= 0.f))
+  if (!ValidResponse(colliders.response))
     return InvalidArgument(
-        "Step: response friction and restitution must be in [0, 1], separation finite and >= 0");
+        "Step: response friction in [0, 1], static_friction in [0, 4], restitution in [0, 1], "
+        "separation finite and >= 0");
   if (colliders.body_map != nullptr && colliders.body_map->empty())
     return InvalidArgument("Step: the body map collider is empty (not built)");
   return Status::Ok();
@@ -452,11 +492,136 @@ void ClothSolver::BeginSubstep(ClothState* state) {
   }
 }
 
-void ClothSolver::ApplyRootMotion(ClothState* state, Float3 shift) {
+// The root's world rotation and position at the frame's start and end; the carried share of its
+// motion is applied per substep by CarryWithRoot, the centrifugal push in Integrate.
+ClothSolver::RootMotion ClothSolver::ComputeRootMotion(const ClothFrame& frame) const {
+  RootMotion root;
+  const float carry_linear = 1.f - settings_.linear_inertia;
+  const float carry_angular = 1.f - settings_.angular_inertia;
+  if (settings_.root_joint < 0 || (carry_linear == 0.f && carry_angular == 0.f)) return root;
+  const size_t r = static_cast<size_t>(settings_.root_joint);
+  root.carry = true;
+  root.pivot0 = TransformPoint(frame.skinning_start[r], settings_.root_bind_position);
+  root.pivot1 = TransformPoint(frame.skinning_end[r], settings_.root_bind_position);
+  const detail::QuatD q0 = detail::RotationOf(frame.skinning_start[r]);
+  const detail::QuatD q1 = detail::RotationOf(frame.skinning_end[r]);
+  detail::QuatD rel = detail::NormalizeQ(detail::Mul(q1, detail::Conjugate(q0)));
+  if (rel.w < 0.0) rel = {-rel.x, -rel.y, -rel.z, -rel.w};  // the short way round
+  root.rotation = {static_cast<float>(rel.x), static_cast<float>(rel.y), static_cast<float>(rel.z),
+                   static_cast<float>(rel.w)};
+  const double sin_half = std::sqrt(rel.x * rel.x + rel.y * rel.y + rel.z * rel.z);
+  if (sin_half > 1e-12) {
+    const double rate = 2.0 * std::atan2(sin_half, rel.w) / (sin_half * frame.dt);  // rad/s
+    root.omega = {static_cast<float>(rel.x * rate), static_cast<float>(rel.y * rate),
+                  static_cast<float>(rel.z * rate)};
+  }
+  root.centrifugal = carry_angular > 0.f && settings_.centrifugal_inertia > 0.f && sin_half > 1e-12;
+  return root;
+}
+
+// Moves every particle (and turns its velocity) by the carried share of the root's motion over
+// the substep: a rotation by (1 - angular_inertia) of the root's turn about its position, then
+// (1 - linear_inertia) of its translation.
+void ClothSolver::CarryWithRoot(ClothState* state, const RootMotion& root, const Substep& sub) {
+  const float carry_linear = 1.f - settings_.linear_inertia;
+  const float carry_angular = 1.f - settings_.angular_inertia;
+  const Quat identity;
+  const Quat r0 = Nlerp(identity, root.rotation, sub.s0);
+  const Quat r1 = Nlerp(identity, root.rotation, sub.s1);
+  const Quat turn = Nlerp(identity, Multiply(r1, Quat{-r0.x, -r0.y, -r0.z, r0.w}), carry_angular);
+  const Float3 pivot = Lerp(root.pivot0, root.pivot1, sub.s0);
+  const Float3 shift = (Lerp(root.pivot0, root.pivot1, sub.s1) - pivot) * carry_linear;
+  Transform t;
+  t.rotation = turn;
+  Mat34 m = ToMatrix(t);
+  const Float3 moved = TransformVector(m, pivot);
+  m.m[3] = pivot.x - moved.x + shift.x;
+  m.m[7] = pivot.y - moved.y + shift.y;
+  m.m[11] = pivot.z - moved.z + shift.z;
   Float3* x = state->positions.data();
+  Float3* v = state->velocities.data();
   const int64_t n = static_cast<int64_t>(state->positions.size());
 #pragma omp for schedule(static) nowait
-  for (int64_t i = 0; i < n; ++i) x[i] += shift;
+  for (int64_t i = 0; i < n; ++i) {
+    x[i] = TransformPoint(m, x[i]);
+    v[i] = TransformVector(m, v[i]);
+  }
+}
+
+// Skinned garments: each skinned target's position and normal at the frame's start and end.
+void ClothSolver::ComputeSkinnedTargets(const ClothFrame& frame) {
+  const Cloth& cloth = *cloth_;
+  const int64_t count = static_cast<int64_t>(skin_targets_.size());
+  if (count == 0) return;
+  const ClothSkinWeights* skin = cloth.skin().data();
+  const Float3* rest = cloth.skin_bind_positions().data();
+  const Float3* normal = cloth.rest_normals().data();
+  const Mat34* s0 = frame.skinning_start.data();
+  const Mat34* s1 = frame.skinning_end.data();
+#pragma omp parallel for schedule(static) if (count >= kParallelParticles)
+  for (int64_t k = 0; k < count; ++k) {
+    const uint32_t i = skin_targets_[k];
+    skin_start_[k] = detail::SkinPoint(skin[i], s0, rest[i]);
+    skin_end_[k] = detail::SkinPoint(skin[i], s1, rest[i]);
+    skin_normal_start_[k] = detail::SkinVector(skin[i], s0, normal[i]);
+    skin_normal_end_[k] = detail::SkinVector(skin[i], s1, normal[i]);
+  }
+}
+
+// Each tethered particle is pulled back onto the sphere of its tether's length around its anchor
+// (a kinematic particle, already placed): writes its own particle only.
+void ClothSolver::ApplyTethers(ClothState* state, const Substep& sub) {
+  const int64_t count = static_cast<int64_t>(cloth_->tethers().size());
+  if (!settings_.tethers || count == 0) return;
+  const ClothTether* tethers = cloth_->tethers().data();
+  Float3* x = state->positions.data();
+  Float3* v = state->velocities.data();
+  const bool euler = settings_.integrator == ClothIntegrator::kExplicitEuler;
+  const float inv_h = 1.f / sub.h;
+#pragma omp for schedule(static)
+  for (int64_t k = 0; k < count; ++k) {
+    const ClothTether& t = tethers[k];
+    const Float3 anchor = x[t.anchor];
+    const Float3 d = x[t.particle] - anchor;
+    const float squared = Dot(d, d);
+    if (!(squared > t.length * t.length)) continue;
+    const Float3 moved = anchor + d * (t.length / std::sqrt(squared));
+    if (euler) v[t.particle] += (moved - x[t.particle]) * inv_h;  // Verlet re-derives it
+    x[t.particle] = moved;
+  }
+}
+
+// Skinned garments: a particle farther than its max distance from its skinned position is pulled
+// onto that sphere; one behind its backstop plane (backstop metres behind the skinned position
+// along the skinned normal) is pushed onto the plane.
+void ClothSolver::ApplySkinConstraints(ClothState* state, const Substep& sub) {
+  const int64_t begin = skin_kinematic_count_, end = static_cast<int64_t>(skin_targets_.size());
+  if (begin == end) return;
+  const float* max_distance = cloth_->max_distances().data();
+  const float* backstop = cloth_->backstops().data();
+  Float3* x = state->positions.data();
+  Float3* v = state->velocities.data();
+  const bool euler = settings_.integrator == ClothIntegrator::kExplicitEuler;
+  const float inv_h = 1.f / sub.h;
+  const float s = sub.s1;
+#pragma omp for schedule(static)
+  for (int64_t k = begin; k < end; ++k) {
+    const uint32_t i = skin_targets_[k];
+    const Float3 target = skin_start_[k] * (1.f - s) + skin_end_[k] * s;
+    Float3 p = x[i];
+    const float limit = max_distance[i];
+    const Float3 d = p - target;
+    const float squared = Dot(d, d);
+    if (squared > limit * limit) p = target + d * (limit / std::sqrt(squared));
+    if (backstop[i] < std::numeric_limits<float>::infinity()) {
+      const Float3 n =
+          NormalizeOr(skin_normal_start_[k] * (1.f - s) + skin_normal_end_[k] * s, Float3{});
+      const float behind = -backstop[i] - Dot(p - target, n);
+      if (behind > 0.f) p += n * behind;
+    }
+    if (euler) v[i] += (p - x[i]) * inv_h;
+    x[i] = p;
+  }
 }
 
 // The same traversal as SolveSprings (chunks, even zones, odd zones, far runs): every spring
@@ -510,7 +675,9 @@ void ClothSolver::AccumulateRun(const SpringRun& run, bool shared, const Float3*
 // r = damping + drag * area / m, v' = (v + h (g + a_spring + r_drag * wind)) / (1 + h r)), which
 // is unconditionally stable for any rate; the spring forces of explicit Euler stay explicit
 // (paper A eq. 1).
-void ClothSolver::Integrate(ClothState* state, const Substep& sub) {
+// A carried rotation adds the centrifugal acceleration w x (r x w) (r from the root's position;
+// scaled by the carried share and centrifugal_inertia).
+void ClothSolver::Integrate(ClothState* state, const Substep& sub, const RootMotion& root) {
   const Cloth& cloth = *cloth_;
   const float* inverse_mass = cloth.inverse_masses().data();
   const float* area = cloth.areas().data();
@@ -524,6 +691,10 @@ void ClothSolver::Integrate(ClothState* state, const Substep& sub) {
   const float h = sub.h;
   const float damping = settings_.damping;
   const float drag = settings_.drag;
+  const bool centrifugal = root.centrifugal;
+  const Float3 omega = root.omega;
+  const Float3 pivot = Lerp(root.pivot0, root.pivot1, sub.s0);
+  const float centrifugal_scale = (1.f - settings_.angular_inertia) * settings_.centrifugal_inertia;
   const int64_t n = static_cast<int64_t>(state->positions.size());
   // Barrier at the end: ApplyAttachments writes particles other threads read here.
 #pragma omp for schedule(static)
@@ -536,6 +707,7 @@ void ClothSolver::Integrate(ClothState* state, const Substep& sub) {
     const float rate = damping + drag_rate;
     Float3 a = g + wind * drag_rate;
     if (!verlet) a += forces[i] * w;
+    if (centrifugal) a += Cross(Cross(omega, xi - pivot), omega) * centrifugal_scale;
     const Float3 v_new = (v[i] + a * h) * (1.f / (1.f + h * rate));
     // Verlet (paper B eq. 4): x + (x - x_prev) + h^2 a, with x - x_prev = h v; the velocity is
     // re-estimated from positions after the spring correction. Euler: v' and x + h v'.
@@ -557,6 +729,11 @@ void ClothSolver::ApplyAttachments(ClothState* state, const ClothFrame& frame, c
     const Float3 end = TransformPoint(frame.skinning_end[j], a.bind_position);
     x[a.particle] = start * (1.f - s) + end * s;  // exactly `end` at s = 1
   }
+  const int64_t skinned = skin_kinematic_count_;
+  if (skinned == 0) return;  // no barrier for an empty loop
+#pragma omp for schedule(static)
+  for (int64_t k = 0; k < skinned; ++k)
+    x[skin_targets_[k]] = skin_start_[k] * (1.f - s) + skin_end_[k] * s;
 }
 
 // Works on the solver's copy of the positions (16-byte aligned particles for the SSE loads),
@@ -573,42 +750,55 @@ void ClothSolver::SolveSprings(ClothState* state) {
   const int64_t odd_count = static_cast<int64_t>(odd_zones_.size());
 #pragma omp for schedule(static)
   for (int64_t i = 0; i < n; ++i) p[i] = Particle4{x[i].x, x[i].y, x[i].z, 0.f};
-  for (uint32_t it = 0; it < settings_.iterations; ++it) {
+  // The iterations, then the strain limit's pass over the stretch springs.
+  const bool limit_stretch = settings_.max_stretch < std::numeric_limits<float>::infinity();
+  const uint32_t passes = settings_.iterations + (limit_stretch ? 1 : 0);
+  for (uint32_t it = 0; it < passes; ++it) {
+    const bool limit = it == settings_.iterations;
 #pragma omp for schedule(static)
-    for (int64_t g = 0; g < chunk_count; ++g) CorrectGroup(chunks[g], p);
+    for (int64_t g = 0; g < chunk_count; ++g) CorrectGroup(chunks[g], limit, p);
 #pragma omp for schedule(static)
-    for (int64_t g = 0; g < even_count; ++g) CorrectGroup(even[g], p);
+    for (int64_t g = 0; g < even_count; ++g) CorrectGroup(even[g], limit, p);
 #pragma omp for schedule(static)
-    for (int64_t g = 0; g < odd_count; ++g) CorrectGroup(odd[g], p);
+    for (int64_t g = 0; g < odd_count; ++g) CorrectGroup(odd[g], limit, p);
     for (uint32_t r = far_runs_.run_begin; r < far_runs_.run_end; ++r)
-      CorrectRun(runs_[r], true, p);
+      CorrectRun(runs_[r], true, limit, p);
   }
-#pragma omp for schedule(static) nowait
+  // A barrier after: the tethers read their anchors, which other threads copy back.
+#pragma omp for schedule(static)
   for (int64_t i = 0; i < n; ++i) x[i] = Float3{p[i].x, p[i].y, p[i].z};
 }
 
-void ClothSolver::CorrectGroup(const SpringGroup& group, Particle4* p) const {
-  for (uint32_t r = group.run_begin; r < group.run_end; ++r) CorrectRun(runs_[r], false, p);
+void ClothSolver::CorrectGroup(const SpringGroup& group, bool limit, Particle4* p) const {
+  for (uint32_t r = group.run_begin; r < group.run_end; ++r) CorrectRun(runs_[r], false, limit, p);
 }
 
 // One run of springs of one kind: sequentially on the calling thread, or shared among the
 // threads of the enclosing region.
-void ClothSolver::CorrectRun(const SpringRun& run, bool shared, Particle4* p) const {
+void ClothSolver::CorrectRun(const SpringRun& run, bool shared, bool limit, Particle4* p) const {
   const SpringBlock* blocks = blocks_.data();
-  const float correction = cloth_->material(run.kind).correction;
-  const InstructionSet set = UsableInstructionSet(settings_.instruction_set);
-  switch (SideOf(run.kind, settings_.buckling)) {
+  Correction c;
+  c.set = UsableInstructionSet(settings_.instruction_set);
+  SpringSide side = SideOf(run.kind, settings_.buckling);
+  if (limit) {
+    if (run.kind != SpringKind::kStretch) return;
+    c.rest_scale = 1.f + settings_.max_stretch;  // only the stretch beyond it, removed whole
+    side = SpringSide::kStretched;
+  } else {
+    c.fraction = cloth_->material(run.kind).correction;
+  }
+  switch (side) {
     case SpringSide::kBoth:
-      shared ? CorrectRunShared<SpringSide::kBoth>(blocks, run, correction, set, p)
-             : CorrectRunSequential<SpringSide::kBoth>(blocks, run, correction, set, p);
+      shared ? CorrectRunShared<SpringSide::kBoth>(blocks, run, c, p)
+             : CorrectRunSequential<SpringSide::kBoth>(blocks, run, c, p);
       break;
     case SpringSide::kStretched:
-      shared ? CorrectRunShared<SpringSide::kStretched>(blocks, run, correction, set, p)
-             : CorrectRunSequential<SpringSide::kStretched>(blocks, run, correction, set, p);
+      shared ? CorrectRunShared<SpringSide::kStretched>(blocks, run, c, p)
+             : CorrectRunSequential<SpringSide::kStretched>(blocks, run, c, p);
       break;
     case SpringSide::kCompressed:
-      shared ? CorrectRunShared<SpringSide::kCompressed>(blocks, run, correction, set, p)
-             : CorrectRunSequential<SpringSide::kCompressed>(blocks, run, correction, set, p);
+      shared ? CorrectRunShared<SpringSide::kCompressed>(blocks, run, c, p)
+             : CorrectRunSequential<SpringSide::kCompressed>(blocks, run, c, p);
       break;
   }
 }
@@ -635,8 +825,8 @@ void ClothSolver::UpdateVelocities(ClothState* state, const Substep& sub) {
 
 Status ClothSolver::Collide(ClothState* state, const ClothColliders& colliders, const Substep& sub,
                             ClothStepStats* stats) {
-  merge_flags_ = false;
-  if (colliders.hulls == nullptr && colliders.body_map == nullptr) {
+  merge_flags_ = 0;
+  if (colliders.hulls == nullptr && colliders.body_map == nullptr && colliders.shapes == nullptr) {
     std::memset(flags_.data(), 0, flags_.size());
     return Status::Ok();
   }
@@ -648,6 +838,8 @@ Status ClothSolver::Collide(ClothState* state, const ClothColliders& colliders, 
   }
   restore_kinematic_ = true;
   const std::span<const Float3> x_start = state->previous_positions;
+  // The first collider that runs writes flags_, the others their own flags (merged after).
+  bool first = true;
   if (colliders.hulls != nullptr) {
     if (Status s = colliders.hulls->SelectSubstep(sub.s0, sub.s1); !s.ok()) return s;
     uint32_t contacts = 0;
@@ -657,16 +849,28 @@ Status ClothSolver::Collide(ClothState* state, const ClothColliders& colliders, 
         !s.ok())
       return s;
     stats->hull_contacts += contacts;
+    first = false;
   }
   if (colliders.body_map != nullptr) {
-    merge_flags_ = colliders.hulls != nullptr;
+    if (!first) merge_flags_ |= 1;
     uint32_t contacts = 0;
     if (Status s = colliders.body_map->CollideBatch(x_start, state->positions, state->velocities,
-                                                    merge_flags_ ? body_map_flags_ : flags_,
+                                                    first ? flags_ : body_map_flags_,
                                                     colliders.response, &contacts);
         !s.ok())
       return s;
     stats->body_map_contacts += contacts;
+    first = false;
+  }
+  if (colliders.shapes != nullptr) {
+    if (!first) merge_flags_ |= 2;
+    uint32_t contacts = 0;
+    if (Status s = colliders.shapes->CollideBatch(x_start, state->positions, state->velocities,
+                                                  first ? flags_ : shape_flags_, colliders.response,
+                                                  sub.s0, sub.s1, sub.h, &contacts);
+        !s.ok())
+      return s;
+    stats->shape_contacts += contacts;
   }
   return Status::Ok();
 }
@@ -681,6 +885,7 @@ void ClothSolver::RestoreKinematic(ClothState* state) {
     state->velocities[i] = kinematic_velocities_[k];
     flags_[i] = 0;
     body_map_flags_[i] = 0;
+    shape_flags_[i] = 0;
   }
 }
 
@@ -706,13 +911,15 @@ uint32_t ClothSolver::FirstNonFinite(const ClothState& state) const {
 
 uint32_t ClothSolver::CountContacts() {
   uint8_t* flags = flags_.data();
-  const uint8_t* extra = body_map_flags_.data();
-  const bool merge = merge_flags_;
+  const uint8_t* body_map = body_map_flags_.data();
+  const uint8_t* shapes = shape_flags_.data();
+  const bool merge_body_map = (merge_flags_ & 1) != 0, merge_shapes = (merge_flags_ & 2) != 0;
   const int64_t n = static_cast<int64_t>(flags_.size());
   uint32_t contacts = 0;
 #pragma omp parallel for schedule(static) reduction(+ : contacts) if (n >= kParallelParticles)
   for (int64_t i = 0; i < n; ++i) {
-    if (merge) flags[i] = static_cast<uint8_t>(flags[i] | extra[i]);
+    if (merge_body_map) flags[i] = static_cast<uint8_t>(flags[i] | body_map[i]);
+    if (merge_shapes) flags[i] = static_cast<uint8_t>(flags[i] | shapes[i]);
     contacts += flags[i] & kCollisionContact;
   }
   return contacts;
@@ -752,6 +959,70 @@ float ClothSolver::MaxStretch(const ClothState& state) const {
     }
   }
   return max_stretch;
+}
+
+// ---- Teleport and reset ------------------------------------------------------------------------
+
+Status ClothSolver::Teleport(ClothState* state, const Mat34& transform) const {
+  if (cloth_ == nullptr) return InvalidArgument("Teleport: Init was not called");
+  if (!state->Matches(*cloth_))
+    return InvalidArgument("Teleport: the state does not match the cloth (call ClothState::Reset)");
+  if (!Finite(transform)) return InvalidArgument("Teleport: the transform is not finite");
+  // Rigid: orthonormal columns within 1e-3 (a scale would change the rest lengths' meaning).
+  for (int a = 0; a < 3; ++a) {
+    for (int b = a; b < 3; ++b) {
+      const float dot = transform.m[a] * transform.m[b] + transform.m[4 + a] * transform.m[4 + b] +
+                        transform.m[8 + a] * transform.m[8 + b];
+      if (!(std::abs(dot - (a == b ? 1.f : 0.f)) <= 1e-3f))
+        return InvalidArgument(
+            "Teleport: the transform is not rigid (a rotation and a translation)");
+    }
+  }
+  const int64_t n = static_cast<int64_t>(state->positions.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelParticles)
+  for (int64_t i = 0; i < n; ++i) {
+    state->positions[i] = TransformPoint(transform, state->positions[i]);
+    state->previous_positions[i] = TransformPoint(transform, state->previous_positions[i]);
+    state->velocities[i] = TransformVector(transform, state->velocities[i]);
+  }
+  return Status::Ok();
+}
+
+Status ClothSolver::Reset(ClothState* state, const ClothColliders& colliders,
+                          std::span<const Mat34> skinning) {
+  if (cloth_ == nullptr) return InvalidArgument("Reset: Init was not called");
+  if (!state->Matches(*cloth_)) state->Reset(*cloth_);
+  ClothFrame frame;
+  frame.skinning_start = skinning;
+  frame.skinning_end = skinning;
+  if (Status s = ValidateFrame(*state, colliders, frame); !s.ok()) return s;
+  const Cloth& cloth = *cloth_;
+  const std::span<const Float3> rest = cloth.rest_positions();
+  const int32_t root = settings_.root_joint;
+  for (size_t i = 0; i < rest.size(); ++i) {
+    Float3 p = root >= 0 ? TransformPoint(skinning[static_cast<size_t>(root)], rest[i]) : rest[i];
+    if (cloth.skinned())
+      p = detail::SkinPoint(cloth.skin()[i], skinning.data(), cloth.skin_bind_positions()[i]);
+    state->positions[i] = p;
+  }
+  for (const ClothAttachment& a : cloth.attachments())
+    state->positions[a.particle] =
+        TransformPoint(skinning[static_cast<size_t>(a.joint)], a.bind_position);
+  state->previous_positions = state->positions;
+  std::fill(state->velocities.begin(), state->velocities.end(), Float3{});
+  // Whatever the pose puts inside a collider is pushed out (segments of length 0: the colliders'
+  // started-inside response).
+  if (colliders.hulls != nullptr) {
+    if (Status s = colliders.hulls->SetPose(skinning, skinning); !s.ok()) return s;
+  }
+  Substep sub;
+  sub.h = frame.dt;
+  ClothStepStats stats;
+  if (Status s = Collide(state, colliders, sub, &stats); !s.ok()) return s;
+  RestoreKinematic(state);
+  state->previous_positions = state->positions;
+  std::fill(state->velocities.begin(), state->velocities.end(), Float3{});
+  return Status::Ok();
 }
 
 }  // namespace drape

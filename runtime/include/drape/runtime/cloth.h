@@ -30,6 +30,21 @@ struct SpringMaterial {
                             // (1 = paper B's full correction)
 };
 
+// Up to four joints that carry a particle by linear blend skinning (a skinned garment). Unused
+// slots have weight 0; the weights sum to 1 (BuildCloth renormalises them).
+struct ClothSkinWeights {             // 32 bytes
+  uint32_t joints[4] = {0, 0, 0, 0};  // indices into the skinning matrices
+  float weights[4] = {0.f, 0.f, 0.f, 0.f};
+};
+
+// A long-range attachment (NvCloth's tether, Jolt's LRA): `particle` may not get farther from
+// `anchor` (a pinned, attached or max-distance-0 particle) than `length` (the geodesic distance
+// over the rest mesh's edges) times (1 + the particle's tether stretch).
+struct ClothTether {  // 12 bytes
+  uint32_t particle = 0, anchor = 0;
+  float length = 0.f;  // metres, > 0, already scaled by (1 + stretch)
+};
+
 // A particle that moves rigidly with a joint (paper B §3.2).
 struct ClothAttachment {
   uint32_t particle = 0;
@@ -52,6 +67,27 @@ struct ClothDescription {
   // per Verlet iteration.
   SpringMaterial bend{20.f, 0.01f, 0.2f};
   bool bend_springs = true;  // false: stretch springs only
+
+  // Long-range attachments: every dynamic particle connected to the kinematic set through the
+  // mesh gets one tether to its geodesically nearest kinematic particle. What keeps a long
+  // garment from stretching under its own weight at few iterations.
+  bool tethers = true;
+  float tether_stretch = 0.02f;  // >= 0, finite: allowed stretch beyond the geodesic length
+  std::vector<float> tether_stretch_per_particle;  // empty, or one value per particle (>= 0)
+
+  // A skinned garment: per particle its joints and weights (empty: not skinned), and where it
+  // sits in the bind pose (asset frame; empty: `positions`, the garment authored in the bind
+  // pose). Its skinned position at a pose is sum_k weight_k * skinning[joint_k] * bind position.
+  std::vector<ClothSkinWeights> skin;
+  std::vector<Float3> skin_bind_positions;
+  // metres per particle (empty: unlimited): how far a particle may move from its skinned
+  // position; 0 makes it kinematic (placed at its skinned position, like an attachment).
+  std::vector<float> max_distance;
+  // metres per particle (empty: none; +inf: none): the particle stays on the outside of the
+  // plane this far behind its skinned position, along the garment's skinned normal (the side
+  // the triangles' counter-clockwise winding faces). Keeps a garment from sinking into the body
+  // it is skinned to, whatever the colliders miss.
+  std::vector<float> backstop;
 };
 
 // What BuildCloth did with input it tolerates.
@@ -62,6 +98,8 @@ struct ClothBuildReport {
   uint32_t non_manifold_edges = 0;   // edges of more than two triangles: no bend spring
   uint32_t stretch_colours = 0;
   uint32_t bend_colours = 0;
+  uint32_t tethers = 0;
+  uint32_t untethered_particles = 0;  // dynamic particles with no mesh path to a kinematic one
 };
 
 // One spring in solver form. weight_a + weight_b = 1 (or both 0): the share of a length
@@ -85,9 +123,11 @@ class Cloth;
 // triangle count not a multiple of 3, a vertex index out of range, masses of the wrong count or
 // not finite and > 0, density or total_mass not finite and >= 0, a pinned index or attachment
 // particle out of range, two attachments of one particle, a negative joint, a non-finite
-// attachment position, a material value out of range, or a particle that gets no mass (in no
-// triangle with area, masses empty) and is neither pinned nor attached. Tolerated and counted in
-// the report: see ClothBuildReport. On error `cloth` is left empty.
+// attachment position, a material value out of range, a particle that gets no mass (in no
+// triangle with area, masses empty) and is neither pinned nor attached, a tether stretch not
+// finite and >= 0, skin weights of the wrong count, negative, not finite or summing to 0, max
+// distances or backstops of the wrong count, negative or NaN, or given without skin weights.
+// Tolerated and counted in the report: see ClothBuildReport. On error `cloth` is left empty.
 Status BuildCloth(const ClothDescription& description, Cloth* cloth);
 
 // The immutable topology of one cloth. Only BuildCloth fills it.
@@ -111,6 +151,17 @@ class Cloth {
   // Particles with inverse mass 0 (pinned or attached), ascending.
   std::span<const uint32_t> kinematic_particles() const { return kinematic_; }
   std::span<const ClothAttachment> attachments() const { return attachments_; }  // by particle
+  std::span<const ClothTether> tethers() const { return tethers_; }              // by particle
+  // Skinned garments: weights per particle (empty when not skinned), unit rest normals (area
+  // weighted, the triangles' winding), max distances and backstops (+inf where unlimited).
+  bool skinned() const { return !skin_.empty(); }
+  std::span<const ClothSkinWeights> skin() const { return skin_; }
+  std::span<const Float3> skin_bind_positions() const { return skin_bind_; }
+  std::span<const Float3> rest_normals() const { return rest_normals_; }
+  std::span<const float> max_distances() const { return max_distance_; }
+  std::span<const float> backstops() const { return backstop_; }
+  // Dynamic particles with a finite max distance or backstop, ascending.
+  std::span<const uint32_t> constrained_particles() const { return constrained_; }
   const SpringMaterial& material(SpringKind kind) const {
     return kind == SpringKind::kStretch ? stretch_ : bend_;
   }
@@ -146,6 +197,12 @@ class Cloth {
   std::vector<SpringColour> colours_;
   std::vector<uint32_t> kinematic_;
   std::vector<ClothAttachment> attachments_;
+  std::vector<ClothTether> tethers_;
+  std::vector<ClothSkinWeights> skin_;
+  std::vector<Float3> skin_bind_;
+  std::vector<Float3> rest_normals_;
+  std::vector<float> max_distance_, backstop_;
+  std::vector<uint32_t> constrained_;
   SpringMaterial stretch_, bend_;
   uint32_t stretch_count_ = 0, bend_count_ = 0;
   uint32_t required_joints_ = 0;

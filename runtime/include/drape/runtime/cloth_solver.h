@@ -1,13 +1,14 @@
 #pragma once
 // Advances a ClothState by one frame: paper A's or paper B's integrator, substeps, continuous
-// collision against the character's colliders in every substep, attachments to joints, and
-// relative simulation. Init allocates; Step allocates nothing and gives the same bits at any
-// thread count. How a substep runs and how to choose substeps and iterations:
-// docs/ALGORITHMS.md §10; figures: docs/PERFORMANCE.md.
+// collision against the character's colliders and the engine's shapes in every substep,
+// attachments to joints, long-range tethers and a strain limit, skinned garments' max distance
+// and backstop, and inertia relative to the character's root. Init allocates; Step allocates
+// nothing and gives the same bits at any thread count. How a substep runs and how to choose
+// substeps and iterations: docs/ALGORITHMS.md §10; figures: docs/PERFORMANCE.md.
 //
 //   ClothSolver solver;
 //   solver.Init(cloth, ClothSolverSettings::PaperB());          // once
-//   solver.Step(&state, {&body_map, &hulls, response}, frame);   // per frame
+//   solver.Step(&state, {&body_map, &hulls, &shapes, response}, frame);   // per frame
 
 #include <cstdint>
 #include <span>
@@ -38,10 +39,24 @@ struct ClothSolverSettings {
   float damping = 0.1f;              // 1/s, finite, >= 0: F_damp = -damping * m * v
   float drag = 0.f;  // kg/(m^2 s), finite, >= 0: F_fluid = -drag * area * (v - wind)
   Float3 wind;       // m/s, the air's velocity for the fluid drag
-  // Relative simulation: the root joint (-1: off) and its position in the bind-pose asset frame
-  // (the translation of inverse(inverse_bind[root])).
+  // The character's root: its joint (-1: none) and its position in the bind-pose asset frame
+  // (the translation of inverse(inverse_bind[root])). Needed for inertia below 1.
   int32_t root_joint = -1;
   Float3 root_bind_position;
+  // Inertia, in [0, 1]: how much of the root's motion the cloth resists. 1 = simulate in the
+  // world (the root's motion drags the cloth through its attachments only); 0 = the cloth is
+  // carried with the root (simulated in the character's frame: a running character's skirt does
+  // not trail). Linear for the root's translation, angular for its rotation; centrifugal scales
+  // the outward push a carried rotation gives (1: a spinning skirt flares as in the world).
+  float linear_inertia = 1.f;
+  float angular_inertia = 1.f;
+  float centrifugal_inertia = 1.f;
+  // Long-range tethers (the cloth's, Cloth::tethers()) and the strain limit of stretch springs:
+  // after the spring iterations a stretch spring longer than rest * (1 + max_stretch) is
+  // shortened to it (+inf: no limit). Verlet only. What keeps a garment from stretching at few
+  // iterations; PaperA() and PaperB() turn both off (the papers' integrators as published).
+  bool tethers = true;
+  float max_stretch = 0.1f;  // >= 0, or +inf
   // The widest instruction set the spring kernel may use (narrowed to the CPU's): four springs
   // per instruction in SSE2 (AVX2 too), or the scalar reference pack. The same bits (tested).
   InstructionSet instruction_set = InstructionSet::kAvx2;
@@ -57,13 +72,17 @@ struct ClothSolverSettings {
 // (in (0, 1]) of cloth.MaxStableEulerStep(damping).
 uint32_t RecommendedEulerSubsteps(const Cloth& cloth, float dt, float damping, float safety = 0.8f);
 
+class ShapeColliderSet;
+
 // The colliders one step tests, each optional. The broad phase is inside the colliders.
 struct ClothColliders {
   const BodyMapCollider* body_map = nullptr;  // one pose (the caller picks it for the frame)
   // Posed by Step (SetPose with the frame's skinning matrices) and switched to each substep
   // (SelectSubstep), hence not const.
   HullColliderSet* hulls = nullptr;
-  ResponseParams response;  // friction, restitution, separation (paper A eq. 5)
+  // The engine's own shapes (floor, props, capsules), posed by the caller for this frame.
+  const ShapeColliderSet* shapes = nullptr;
+  ResponseParams response;  // friction, restitution, separation
 };
 
 // Solver-internal layouts (see ClothSolver::BuildSpringGroups); not part of the API.
@@ -107,6 +126,7 @@ struct ClothStepStats {
   uint32_t contacts = 0;           // particles with a contact in the last substep
   uint32_t hull_contacts = 0;      // sum over substeps of the hulls' contact counts
   uint32_t body_map_contacts = 0;  // sum over substeps of the body map's contact counts
+  uint32_t shape_contacts = 0;     // sum over substeps of the engine shapes' contact counts
   float max_stretch = 0.f;         // after the step: max over stretch springs of L / R - 1
 };
 
@@ -130,8 +150,20 @@ class ClothSolver {
   Status Step(ClothState* state, const ClothColliders& colliders, const ClothFrame& frame,
               ClothStepStats* stats = nullptr);
 
-  // Collision flags (CollisionFlags, OR over hulls and body map) of the last substep.
+  // Collision flags (CollisionFlags, OR over hulls, body map and shapes) of the last substep.
   std::span<const uint8_t> contact_flags() const { return flags_; }
+
+  // Moves the cloth rigidly by `transform` (a rotation and a translation: positions, previous
+  // positions and velocities), for a character that teleports. The next Step's skinning_start
+  // must then be the pose at the new place. kInvalidArgument for a non-rigid or non-finite
+  // transform or a state that does not match.
+  Status Teleport(ClothState* state, const Mat34& transform) const;
+
+  // Puts every particle at its skinned position at the pose `skinning` with zero velocity:
+  // skinned garments by their weights, attached particles by their joint, the rest carried
+  // rigidly by the root joint from the rest shape (or at rest without a root). Then pushes out
+  // of the given colliders (posed at `skinning` for the whole frame) whatever lies inside.
+  Status Reset(ClothState* state, const ClothColliders& colliders, std::span<const Mat34> skinning);
 
  private:
   struct Substep {
@@ -143,14 +175,28 @@ class ClothSolver {
                        const ClothFrame& frame) const;
   // The stages of one substep, in order.
   void BeginSubstep(ClothState* state);
-  void ApplyRootMotion(ClothState* state, Float3 shift);
+  // The root's motion over the frame and the share of it each substep carries the cloth.
+  struct RootMotion {
+    bool carry = false;        // linear or angular inertia below 1
+    bool centrifugal = false;  // a carried rotation pushes outward
+    Float3 pivot0, pivot1;     // root position at the frame's start and end, metres
+    Quat rotation;             // the root's rotation over the frame (start -> end)
+    Float3 omega;              // rad/s: the root's angular velocity
+  };
+  RootMotion ComputeRootMotion(const ClothFrame& frame) const;
+  void CarryWithRoot(ClothState* state, const RootMotion& root, const Substep& sub);
+  void ComputeSkinnedTargets(const ClothFrame& frame);
+  void ApplyTethers(ClothState* state, const Substep& sub);
+  void ApplySkinConstraints(ClothState* state, const Substep& sub);
   void AccumulateSpringForces(const ClothState& state);
-  void Integrate(ClothState* state, const Substep& sub);
+  void Integrate(ClothState* state, const Substep& sub, const RootMotion& root);
   void ApplyAttachments(ClothState* state, const ClothFrame& frame, const Substep& sub);
   void SolveSprings(ClothState* state);
   void BuildSpringGroups(const Cloth& cloth);
-  void CorrectGroup(const internal::SpringGroup& group, internal::Particle4* p) const;
-  void CorrectRun(const internal::SpringRun& run, bool shared, internal::Particle4* p) const;
+  // limit: the strain limit's pass (stretch runs only, acting beyond rest * (1 + max_stretch)).
+  void CorrectGroup(const internal::SpringGroup& group, bool limit, internal::Particle4* p) const;
+  void CorrectRun(const internal::SpringRun& run, bool shared, bool limit,
+                  internal::Particle4* p) const;
   void AccumulateRun(const internal::SpringRun& run, bool shared, const Float3* x, const Float3* v,
                      Float3* forces) const;
   void UpdateVelocities(ClothState* state, const Substep& sub);
@@ -159,7 +205,7 @@ class ClothSolver {
   void RestoreKinematic(ClothState* state);
   // The first particle with a non-finite position or velocity, or UINT32_MAX.
   uint32_t FirstNonFinite(const ClothState& state) const;
-  // ORs the body map's flags into flags_ (when both colliders ran) and counts the contacts.
+  // ORs the other colliders' flags into flags_ (when several ran) and counts the contacts.
   uint32_t CountContacts();
   void RestoreBackup(ClothState* state);
   float MaxStretch(const ClothState& state) const;
@@ -170,7 +216,12 @@ class ClothSolver {
   std::vector<Float3> backup_positions_, backup_velocities_;
   std::vector<Float3> forces_;  // explicit Euler spring forces, N
   std::vector<Float3> kinematic_positions_, kinematic_velocities_;  // kinematic_particles() sized
-  std::vector<uint8_t> flags_, body_map_flags_;
+  std::vector<uint8_t> flags_, body_map_flags_, shape_flags_;
+  // Skinned garments: targets and normals at the frame's start and end, for the particles in
+  // skin_targets_ (the constrained ones and the kinematic skinned ones).
+  std::vector<uint32_t> skin_targets_;
+  uint32_t skin_kinematic_count_ = 0;  // the first ones of skin_targets_ are kinematic
+  std::vector<Float3> skin_start_, skin_end_, skin_normal_start_, skin_normal_end_;
   // SolveSprings' working copy of the positions (16-byte aligned particles for aligned SSE
   // loads) and the springs in blocks of four, by group and colour (BuildSpringGroups).
   std::vector<internal::Particle4> solver_positions_;
@@ -178,7 +229,7 @@ class ClothSolver {
   std::vector<internal::SpringRun> runs_;
   std::vector<internal::SpringGroup> chunk_groups_, even_zones_, odd_zones_;
   internal::SpringGroup far_runs_;
-  bool merge_flags_ = false;        // both colliders ran: OR body_map_flags_ into flags_
+  uint8_t merge_flags_ = 0;         // bit 0: OR body_map_flags_, bit 1: shape_flags_ into flags_
   bool restore_kinematic_ = false;  // Collide saved the kinematic particles
 };
 
