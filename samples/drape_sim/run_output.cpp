@@ -181,6 +181,7 @@ nlohmann::json FrameJson(const FrameStats& f) {
           {"contacts", f.contacts},
           {"hull_contacts", f.hull_contacts},
           {"body_map_contacts", f.body_map_contacts},
+          {"shape_contacts", f.shape_contacts},
           {"inside_particles", f.inside_particles},
           {"max_penetration_mm", f.max_penetration * 1000.f},
           {"max_stretch", f.max_stretch},

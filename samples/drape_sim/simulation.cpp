@@ -168,11 +168,22 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
     has_maps_ = true;
   }
 
+  // The engine shapes, placed from the rest pose.
+  {
+    SkeletonPose rest;
+    if (Status s = rest.Init(asset.skeleton); !s.ok()) return s;
+    rest.SetRest();
+    if (Status s = scene_shapes_.Init(scene, asset.skeleton, rest.skinning()); !s.ok()) return s;
+    shapes_.Reserve(scene_shapes_.size(), 0);
+  }
+
   // Garments, placed at the start pose.
   if (Status s = Pose(scene.animation.start, &skin_start_); !s.ok()) return s;
   skin_end_ = skin_start_;
   ClothSolverSettings settings = scene.solver;
-  if (scene.relative) {
+  // `relative` is linear inertia 0; any inertia below 1 is relative to the root joint.
+  if (scene.relative) settings.linear_inertia = 0.f;
+  if (settings.linear_inertia < 1.f || settings.angular_inertia < 1.f) {
     settings.root_joint = 0;
     Mat34 root;
     if (!asset.skeleton.inverse_bind.empty() &&
@@ -181,7 +192,8 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
   }
   for (size_t g = 0; g < scene.garments.size(); ++g) {
     auto garment = std::make_unique<Garment>();
-    if (Status s = bake::ResolveGarment(scene, g, asset.skeleton, &garment->resolved); !s.ok())
+    if (Status s = bake::ResolveGarment(scene, g, asset.skeleton, &garment->resolved, &asset.mesh);
+        !s.ok())
       return s;
     const std::string at = where + scene.garments[g].path + ": ";
     if (Status s = BuildCloth(garment->resolved.description, &garment->cloth); !s.ok())
@@ -194,9 +206,15 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
     if (Status s = garment->solver.Init(garment->cloth, garment_settings); !s.ok())
       return Status(s.code(), at + s.message());
     garment->state.Reset(garment->cloth);
-    bake::PlaceGarment(garment->resolved, skin_start_, &garment->start_positions);
-    garment->state.positions = garment->start_positions;
-    garment->state.previous_positions = garment->start_positions;
+    if (garment->cloth.skinned()) {  // at its skinned positions
+      if (Status s = garment->solver.Reset(&garment->state, {}, skin_start_); !s.ok())
+        return Status(s.code(), at + s.message());
+      garment->start_positions = garment->state.positions;
+    } else {
+      bake::PlaceGarment(garment->resolved, skin_start_, &garment->start_positions);
+      garment->state.positions = garment->start_positions;
+      garment->state.previous_positions = garment->start_positions;
+    }
     garments_.push_back(std::move(garment));
   }
   return Status::Ok();
@@ -244,6 +262,11 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
                                       : 0.f;
     colliders.body_map = &maps_.At(map_time, &map_scratch_);
   }
+  if (!scene_shapes_.empty()) {
+    if (Status s = scene_shapes_.Pose(skin_start_, skin_end_, &shapes_); !s.ok())
+      return Status(s.code(), scene_->source + ": " + s.message());
+    colliders.shapes = &shapes_;
+  }
   ClothFrame cloth_frame;
   cloth_frame.dt = scene_->dt;
   cloth_frame.skinning_start = skin_start_;
@@ -260,6 +283,7 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
     stats->contacts += step.contacts;
     stats->hull_contacts += step.hull_contacts;
     stats->body_map_contacts += step.body_map_contacts;
+    stats->shape_contacts += step.shape_contacts;
     stats->max_stretch = std::max(stats->max_stretch, step.max_stretch);
     if (!result.ok()) {
       result = Status(result.code(), scene_->source + ": frame " + std::to_string(frame) + ", " +

@@ -19,7 +19,9 @@
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/hull_collider_set.h"
+#include "drape/runtime/shape_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
+#include "scene_shapes.h"
 
 namespace drape::sim {
 
@@ -30,6 +32,7 @@ struct FrameStats {
   uint32_t contacts = 0;           // particles in contact in the last substep, all garments
   uint32_t hull_contacts = 0;      // hulls and spheres, summed over substeps
   uint32_t body_map_contacts = 0;  // summed over substeps
+  uint32_t shape_contacts = 0;     // the scene's engine shapes, summed over substeps
   // After the step, at the frame's end pose: particles inside a collider the scene uses and the
   // deepest of them (metres), from HullColliderSet::Query and BodyMapCollider::Query of the
   // particle's position (a point query).
@@ -140,6 +143,8 @@ class SceneSimulation {
   BodyMapCollider rendered_maps_;
   bool renders_maps_ = false;
   std::vector<std::unique_ptr<Garment>> garments_;
+  SceneShapes scene_shapes_;  // the scene's engine colliders, posed per frame into shapes_
+  ShapeColliderSet shapes_;
 };
 
 // The clip time a scene time plays (wrapped when looping, clamped to the clip).

@@ -1,7 +1,10 @@
 // What a game engine does with drape, through the installed runtime alone: load a .drape, then
 // every frame hand the runtime the engine's own joint world matrices (here sampled from the
-// file's first clip, standing in for the engine's animation system) and step a skirt held at the
-// root joint against the hull and sphere colliders.   Usage: engine_sample FILE.drape
+// file's first clip, standing in for the engine's animation system) and step a skirt skinned to
+// the root joint (its waistband follows the skin exactly, the rest within 15 cm of it) against
+// the hull and sphere colliders and the engine's own shapes: a floor and a capsule (a staff the
+// engine swings through the skirt).   Usage: engine_sample FILE.drape
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -9,6 +12,7 @@
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/garments.h"
 #include "drape/runtime/math.h"
+#include "drape/runtime/shape_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
 
 static bool Check(const drape::Status& s) {
@@ -44,15 +48,33 @@ int main(int argc, char** argv) {
   shape.top_radius = 0.19f;
   drape::GarmentMesh mesh;
   if (!Check(drape::MakeSkirt(shape, &mesh))) return 1;
-  drape::ClothDescription description = drape::DescribeAttachedGarment(mesh, 0);
+  // Skinned: every particle carried by the root joint (weight 1), the waistband exactly (max
+  // distance 0), the rest free within 15 cm of where the skin puts it.
+  drape::ClothDescription description;
+  description.positions = mesh.positions;
+  description.triangles = mesh.triangles;
+  description.skin.assign(mesh.positions.size(), drape::ClothSkinWeights{});
+  for (drape::ClothSkinWeights& w : description.skin) w.weights[0] = 1.f;
+  description.max_distance.assign(mesh.positions.size(), 0.15f);
+  for (const uint32_t waist : mesh.held) description.max_distance[waist] = 0.f;
   drape::Cloth cloth;
   drape::ClothSolver solver;
-  drape::ClothSolverSettings settings = drape::ClothSolverSettings::PaperB();
+  drape::ClothSolverSettings settings;  // tethers, a 10 % strain limit, Verlet
   settings.substeps = 4;
   if (!Check(drape::BuildCloth(description, &cloth)) || !Check(solver.Init(cloth, settings)))
     return 1;
   drape::ClothState state;
   state.Reset(cloth);
+  // The engine's own colliders, re-posed every frame: room for two, allocated once.
+  drape::ShapeColliderSet engine_shapes;
+  engine_shapes.Reserve(2, 0);
+  const auto staff_at = [&](int frame) {  // a 0.6 m capsule sweeping side to side at knee height
+    drape::Mat34 m;
+    m.m[3] = root.m[3] + 0.4f * std::sin(0.05f * static_cast<float>(frame));
+    m.m[7] = root.m[7] * 0.5f;
+    m.m[11] = root.m[11] + 0.25f;
+    return m;
+  };
   const float dt = 1.f / 60.f;
   std::vector<drape::Mat34> start(joints), end(joints);
   for (int frame = 0; frame <= 120; ++frame) {
@@ -61,13 +83,23 @@ int main(int argc, char** argv) {
         !Check(pose.SetJointWorldMatrices(engine_animation.world())))
       return 1;
     end.assign(pose.skinning().begin(), pose.skinning().end());
-    if (frame == 0) start = end;
-    drape::ClothColliders hit{nullptr, &colliders, {}};
+    if (frame == 0) {
+      start = end;
+      if (!Check(solver.Reset(&state, {}, end))) return 1;  // at the skinned positions
+    }
+    engine_shapes.Clear();
+    if (!Check(engine_shapes.AddPlane(drape::Mat34{}, drape::Mat34{})) ||  // the floor, y = 0
+        !Check(engine_shapes.AddCapsule(staff_at(frame - 1), staff_at(frame), 0.3f, 0.03f, 0.03f)))
+      return 1;
+    drape::ClothColliders hit;
+    hit.hulls = &colliders;
+    hit.shapes = &engine_shapes;
     drape::ClothStepStats stats;
     if (!Check(solver.Step(&state, hit, {dt, start, end}, &stats))) return 1;
     if (frame % 30 == 0)
-      std::printf("engine_sample: frame %3d  contacts %4u  max stretch %.3f\n", frame,
-                  stats.contacts, static_cast<double>(stats.max_stretch));
+      std::printf(
+          "engine_sample: frame %3d  contacts %4u (staff and floor %3u)  max stretch %.3f\n", frame,
+          stats.contacts, stats.shape_contacts, static_cast<double>(stats.max_stretch));
     start = end;
   }
   return 0;

@@ -337,6 +337,54 @@ TEST_F(SceneTest, ResolutionErrorsNameTheirPath) {
   EXPECT_NE(s.message().find("(clips: walk)"), std::string::npos) << s.message();
 }
 
+// A skinned skirt: weights from the mannequin's closest body points (smoothed), so at the bind
+// pose every particle's skinned position is where it was authored, the waist stays attached, the
+// free particles get the max distance and backstop, and the hem (between the legs) blends both
+// thighs after smoothing. Without a body mesh the scene is refused with the garment's path.
+TEST_F(SceneTest, SkinnedGarmentTakesItsWeightsFromTheBody) {
+  json j = DemoJson();
+  j["garments"][0]["skin"] = {{"max_distance", 0.06}, {"backstop", 0.01}};
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  ResolvedGarment garment;
+  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment, &asset().mesh);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const ClothDescription& d = garment.description;
+  ASSERT_EQ(d.skin.size(), d.positions.size());
+  ASSERT_EQ(d.attachments.size(), 64u);
+  std::vector<Mat34> bind(asset().skeleton.joint_count());  // skinning = identity at the bind pose
+  const int32_t left = FindJoint(asset().skeleton, "hip_l"),
+                right = FindJoint(asset().skeleton, "hip_r");
+  uint32_t hem_on_both_thighs = 0;
+  for (size_t i = 0; i < d.positions.size(); ++i) {
+    Float3 skinned;
+    float sum = 0.f;
+    float on_left = 0.f, on_right = 0.f;
+    for (int k = 0; k < 4; ++k) {
+      skinned += TransformPoint(bind[d.skin[i].joints[k]], d.skin_bind_positions[i]) *
+                 d.skin[i].weights[k];
+      sum += d.skin[i].weights[k];
+      if (static_cast<int32_t>(d.skin[i].joints[k]) == left) on_left += d.skin[i].weights[k];
+      if (static_cast<int32_t>(d.skin[i].joints[k]) == right) on_right += d.skin[i].weights[k];
+    }
+    ASSERT_NEAR(sum, 1.f, 1e-5f) << i;
+    ASSERT_LT(Length(skinned - d.positions[i]), 1e-5f) << i;
+    const bool held = i < 64;  // the waist ring
+    EXPECT_EQ(d.max_distance[i], held ? std::numeric_limits<float>::infinity() : 0.06f) << i;
+    EXPECT_EQ(d.backstop[i], held ? std::numeric_limits<float>::infinity() : 0.01f) << i;
+    if (i >= d.positions.size() - 64 && on_left > 0.1f && on_right > 0.1f) ++hem_on_both_thighs;
+  }
+  EXPECT_GT(hem_on_both_thighs, 8u);
+  Cloth cloth;
+  EXPECT_TRUE(BuildCloth(d, &cloth).ok());
+  s = ResolveGarment(scene, 0, asset().skeleton, &garment);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.message().rfind("scene.json: /garments/0/skin: the asset has no body mesh", 0), 0u)
+      << s.message();
+  j["garments"][0]["skin"] = {{"max_distance", -1}};
+  EXPECT_FALSE(Parse(j, &scene).ok());
+}
+
 TEST_F(SceneTest, GarmentIsHeldInTheBindFrame) {
   Scene scene;
   ASSERT_TRUE(LoadScene(DemoPath(), &scene).ok());

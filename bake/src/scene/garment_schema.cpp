@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -200,7 +201,49 @@ const JsonSchema<SceneGarment>& MaterialSchema() {
           .Object("bend", SpringSchema(), "the bend springs",
                   [](SceneGarment& g) -> SpringMaterial& { return g.bend; })
           .Bool("bend_springs", "false: stretch springs only",
-                [](SceneGarment& g) -> bool& { return g.bend_springs; });
+                [](SceneGarment& g) -> bool& { return g.bend_springs; })
+          .Float("tether_stretch", "", Closed(0, 10),
+                 "how far beyond its geodesic distance to the held particles a particle may go "
+                 "(the long-range tethers of `/solver/tethers`)",
+                 [](SceneGarment& g) -> float& { return g.tether_stretch; });
+  return schema;
+}
+
+// ---- /garments/i/skin ----------------------------------------------------------------------
+
+// A distance in metres, or "none" (+inf: no limit).
+Status ReadDistanceOrNone(const JsonAt& at, float* out) {
+  if (at.value().is_string()) {
+    if (at.value().get<std::string>() != "none")
+      return at.Error("must be a number in [0, 100] (metres) or \"none\"");
+    *out = std::numeric_limits<float>::infinity();
+    return Status::Ok();
+  }
+  return ReadFloat(at, Closed(0, 100), out);
+}
+
+const JsonSchema<SceneGarment>& SkinSchema() {
+  static const JsonSchema<SceneGarment> schema =
+      JsonSchema<SceneGarment>(
+          "A skinned garment: each particle takes the skin weights of the closest point of the "
+          "character's body and follows the skinned surface within `max_distance`, never more "
+          "than `backstop` behind it (along the garment's normal: the side its triangles' "
+          "counter-clockwise winding faces, which should face away from the body). Attached "
+          "and pinned particles stay held.")
+          .Custom(CustomFieldInfo("max_distance", "metres ≥ 0 or `\"none\"`",
+                                  "a number in [0, 100] or \"none\"",
+                                  "how far a particle may move from its skinned position (0: it "
+                                  "follows the skin exactly)"),
+                  [](const JsonAt& at, SceneGarment& g) {
+                    return ReadDistanceOrNone(at, &g.max_distance);
+                  })
+          .Default("0.05")
+          .Custom(
+              CustomFieldInfo("backstop", "metres ≥ 0 or `\"none\"`",
+                              "a number in [0, 100] or \"none\"",
+                              "how far behind its skinned position a particle may go"),
+              [](const JsonAt& at, SceneGarment& g) { return ReadDistanceOrNone(at, &g.backstop); })
+          .Default("none");
   return schema;
 }
 
@@ -314,7 +357,8 @@ const JsonSchema<SceneGarment>& GarmentSchema() {
           "joint of its nearest held particle (along the mesh), from `frame` to that pose. "
           "Attached particles then follow their joint exactly (paper B's geometric constraints); "
           "pinned ones stay put. A garment with no held particle falls freely. Garments do not "
-          "collide with each other; nothing collides with a floor. A garment has at most 2^20 "
+          "collide with each other; a floor is one of `/collision/shapes`. A garment has at most "
+          "2^20 "
           "particles.")
           .Enum<GarmentType>("type",
                              {{"sheet", GarmentType::kSheet},
@@ -355,6 +399,18 @@ const JsonSchema<SceneGarment>& GarmentSchema() {
           .Default("the generator's defaults")
           .Object("material", MaterialSchema(), "the cloth material",
                   [](SceneGarment& g) -> SceneGarment& { return g; })
+          .Custom(
+              CustomFieldInfo("skin", "object", "an object",
+                              "skin the garment to the body (weights from its closest point)"),
+              [](const JsonAt& at, SceneGarment& g) {
+                g.skinned = true;
+                return SkinSchema().Read(at, &g);
+              },
+              nullptr,
+              [](const SceneGarment& defaults, const std::string& path, std::string* out) {
+                SkinSchema().WriteSections(defaults, path, "`" + path + "`", out);
+              })
+          .Default("not skinned")
           .Custom(
               CustomFieldInfo("attach", "object or array of objects",
                               "an object or an array of objects", "selections held by joints"),

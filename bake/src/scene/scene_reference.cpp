@@ -24,6 +24,9 @@ constexpr SampleScene kSampleScenes[] = {
      "rendered for every frame"},
     {"cesium_man_cape.json", "`CesiumMan.glb` (shared assets)",
      "a cape held at the upper torso, body maps rendered per frame + hulls"},
+    {"cesium_man_skinned_dress.json", "`CesiumMan.glb` (shared assets)",
+     "a dress skinned to the body (weights from the closest body point, smoothed; max distance "
+     "and backstop) whose hem nears a floor the scene adds (`/collision/shapes`)"},
     {"robot_expressive_cape.json", "`RobotExpressive.glb` (shared assets)",
      "a cape on a rigid-part robot (4.4 m tall as authored), 18 hulls"},
     {"animated_human_skirt.json", "`Animated_Human.fbx` (shared assets)",

@@ -1,10 +1,12 @@
 #include "scene/scene_schema.h"
 
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "config/bake_config_schema.h"
+#include "drape/runtime/math.h"
 #include "scene/garment_schema.h"
 #include "scene/scene_messages.h"
 
@@ -58,6 +60,49 @@ const JsonSchema<SceneAnimation>& AnimationSchema() {
               return at.Member("pose").Error("give either a clip or a static pose, not both");
             if (!a.blend_clip.empty() && a.clip.empty())
               return at.Member("blend_clip").Error("blends with `clip`: give a clip too");
+            return Status::Ok();
+          });
+  return schema;
+}
+
+const JsonSchema<SceneShape>& ShapeSchema() {
+  constexpr double kLimit = 1e4;  // metres
+  static const JsonSchema<SceneShape> schema =
+      JsonSchema<SceneShape>(
+          "An engine collider (drape/runtime/shape_collider_set.h): continuous collision and the "
+          "scene's friction like the character's colliders. Positions in the world at the rest "
+          "pose; with a `joint` the shape moves with it.")
+          .Enum<SceneShapeType>("type",
+                                {{"plane", SceneShapeType::kPlane},
+                                 {"sphere", SceneShapeType::kSphere},
+                                 {"capsule", SceneShapeType::kCapsule},
+                                 {"box", SceneShapeType::kBox}},
+                                "a half-space (a floor), a sphere, a tapered capsule or a box",
+                                [](SceneShape& s) -> SceneShapeType& { return s.type; })
+          .Required()
+          .String("joint", StringRule::kNonEmpty, "the joint that carries it (none: fixed)",
+                  [](SceneShape& s) -> std::string& { return s.joint; })
+          .Vector("center", "m", kLimit, "plane: a point on it; sphere, box: the centre",
+                  [](SceneShape& s) -> Float3& { return s.center; })
+          .Vector("normal", "", 1, "plane: the outward normal (normalised)",
+                  [](SceneShape& s) -> Float3& { return s.normal; })
+          .Vector("from", "m", kLimit, "capsule: the centre of one end sphere",
+                  [](SceneShape& s) -> Float3& { return s.from; })
+          .Vector("to", "m", kLimit, "capsule: the centre of the other",
+                  [](SceneShape& s) -> Float3& { return s.to; })
+          .Float("radius", "m", OpenBelow(0, 100), "sphere; capsule at `from`",
+                 [](SceneShape& s) -> float& { return s.radius; })
+          .Float("radius_to", "m", OpenBelow(0, 100), "capsule at `to`",
+                 [](SceneShape& s) -> float& { return s.radius_to; })
+          .Default("`radius`")
+          .Vector("half_extents", "m", 100, "box: half its size along x, y, z (each > 0)",
+                  [](SceneShape& s) -> Float3& { return s.half_extents; })
+          .Rule([](const JsonAt& at, SceneShape& s) {
+            if (s.type == SceneShapeType::kPlane && !(Length(s.normal) > 1e-6f))
+              return at.Member("normal").Error("must not be zero");
+            if (s.type == SceneShapeType::kBox &&
+                !(s.half_extents.x > 0.f && s.half_extents.y > 0.f && s.half_extents.z > 0.f))
+              return at.Member("half_extents").Error("each must be > 0");
             return Status::Ok();
           });
   return schema;
@@ -154,7 +199,29 @@ const JsonSchema<Scene>& CollisionSchema() {
                  "how much the cloth may stretch beyond its rest lengths, for the reach radius",
                  [](Scene& s) -> float& { return s.reach_stretch; })
           .Bool("prune", "drop the colliders the garments cannot reach before simulating",
-                [](Scene& s) -> bool& { return s.prune; });
+                [](Scene& s) -> bool& { return s.prune; })
+          .Custom(
+              CustomFieldInfo("shapes", "array of objects", "an array of shapes",
+                              "the engine's own colliders (a floor, props), besides the "
+                              "character's"),
+              [](const JsonAt& at, Scene& scene) {
+                if (!at.value().is_array())
+                  return at.Error(std::string("must be an array of shapes, not ") +
+                                  JsonTypeName(at.value()));
+                for (size_t i = 0; i < at.value().size(); ++i) {
+                  const JsonAt element = at.Element(i);
+                  SceneShape shape;
+                  shape.path = element.path();
+                  DRAPE_RETURN_IF_ERROR(ShapeSchema().Read(element, &shape));
+                  scene.shapes.push_back(std::move(shape));
+                }
+                return Status::Ok();
+              },
+              nullptr,
+              [](const Scene&, const std::string& path, std::string* out) {
+                ShapeSchema().WriteSections(SceneShape{}, path + "/i", "`" + path + "/i`", out);
+              })
+          .Default("none");
   return schema;
 }
 
@@ -201,8 +268,45 @@ const JsonSchema<Scene>& SolverSchema() {
                  [](Scene& s) -> float& { return s.solver.drag; })
           .Vector("wind", "m/s", 1e3, "the air's velocity",
                   [](Scene& s) -> Float3& { return s.solver.wind; })
-          .Float("friction", "", Closed(0, 1), "paper A eq. 5 c_fric",
+          .Bool("tethers",
+                "long-range tethers from every particle to the held ones (geodesic lengths; "
+                "the garment's `tether_stretch`)",
+                [](Scene& s) -> bool& { return s.solver.tethers; })
+          .Custom(CustomFieldInfo("max_stretch", "number ≥ 0 or `\"none\"`",
+                                  "a number >= 0 or \"none\"",
+                                  "strain limit: after the iterations no stretch spring stays "
+                                  "longer than rest × (1 + this)"),
+                  [](const JsonAt& at, Scene& s) {
+                    if (at.value().is_string()) {
+                      if (at.value().get<std::string>() != "none")
+                        return at.Error("must be a number >= 0 or \"none\"");
+                      s.solver.max_stretch = std::numeric_limits<float>::infinity();
+                      return Status::Ok();
+                    }
+                    return ReadFloat(at, Closed(0, 100), &s.solver.max_stretch);
+                  })
+          .Default("0.1")
+          .Float("linear_inertia", "", Closed(0, 1),
+                 "how much of the root's translation the cloth resists: 1 simulates in the "
+                 "world, 0 carries the cloth with the character",
+                 [](Scene& s) -> float& { return s.solver.linear_inertia; })
+          .Float("angular_inertia", "", Closed(0, 1), "the same for the root's rotation",
+                 [](Scene& s) -> float& { return s.solver.angular_inertia; })
+          .Float("centrifugal_inertia", "", Closed(0, 1),
+                 "the outward push of a carried rotation (1: as in the world)",
+                 [](Scene& s) -> float& { return s.solver.centrifugal_inertia; })
+          .Enum<FrictionModel>(
+              "friction_model",
+              {{"coulomb", FrictionModel::kCoulomb}, {"paper_a", FrictionModel::kPaperA}},
+              "`coulomb`: static and kinetic friction (a particle sticks while its sliding speed "
+              "is below static_friction × the speed it hit with); `paper_a`: eq. 5's scaling "
+              "of the tangential velocity by 1 − friction",
+              [](Scene& s) -> FrictionModel& { return s.response.friction_model; })
+          .Float("friction", "", Closed(0, 1),
+                 "Coulomb's kinetic coefficient, or paper A eq. 5 c_fric",
                  [](Scene& s) -> float& { return s.response.friction; })
+          .Float("static_friction", "", Closed(0, 4), "Coulomb's static coefficient",
+                 [](Scene& s) -> float& { return s.response.static_friction; })
           .Float("restitution", "", Closed(0, 1), "paper A eq. 5 c_res",
                  [](Scene& s) -> float& { return s.response.restitution; })
           .Float("separation", "m", Closed(0, 0.1),

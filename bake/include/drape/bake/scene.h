@@ -74,10 +74,34 @@ struct SceneGarment {
   SpringMaterial stretch;
   SpringMaterial bend{20.f, 0.01f, 0.2f};
   bool bend_springs = true;
-  std::vector<SceneAttachment> attachments;       // particles moving rigidly with a joint
-  std::vector<SceneSelection> pins;               // particles fixed in the world
+  std::vector<SceneAttachment> attachments;  // particles moving rigidly with a joint
+  std::vector<SceneSelection> pins;          // particles fixed in the world
+  // A skinned garment: every particle carried by the body's skin weights at its closest body
+  // point, free within max_distance of that skinned position and outside the backstop plane
+  // that far behind it (+inf: unlimited / none). Attached and pinned particles stay held.
+  bool skinned = false;
+  float max_distance = 0.05f;                               // metres, >= 0
+  float backstop = std::numeric_limits<float>::infinity();  // metres, >= 0
+  uint32_t skin_smoothing = 20;  // passes averaging the weights with the mesh neighbours
+  float tether_stretch = 0.02f;  // long-range tethers' allowed stretch, >= 0
   std::array<float, 3> color{0.8f, 0.25f, 0.3f};  // linear RGB in [0, 1], for pictures
   std::string path;                               // "/garments/<index>"
+};
+
+// An engine collider of the scene (drape/runtime/shape_collider_set.h): fixed in the world, or
+// carried by a joint. Positions are in the world at the rest pose; a carried shape moves with
+// its joint's world matrix from there.
+enum class SceneShapeType : uint8_t { kPlane, kSphere, kCapsule, kBox };
+struct SceneShape {
+  SceneShapeType type = SceneShapeType::kPlane;
+  std::string joint;                      // empty: fixed in the world
+  Float3 center;                          // plane: a point on it; sphere, box: the centre; metres
+  Float3 normal{0.f, 1.f, 0.f};           // plane: the outward normal (the solid side is behind it)
+  Float3 from, to;                        // capsule: the centres of its end spheres, metres
+  float radius = 0.1f;                    // sphere; capsule at `from`; metres, > 0
+  float radius_to = -1.f;                 // capsule at `to` (< 0: radius), metres
+  Float3 half_extents{0.1f, 0.1f, 0.1f};  // box, axis-aligned, metres
+  std::string path;                       // "/collision/shapes/<index>"
 };
 
 enum class ScenePose : uint8_t { kRest, kBind };
@@ -131,13 +155,15 @@ struct Scene {
   MapSource maps_source = MapSource::kRendered;
   PoseBlend maps_blend = PoseBlend::kBracket;  // kBaked only
   HullColliderOptions hull_options;
-  float reach_margin = 0.05f;   // metres added to each garment's reach radius, >= 0
-  float reach_stretch = 0.15f;  // fraction the cloth may stretch beyond its rest lengths, >= 0
-  bool prune = true;            // drape-sim drops colliders the garments cannot reach
+  float reach_margin = 0.05f;      // metres added to each garment's reach radius, >= 0
+  float reach_stretch = 0.15f;     // fraction the cloth may stretch beyond its rest lengths, >= 0
+  bool prune = true;               // drape-sim drops colliders the garments cannot reach
+  std::vector<SceneShape> shapes;  // the engine's own colliders: floors, props
 
   // Solver. settings.root_joint/root_bind_position are filled at resolution (relative).
+  // Engine defaults (long-range tethers, a 10 % strain limit) with paper B's Verlet.
   ClothSolverSettings solver = [] {
-    ClothSolverSettings s = ClothSolverSettings::PaperB();
+    ClothSolverSettings s;
     s.substeps = 4;
     s.iterations = 5;
     s.damping = 0.2f;
@@ -146,7 +172,7 @@ struct Scene {
   bool auto_substeps = false;  // explicit Euler: RecommendedEulerSubsteps per garment
   bool relative = false;       // relative simulation against the skeleton's root joint
   float dt = 1.f / 60.f;       // seconds per frame, (0, 1]
-  ResponseParams response{0.3f, 0.f, 1e-3f};
+  ResponseParams response{0.3f, 0.f, 1e-3f, 0.5f};  // Coulomb: kinetic 0.3, static 0.5
 
   SceneOutput output;
 
@@ -226,8 +252,9 @@ struct ResolvedGarment {
 // Builds garment `index` of the scene against the skeleton: generator or OBJ mesh, anchoring,
 // selections (errors name the JSON path: unknown ring, vertex index out of range, empty box,
 // unknown joint, a particle both attached and pinned ...). Allocates.
+// A skinned garment takes its weights from `body` (the asset's mesh; refused when null).
 Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skeleton,
-                      ResolvedGarment* out);
+                      ResolvedGarment* out, const MeshData* body = nullptr);
 
 // Positions of the garment at a pose: every particle moved rigidly by its carrier joint's
 // skinning matrix from the garment frame (S[j] * frame_to_bind[j] * p); particles without one

@@ -1,0 +1,146 @@
+#include "scene/garment_skinning.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "drape/bake/mesh_reference.h"
+
+namespace drape::bake::detail {
+namespace {
+
+// Barycentric coordinates of p (on or near the triangle abc), in double; equal thirds for a
+// degenerate triangle.
+std::array<double, 3> Barycentric(const double p[3], Float3 a, Float3 b, Float3 c) {
+  const double e0[3] = {double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z};
+  const double e1[3] = {double(c.x) - a.x, double(c.y) - a.y, double(c.z) - a.z};
+  const double q[3] = {p[0] - a.x, p[1] - a.y, p[2] - a.z};
+  const auto dot = [](const double* u, const double* v) {
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+  };
+  const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1);
+  const double d20 = dot(q, e0), d21 = dot(q, e1);
+  const double det = d00 * d11 - d01 * d01;
+  if (!(std::abs(det) > 1e-30 * (d00 * d11 + 1e-300))) return {1.0 / 3, 1.0 / 3, 1.0 / 3};
+  const double v = (d11 * d20 - d01 * d21) / det;
+  const double w = (d00 * d21 - d01 * d20) / det;
+  return {std::clamp(1.0 - v - w, 0.0, 1.0), std::clamp(v, 0.0, 1.0), std::clamp(w, 0.0, 1.0)};
+}
+
+}  // namespace
+
+Status TransferSkinWeights(const MeshData& body, std::span<const Float3> body_positions,
+                           std::span<const Float3> garment, std::vector<ClothSkinWeights>* weights,
+                           std::vector<float>* distances) {
+  if (body.triangles.empty() || body_positions.size() != body.positions.size())
+    return Status(StatusCode::kInvalidArgument,
+                  "skin weights from the body: the asset has no body mesh");
+  if (body.influence_offsets.size() != body.positions.size() + 1 || body.influence_joints.empty())
+    return Status(StatusCode::kInvalidArgument,
+                  "skin weights from the body: the asset's body mesh has no skin influences");
+  const MeshReference surface(body_positions, body.triangles);
+  weights->assign(garment.size(), ClothSkinWeights{});
+  if (distances != nullptr) distances->assign(garment.size(), 0.f);
+  std::vector<std::pair<uint32_t, double>> blend;  // (joint, weight), merged by joint
+  for (size_t i = 0; i < garment.size(); ++i) {
+    const double q[3] = {garment[i].x, garment[i].y, garment[i].z};
+    double point[3];
+    uint32_t triangle = 0;
+    const double distance = surface.ClosestPoint(q, point, &triangle, nullptr);
+    if (!std::isfinite(distance))
+      return Status(StatusCode::kInvalidArgument, "skin weights from the body: particle " +
+                                                      std::to_string(i) +
+                                                      " has no closest body point (not finite)");
+    if (distances != nullptr) (*distances)[i] = static_cast<float>(distance);
+    const uint32_t* corner = &body.triangles[3 * size_t{triangle}];
+    const std::array<double, 3> bary = Barycentric(
+        point, body_positions[corner[0]], body_positions[corner[1]], body_positions[corner[2]]);
+    blend.clear();
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = corner[k];
+      for (uint32_t f = body.influence_offsets[v]; f < body.influence_offsets[v + 1]; ++f) {
+        const uint32_t joint = body.influence_joints[f];
+        const double w = bary[k] * body.influence_weights[f];
+        const auto it = std::find_if(blend.begin(), blend.end(),
+                                     [&](const auto& e) { return e.first == joint; });
+        if (it != blend.end())
+          it->second += w;
+        else
+          blend.emplace_back(joint, w);
+      }
+    }
+    // The four heaviest, ties by joint index (deterministic), renormalised.
+    std::sort(blend.begin(), blend.end(), [](const auto& a, const auto& b) {
+      return a.second != b.second ? a.second > b.second : a.first < b.first;
+    });
+    double sum = 0.0;
+    const size_t kept = std::min<size_t>(4, blend.size());
+    for (size_t k = 0; k < kept; ++k) sum += blend[k].second;
+    ClothSkinWeights& out = (*weights)[i];
+    if (!(sum > 0.0)) {  // corners without influences: the root carries the particle
+      out.weights[0] = 1.f;
+      continue;
+    }
+    for (size_t k = 0; k < kept; ++k) {
+      out.joints[k] = blend[k].first;
+      out.weights[k] = static_cast<float>(blend[k].second / sum);
+    }
+  }
+  return Status::Ok();
+}
+
+void SmoothSkinWeights(std::span<const uint32_t> triangles, uint32_t iterations,
+                       std::vector<ClothSkinWeights>* weights) {
+  const size_t n = weights->size();
+  std::vector<std::vector<uint32_t>> neighbours(n);
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = triangles[t + e], b = triangles[t + (e + 1) % 3];
+      neighbours[a].push_back(b);
+      neighbours[b].push_back(a);
+    }
+  }
+  for (std::vector<uint32_t>& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  std::vector<ClothSkinWeights> next(n);
+  std::vector<std::pair<uint32_t, double>> blend;
+  for (uint32_t it = 0; it < iterations; ++it) {
+    for (size_t i = 0; i < n; ++i) {
+      blend.clear();
+      const auto add = [&](const ClothSkinWeights& w, double scale) {
+        for (int k = 0; k < 4; ++k) {
+          if (!(w.weights[k] > 0.f)) continue;
+          const auto found = std::find_if(blend.begin(), blend.end(),
+                                          [&](const auto& e) { return e.first == w.joints[k]; });
+          if (found != blend.end())
+            found->second += w.weights[k] * scale;
+          else
+            blend.emplace_back(w.joints[k], w.weights[k] * scale);
+        }
+      };
+      // Half its own weights, half its neighbours' mean.
+      add((*weights)[i], neighbours[i].empty() ? 1.0 : 0.5);
+      const double share = 0.5 / static_cast<double>(neighbours[i].size());
+      for (const uint32_t j : neighbours[i]) add((*weights)[j], share);
+      std::sort(blend.begin(), blend.end(), [](const auto& a, const auto& b) {
+        return a.second != b.second ? a.second > b.second : a.first < b.first;
+      });
+      const size_t kept = std::min<size_t>(4, blend.size());
+      double sum = 0.0;
+      for (size_t k = 0; k < kept; ++k) sum += blend[k].second;
+      ClothSkinWeights out;
+      for (size_t k = 0; k < kept; ++k) {
+        out.joints[k] = blend[k].first;
+        out.weights[k] = static_cast<float>(blend[k].second / sum);
+      }
+      next[i] = out;
+    }
+    weights->swap(next);
+  }
+}
+
+}  // namespace drape::bake::detail

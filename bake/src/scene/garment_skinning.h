@@ -1,0 +1,31 @@
+#pragma once
+// Skin weights for a garment from the body it is worn on (drape-sim's skinned garments).
+
+#include <span>
+#include <vector>
+
+#include "drape/formats/mesh_data.h"
+#include "drape/formats/status.h"
+#include "drape/formats/types.h"
+#include "drape/runtime/cloth.h"
+
+namespace drape::bake::detail {
+
+// Each garment particle takes the skin weights of the closest point of the body's surface: the
+// barycentric blend of that triangle's corners' influences, the four largest kept and
+// renormalised. body_positions: the body's vertices in the garment's frame (the bind positions,
+// or the body posed at the rest pose for a garment authored there). distances (optional):
+// metres from each particle to the body. kInvalidArgument when the body has no triangles or no
+// skin influences.
+Status TransferSkinWeights(const MeshData& body, std::span<const Float3> body_positions,
+                           std::span<const Float3> garment, std::vector<ClothSkinWeights>* weights,
+                           std::vector<float>* distances = nullptr);
+
+// Averages each particle's weights with its mesh neighbours' `iterations` times (Jacobi, the four
+// heaviest joints kept): a skirt's particles between the legs, which the closest body point gives
+// to one thigh, get a blend of both thighs and the hips, so the skirt does not split like
+// trousers when the legs stride.
+void SmoothSkinWeights(std::span<const uint32_t> triangles, uint32_t iterations,
+                       std::vector<ClothSkinWeights>* weights);
+
+}  // namespace drape::bake::detail
