@@ -20,6 +20,8 @@
 #include <random>
 #include <vector>
 
+#include "rigid_poses.h"
+
 #include "drape/runtime/math.h"
 #include "drape/runtime/shape_collider_set.h"
 
@@ -29,21 +31,7 @@ namespace {
 constexpr float kFrame = 1.f / 60.f;  // seconds
 constexpr size_t kParticles = 10000;
 
-// Rotation by `degrees` about the unit `axis`, then the translation.
-Mat34 Pose(Float3 translation, Float3 axis, double degrees) {
-  const double a = degrees * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a);
-  const double x = axis.x, y = axis.y, z = axis.z, t = 1.0 - c;
-  const double r[9] = {t * x * x + c,     t * x * y - s * z, t * x * z + s * y,
-                       t * x * y + s * z, t * y * y + c,     t * y * z - s * x,
-                       t * x * z - s * y, t * y * z + s * x, t * z * z + c};
-  Mat34 m;
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col) m.m[4 * row + col] = static_cast<float>(r[3 * row + col]);
-  m.m[3] = translation.x;
-  m.m[7] = translation.y;
-  m.m[11] = translation.z;
-  return m;
-}
+using test::Pose;
 
 struct Scene {
   ShapeColliderSet set;

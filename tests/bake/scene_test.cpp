@@ -385,6 +385,56 @@ TEST_F(SceneTest, SkinnedGarmentTakesItsWeightsFromTheBody) {
   EXPECT_FALSE(Parse(j, &scene).ok());
 }
 
+// An OBJ garment painted with vertex colours: the red channel scales max_distance per particle
+// (black: the particle follows the skin exactly, as a held one). Without colours: refused.
+TEST_F(SceneTest, SkinnedObjGarmentTakesItsPaintedMaxDistance) {
+  const std::string obj = ::testing::TempDir() + "/painted_band.obj";
+  {
+    std::ofstream out(obj);
+    // A band around the hips (the mannequin's hips at y = 0.95): 12 columns x 2 rows of quads,
+    // red 0 on the top ring, 0.5 in the middle, 1 at the bottom.
+    for (int row = 0; row < 3; ++row) {
+      for (int c = 0; c < 12; ++c) {
+        const double a = 2 * 3.14159265358979 * c / 12;
+        out << "v " << 0.2 * std::sin(a) << " " << 1.0 - 0.1 * row << " " << 0.2 * std::cos(a)
+            << " " << 0.5 * row << " 0 0\n";
+      }
+    }
+    for (int row = 0; row < 2; ++row)
+      for (int c = 0; c < 12; ++c)
+        out << "f " << row * 12 + c + 1 << " " << (row + 1) * 12 + c + 1 << " "
+            << (row + 1) * 12 + (c + 1) % 12 + 1 << " " << row * 12 + (c + 1) % 12 + 1 << "\n";
+  }
+  json j = DemoJson();
+  j["garments"][0] = {{"type", "obj"},
+                      {"shape", {{"file", obj}}},
+                      {"skin", {{"max_distance", 0.1}, {"paint", "r"}}}};
+  Scene scene;
+  {
+    const Status parsed = Parse(j, &scene);
+    ASSERT_TRUE(parsed.ok()) << parsed.message();
+  }
+  ResolvedGarment garment;
+  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment, &asset().mesh);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const ClothDescription& d = garment.description;
+  ASSERT_EQ(d.max_distance.size(), 36u);
+  for (size_t i = 0; i < 36; ++i)
+    EXPECT_NEAR(d.max_distance[i], 0.05f * static_cast<float>(i / 12), 1e-6f) << i;
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+  EXPECT_EQ(cloth.kinematic_particles().size(), 12u);  // the black ring
+  {
+    std::ofstream out(obj);
+    out << "v 0 1 0\nv 0.1 1 0\nv 0 1 0.1\nf 1 2 3\n";
+  }
+  s = ResolveGarment(scene, 0, asset().skeleton, &garment, &asset().mesh);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("/garments/0/skin/paint: the garment has no vertex colours"),
+            std::string::npos)
+      << s.message();
+}
+
 TEST_F(SceneTest, GarmentIsHeldInTheBindFrame) {
   Scene scene;
   ASSERT_TRUE(LoadScene(DemoPath(), &scene).ok());

@@ -3,6 +3,8 @@
 // friction on a slope, the round cone's distance against a brute-force reference, hostile
 // inputs, argument validation, thread-count independence and no allocation on re-adding.
 
+#include "rigid_poses.h"
+
 #include "drape/runtime/shape_collider_set.h"
 
 #include <gtest/gtest.h>
@@ -48,22 +50,7 @@ double Distance3(Float3 a, Float3 b) {
   return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-// Rotation by `degrees` about `axis` (normalised here), then the translation.
-Mat34 Pose(Float3 translation, Float3 axis = {0.f, 0.f, 1.f}, double degrees = 0.0) {
-  const double a = degrees * 3.14159265358979323846 / 180.0, c = std::cos(a), s = std::sin(a);
-  const double length = Distance3(axis, {});
-  const double x = axis.x / length, y = axis.y / length, z = axis.z / length, t = 1.0 - c;
-  const double r[9] = {t * x * x + c,     t * x * y - s * z, t * x * z + s * y,
-                       t * x * y + s * z, t * y * y + c,     t * y * z - s * x,
-                       t * x * z - s * y, t * y * z + s * x, t * z * z + c};
-  Mat34 m;
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col) m.m[4 * row + col] = static_cast<float>(r[3 * row + col]);
-  m.m[3] = translation.x;
-  m.m[7] = translation.y;
-  m.m[11] = translation.z;
-  return m;
-}
+using test::Pose;
 
 // The shape's signed distance at world point p, the shape posed by `pose`.
 double WorldDistance(const detail::LocalShape& shape, const Mat34& pose, Float3 p) {

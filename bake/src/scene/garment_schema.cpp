@@ -222,6 +222,20 @@ Status ReadDistanceOrNone(const JsonAt& at, float* out) {
   return ReadFloat(at, Closed(0, 100), out);
 }
 
+// "r", "g", "b" (a colour channel: 0, 1, 2) or "none" (-1).
+Status ReadPaintChannel(const JsonAt& at, SceneGarment& g) {
+  const std::string value = at.value().is_string() ? at.value().get<std::string>() : "";
+  const size_t channel = std::string("rgb").find(value);
+  if (value == "none") {
+    g.max_distance_channel = -1;
+  } else if (value.size() == 1 && channel != std::string::npos) {
+    g.max_distance_channel = static_cast<int32_t>(channel);
+  } else {
+    return at.Error("must be one of \"r\", \"g\", \"b\", \"none\"");
+  }
+  return Status::Ok();
+}
+
 const JsonSchema<SceneGarment>& SkinSchema() {
   static const JsonSchema<SceneGarment> schema =
       JsonSchema<SceneGarment>(
@@ -243,7 +257,19 @@ const JsonSchema<SceneGarment>& SkinSchema() {
                               "a number in [0, 100] or \"none\"",
                               "how far behind its skinned position a particle may go"),
               [](const JsonAt& at, SceneGarment& g) { return ReadDistanceOrNone(at, &g.backstop); })
-          .Default("none");
+          .Default("none")
+          .Custom(CustomFieldInfo("paint", "`\"r\"` \\| `\"g\"` \\| `\"b\"` \\| `\"none\"`",
+                                  "one of \"r\", \"g\", \"b\", \"none\"",
+                                  "an OBJ garment's vertex colour channel (`v x y z r g b`) that "
+                                  "scales `max_distance` per particle (painted black: the particle "
+                                  "follows the skin exactly)"),
+                  [](const JsonAt& at, SceneGarment& g) { return ReadPaintChannel(at, g); })
+          .Default("none")
+          .Unsigned<uint32_t>("smoothing", "", 0, 1000,
+                              "passes averaging each particle's weights with its mesh "
+                              "neighbours' (a skirt then follows the hips and both legs, not one "
+                              "leg on each side)",
+                              [](SceneGarment& g) -> uint32_t& { return g.skin_smoothing; });
   return schema;
 }
 

@@ -3,14 +3,17 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "scene/scene_messages.h"
 
 namespace drape::bake::detail {
 
 Status ReadObj(const std::string& file, const std::string& where, std::vector<Float3>* positions,
-               std::vector<uint32_t>* triangles) {
+               std::vector<uint32_t>* triangles, std::vector<Float3>* colors) {
   std::ifstream in(file);
+  std::vector<Float3> read_colors;
+  bool every_vertex_colored = true;
   if (!in) return Invalid(where + ": cannot open " + Quote(file));
   std::string line;
   uint32_t line_number = 0;
@@ -26,6 +29,15 @@ Status ReadObj(const std::string& file, const std::string& where, std::vector<Fl
         return Invalid(at + ": a vertex needs 3 finite coordinates");
       }
       positions->push_back({static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)});
+      double r = 0, g = 0, b = 0;
+      if (tokens >> r >> g >> b) {
+        if (!(r >= 0 && r <= 1 && g >= 0 && g <= 1 && b >= 0 && b <= 1))
+          return Invalid(at + ": a vertex colour needs 3 channels in [0, 1]");
+        read_colors.push_back(
+            {static_cast<float>(r), static_cast<float>(g), static_cast<float>(b)});
+      } else {
+        every_vertex_colored = false;
+      }
     } else if (tag == "f") {
       std::vector<uint32_t> face;
       std::string corner;
@@ -52,6 +64,10 @@ Status ReadObj(const std::string& file, const std::string& where, std::vector<Fl
   }
   if (positions->empty() || triangles->empty())
     return Invalid(where + ": " + Quote(file) + " holds no triangles");
+  if (colors != nullptr) {
+    colors->clear();
+    if (every_vertex_colored) *colors = std::move(read_colors);
+  }
   return Status::Ok();
 }
 

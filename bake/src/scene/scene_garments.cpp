@@ -136,9 +136,9 @@ Status FindNamedJoint(const std::string& prefix, const SkeletonData& skeleton,
 }
 
 // The garment's particles and triangles: a generated shape placed at the anchor, or an OBJ file
-// scaled, offset and placed at the anchor.
+// scaled, offset and placed at the anchor (with its vertex colours when every vertex has one).
 Status MakeGarmentMesh(const std::string& prefix, const SceneGarment& g, Float3 anchor,
-                       GarmentMesh* mesh) {
+                       GarmentMesh* mesh, std::vector<Float3>* colors) {
   Status made;
   switch (g.type) {
     case GarmentType::kSheet: {
@@ -166,8 +166,8 @@ Status MakeGarmentMesh(const std::string& prefix, const SceneGarment& g, Float3 
       break;
     }
     case GarmentType::kObj: {
-      made =
-          ReadObj(g.obj_file, prefix + g.path + "/shape/file", &mesh->positions, &mesh->triangles);
+      made = ReadObj(g.obj_file, prefix + g.path + "/shape/file", &mesh->positions,
+                     &mesh->triangles, colors);
       if (!made.ok()) return made;
       for (Float3& p : mesh->positions) p = p * g.obj_scale + g.obj_offset + anchor;
       break;
@@ -251,7 +251,7 @@ std::vector<int32_t> CarrierJoints(const ClothDescription& d,
 // frame_to_bind, the max distance and backstop for every particle no joint or pin holds.
 Status SkinGarment(const std::string& prefix, const SceneGarment& g, const SkeletonPose& rest,
                    const MeshData* body, const std::vector<Mat34>& frame_to_bind,
-                   const Holds& holds, ClothDescription* d) {
+                   const Holds& holds, const std::vector<Float3>& colors, ClothDescription* d) {
   if (body == nullptr || body->triangles.empty())
     return Invalid(prefix + g.path + "/skin: the asset has no body mesh to take weights from");
   std::vector<Float3> body_positions = body->positions;
@@ -278,6 +278,18 @@ Status SkinGarment(const std::string& prefix, const SceneGarment& g, const Skele
   }
   d->max_distance.assign(n, g.max_distance);
   d->backstop.assign(n, g.backstop);
+  if (g.max_distance_channel >= 0) {  // painted: the channel scales max_distance
+    if (colors.size() != n)
+      return Invalid(prefix + g.path +
+                     "/skin/paint: the garment has no vertex colours (an OBJ whose every `v` "
+                     "line has r g b after x y z)");
+    for (size_t i = 0; i < n; ++i) {
+      const Float3 c = colors[i];
+      const float channel =
+          g.max_distance_channel == 0 ? c.x : (g.max_distance_channel == 1 ? c.y : c.z);
+      d->max_distance[i] = g.max_distance * channel;
+    }
+  }
   for (size_t i = 0; i < n; ++i) {
     if (holds.held_joint[i] == -2) continue;  // free
     d->max_distance[i] = kInf;                // held by a joint or a pin: not the skin's
@@ -341,7 +353,8 @@ Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skel
     anchor = joint_positions[static_cast<size_t>(j)];
   }
   GarmentMesh mesh;
-  DRAPE_RETURN_IF_ERROR(MakeGarmentMesh(prefix, g, anchor, &mesh));
+  std::vector<Float3> colors;  // an OBJ's vertex colours: the painted max distance
+  DRAPE_RETURN_IF_ERROR(MakeGarmentMesh(prefix, g, anchor, &mesh, &colors));
 
   ClothDescription& d = out->description;
   d.positions = mesh.positions;
@@ -356,7 +369,8 @@ Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skel
       HoldParticles(scene, prefix, g, skeleton, mesh, anchor, out->frame_to_bind, &d, &holds));
   d.tether_stretch = g.tether_stretch;
   if (g.skinned)
-    DRAPE_RETURN_IF_ERROR(SkinGarment(prefix, g, rest, body, out->frame_to_bind, holds, &d));
+    DRAPE_RETURN_IF_ERROR(
+        SkinGarment(prefix, g, rest, body, out->frame_to_bind, holds, colors, &d));
 
   // Validate the cloth now, so that a bad garment is refused with its path.
   Cloth check;

@@ -83,7 +83,10 @@ struct SceneGarment {
   float max_distance = 0.05f;                               // metres, >= 0
   float backstop = std::numeric_limits<float>::infinity();  // metres, >= 0
   uint32_t skin_smoothing = 20;  // passes averaging the weights with the mesh neighbours
-  float tether_stretch = 0.02f;  // long-range tethers' allowed stretch, >= 0
+  // -1: max_distance everywhere; 0, 1, 2: an OBJ's vertex colour channel (r, g, b) in [0, 1]
+  // scales it per particle (painted 0: the particle follows the skin exactly).
+  int32_t max_distance_channel = -1;
+  float tether_stretch = 0.02f;                   // long-range tethers' allowed stretch, >= 0
   std::array<float, 3> color{0.8f, 0.25f, 0.3f};  // linear RGB in [0, 1], for pictures
   std::string path;                               // "/garments/<index>"
 };
