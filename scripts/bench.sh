@@ -5,6 +5,9 @@
 #   scripts/bench.sh --quick      the reduced sweep, fewer motions (about a minute)
 #   scripts/bench.sh --gbench     also every Google Benchmark program (bench_*), output in
 #                                 out/bench/gbench/*.json
+#   scripts/bench.sh --gbench-only NAME...   re-runs those Google Benchmark programs alone
+#                                 (bench_NAME) into an earlier full run's out/bench, each JSON
+#                                 recording its own commit and date, and rewrites the document
 # Then it writes out/bench/PERFORMANCE.md (scripts/performance_doc.py: docs/PERFORMANCE.md's
 # shape, this run's figures, machine, command and commit) with its charts in out/bench/images/.
 # Installs what is missing, builds the bench preset (Release + benchmarks), runs on two cores.
@@ -15,15 +18,37 @@ jobs=${DRAPE_JOBS:-2}
 load_start=$(cut -d ' ' -f 1-3 /proc/loadavg)  # before this command's own build and runs
 quick=()
 gbench=0
+only=()
 for arg in "$@"; do
   case "$arg" in
     --quick) quick=(--quick --queries 1000) ;;
     --gbench) gbench=1 ;;
-    *) echo "bench.sh: unknown option $arg (--quick, --gbench)" >&2; exit 2 ;;
+    --gbench-only) gbench=only ;;
+    -*) echo "bench.sh: unknown option $arg (--quick, --gbench, --gbench-only NAME...)" >&2
+        exit 2 ;;
+    *) [ "$gbench" = only ] || { echo "bench.sh: $arg: a name needs --gbench-only" >&2; exit 2; }
+       only+=("bench_${arg#bench_}") ;;
   esac
 done
 scripts/setup.sh
 cmake --preset bench >/dev/null
+if [ "$gbench" = only ]; then
+  # One program at a time into the last full run's output; its JSON carries its commit and date.
+  [ ${#only[@]} -gt 0 ] || { echo "bench.sh: --gbench-only needs program names" >&2; exit 2; }
+  [ -f out/bench/run_info.txt ] || { echo "bench.sh: no earlier run in out/bench" >&2; exit 2; }
+  cmake --build build-bench -j "$jobs" --target "${only[@]}"
+  mkdir -p out/bench/gbench
+  commit=$(git rev-parse --short HEAD)
+  [ -z "$(git status --porcelain --untracked-files=no)" ] || commit="$commit with local changes"
+  for b in "${only[@]}"; do
+    echo "== $b"
+    "build-bench/bin/$b" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+      --benchmark_context=drape_commit="$commit" --benchmark_context=drape_date="$(date -u +%F)" \
+      --benchmark_out="out/bench/gbench/$b.json" --benchmark_out_format=json
+  done
+  python3 scripts/performance_doc.py --out out/bench
+  exit 0
+fi
 targets=(drape-speed-vs-error)
 if [ "$gbench" = 1 ]; then
   for source in bench/gbench/*_bench.cpp; do

@@ -26,7 +26,7 @@ sys.dont_write_bytecode = True  # no __pycache__ beside the scripts
 from performance_doc_format import (Doc, file_safe, mm, ns, number, pair,  # noqa: E402
                                     pct, size, span)
 from performance_doc_gbench import (body_map_bake, body_map_queries, cloth,  # noqa: E402
-                                    following_maps, hull_bake, hull_queries, read_gbench)
+                                    following_maps, hull_bake, hull_queries, read_gbench, shapes)
 
 # A run that starts with a 1-minute load average at or above this shares the machine.
 LOADED = 1.0
@@ -502,6 +502,7 @@ def main():
     following_maps(doc, gb, rows)
     hull_queries(doc, gb)
     cloth(doc, gb, sections)
+    shapes(doc, gb)
     body_map_bake(doc, gb)
     hull_bake(doc, gb)
     footer(doc, gb)

@@ -64,11 +64,17 @@ class Doc:
         return (f"{i.get('cpu', '?')}, {i.get('cores', '?')} cores, {i.get('compiler', '?')}, "
                 f"preset {i.get('preset', 'bench')}")
 
-    def source(self, what):
-        """The line under every table: machine, command and commit."""
+    def source(self, what, commit=None, date=None):
+        """The line under every table: machine, command and commit (a program re-run alone
+        gives its own commit and date)."""
         i = self.info
-        commit = f"`{i.get('commit', '?')}`"
-        if i.get("worktree") == "modified":
-            commit += " with local changes"
-        self.add("", f"*{self.machine()}; `{i.get('command', '?')}` ({what}); commit {commit}; "
-                 f"{i.get('date', '')}.*", "")
+        command = i.get('command', '?')
+        if commit:
+            command = f"scripts/bench.sh --gbench-only {what}"
+            commit = f"`{commit}`"
+        else:
+            commit = f"`{i.get('commit', '?')}`"
+            if i.get("worktree") == "modified":
+                commit += " with local changes"
+        self.add("", f"*{self.machine()}; `{command}` ({what}); commit {commit}; "
+                 f"{date or i.get('date', '')}.*", "")

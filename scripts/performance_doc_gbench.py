@@ -38,7 +38,19 @@ def read_gbench(out):
             if aggregate == "median" or key not in entries:
                 entries[key] = b
         programs[name[:-len(".json")]] = entries
+        CONTEXTS[name[:-len(".json")]] = data.get("context", {})
     return programs
+
+
+# Per program, its run's Google Benchmark context: a program re-run alone (scripts/bench.sh
+# --gbench-only NAME) records its own commit and date there (drape_commit, drape_date).
+CONTEXTS = {}
+
+
+def source(doc, program):
+    """The line under a program's table: its own run's commit when it was re-run alone."""
+    context = CONTEXTS.get(program, {})
+    doc.source(program, context.get("drape_commit"), context.get("drape_date"))
 
 
 def value(gb, program, name, args, field="ns_per_particle"):
@@ -93,7 +105,7 @@ def body_map_queries(doc, gb):
             "figure, N = 1024 (the walk's cost against its length), ns for segments of " +
             " / ".join(str(n) for n in lengths) + f" texels: nearest {cells['nearest']}, "
             f"bilinear {cells['bilinear']}.")
-    doc.source(p)
+    source(doc, p)
 
 
 def hull_queries(doc, gb):
@@ -132,7 +144,7 @@ def hull_queries(doc, gb):
         doc.add(f"| {label} | " + " | ".join(
             pair(value(gb, p, "BM_Scene", (1, mode, d)), value(gb, p, "BM_Scene", (2, mode, d)))
             for d in (0, 1, 2)) + " |")
-    doc.source(p)
+    source(doc, p)
 
 
 def cloth(doc, gb, sections):
@@ -168,11 +180,31 @@ def cloth(doc, gb, sections):
             depth = value(gb, p, "BM_BulletSkirt", (substeps,), "frame_max_depth_mm")
             doc.add(f"| Bullet btSoftBody, {substeps} substep{'s' if substeps > 1 else ''} | "
                     f"{mm(t, 2)} | - | - | {mm(depth, 2)} | - |")
-        doc.source(p)
+        source(doc, p)
     if title in sections:
         doc.add("The same comparison on the walking mannequin, penetration measured against the "
                 "exact posed body (from `drape-speed-vs-error`):", "", sections[title])
         doc.source("speed against error")
+
+
+def shapes(doc, gb):
+    p = "bench_shape_collider"
+    if p not in gb:
+        return
+    doc.add("## Engine shapes", "",
+            "`bench_shape_collider`: `ShapeColliderSet::CollideBatch` of 10 000 particles against "
+            "16 spheres, 4 tapered capsules, a floor and 2 boxes moving 1 cm and turning 2° in "
+            "the substep; ns per particle, median of 3.", "",
+            "| particles | 1 thread | 2 threads | in contact |", "|---|---|---|---|")
+    for label, dist in (("half within 3 cm of a surface", 0), ("uniform in the scene's box", 1),
+                        ("a 100 × 100 sheet slanting through the shapes", 3),
+                        ("5 m above everything", 2)):
+        one = value(gb, p, "BM_ShapeScene", (1, dist))
+        two = value(gb, p, "BM_ShapeScene", (2, dist))
+        contact = value(gb, p, "BM_ShapeScene", (1, dist), "contact_fraction")
+        doc.add(f"| {label} | {mm(one, 0)} | {mm(two, 0)} | "
+                f"{f'{100 * contact:.0f} %' if contact is not None else '-'} |")
+    source(doc, p)
 
 
 def body_map_bake(doc, gb):
@@ -203,7 +235,7 @@ def body_map_bake(doc, gb):
         doc.add("", "The air-gap fragment pass (`maps.layers` 3) on the 80k-triangle meshes at "
                 "N = 1024: " + ", ".join(f"{'mannequin' if m else 'sphere'} {mm(g)} ms"
                                          for m, g in gaps) + ".")
-    doc.source(p)
+    source(doc, p)
 
 
 def hull_bake(doc, gb):
@@ -249,7 +281,7 @@ def hull_bake(doc, gb):
                 f"hulls (slowest bone {mm(value(gb, p, 'BM_CesiumManHulls', (), 'max_bone_ms'))} "
                 f"ms, mean {mm(value(gb, p, 'BM_CesiumManHulls', (), 'mean_tris'), 0)} "
                 "triangles).")
-    doc.source(p)
+    source(doc, p)
 
 
 def following_maps(doc, gb, rows):
