@@ -192,7 +192,9 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
   }
   for (size_t g = 0; g < scene.garments.size(); ++g) {
     auto garment = std::make_unique<Garment>();
-    if (Status s = bake::ResolveGarment(scene, g, asset.skeleton, &garment->resolved, &asset.mesh);
+    if (Status s = bake::ResolveGarment(scene, g, asset.skeleton, &garment->resolved); !s.ok())
+      return s;
+    if (Status s = bake::SkinGarment(scene, g, asset.skeleton, asset.mesh, &garment->resolved);
         !s.ok())
       return s;
     const std::string at = where + scene.garments[g].path + ": ";

@@ -347,7 +347,9 @@ TEST_F(SceneTest, SkinnedGarmentTakesItsWeightsFromTheBody) {
   Scene scene;
   ASSERT_TRUE(Parse(j, &scene).ok());
   ResolvedGarment garment;
-  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment, &asset().mesh);
+  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment);
+  ASSERT_TRUE(s.ok()) << s.message();
+  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
   ASSERT_TRUE(s.ok()) << s.message();
   const ClothDescription& d = garment.description;
   ASSERT_EQ(d.skin.size(), d.positions.size());
@@ -377,7 +379,8 @@ TEST_F(SceneTest, SkinnedGarmentTakesItsWeightsFromTheBody) {
   EXPECT_GT(hem_on_both_thighs, 8u);
   Cloth cloth;
   EXPECT_TRUE(BuildCloth(d, &cloth).ok());
-  s = ResolveGarment(scene, 0, asset().skeleton, &garment);
+  ASSERT_TRUE(ResolveGarment(scene, 0, asset().skeleton, &garment).ok());
+  s = SkinGarment(scene, 0, asset().skeleton, MeshData{}, &garment);
   ASSERT_FALSE(s.ok());
   EXPECT_EQ(s.message().rfind("scene.json: /garments/0/skin: the asset has no body mesh", 0), 0u)
       << s.message();
@@ -415,7 +418,9 @@ TEST_F(SceneTest, SkinnedObjGarmentTakesItsPaintedMaxDistance) {
     ASSERT_TRUE(parsed.ok()) << parsed.message();
   }
   ResolvedGarment garment;
-  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment, &asset().mesh);
+  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment);
+  ASSERT_TRUE(s.ok()) << s.message();
+  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
   ASSERT_TRUE(s.ok()) << s.message();
   const ClothDescription& d = garment.description;
   ASSERT_EQ(d.max_distance.size(), 36u);
@@ -428,7 +433,8 @@ TEST_F(SceneTest, SkinnedObjGarmentTakesItsPaintedMaxDistance) {
     std::ofstream out(obj);
     out << "v 0 1 0\nv 0.1 1 0\nv 0 1 0.1\nf 1 2 3\n";
   }
-  s = ResolveGarment(scene, 0, asset().skeleton, &garment, &asset().mesh);
+  ASSERT_TRUE(ResolveGarment(scene, 0, asset().skeleton, &garment).ok());
+  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("/garments/0/skin/paint: the garment has no vertex colours"),
             std::string::npos)

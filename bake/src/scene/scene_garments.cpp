@@ -11,7 +11,6 @@
 #include "drape/bake/scene.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
-#include "scene/garment_skinning.h"
 #include "scene/obj_reader.h"
 #include "scene/scene_messages.h"
 
@@ -246,58 +245,6 @@ std::vector<int32_t> CarrierJoints(const ClothDescription& d,
   return carrier_joint;
 }
 
-// A skinned garment: weights from the body's closest point (the body posed at the rest pose for
-// a garment authored there), bind positions through each particle's blend of its joints'
-// frame_to_bind, the max distance and backstop for every particle no joint or pin holds.
-Status SkinGarment(const std::string& prefix, const SceneGarment& g, const SkeletonPose& rest,
-                   const MeshData* body, const std::vector<Mat34>& frame_to_bind,
-                   const Holds& holds, const std::vector<Float3>& colors, ClothDescription* d) {
-  if (body == nullptr || body->triangles.empty())
-    return Invalid(prefix + g.path + "/skin: the asset has no body mesh to take weights from");
-  std::vector<Float3> body_positions = body->positions;
-  if (g.frame == GarmentFrame::kRest) {
-    for (size_t v = 0; v < body_positions.size(); ++v) {
-      Float3 p;
-      for (uint32_t f = body->influence_offsets[v]; f < body->influence_offsets[v + 1]; ++f)
-        p += TransformPoint(rest.skinning()[body->influence_joints[f]], body->positions[v]) *
-             body->influence_weights[f];
-      body_positions[v] = p;
-    }
-  }
-  if (Status s = TransferSkinWeights(*body, body_positions, d->positions, &d->skin); !s.ok())
-    return Invalid(prefix + g.path + "/skin: " + s.message());
-  SmoothSkinWeights(d->triangles, g.skin_smoothing, &d->skin);
-  const size_t n = d->positions.size();
-  d->skin_bind_positions.assign(n, Float3{});
-  for (size_t i = 0; i < n; ++i) {
-    const ClothSkinWeights& w = d->skin[i];
-    for (int k = 0; k < 4; ++k)
-      if (w.weights[k] > 0.f)
-        d->skin_bind_positions[i] +=
-            TransformPoint(frame_to_bind[w.joints[k]], d->positions[i]) * w.weights[k];
-  }
-  d->max_distance.assign(n, g.max_distance);
-  d->backstop.assign(n, g.backstop);
-  if (g.max_distance_channel >= 0) {  // painted: the channel scales max_distance
-    if (colors.size() != n)
-      return Invalid(prefix + g.path +
-                     "/skin/paint: the garment has no vertex colours (an OBJ whose every `v` "
-                     "line has r g b after x y z)");
-    for (size_t i = 0; i < n; ++i) {
-      const Float3 c = colors[i];
-      const float channel =
-          g.max_distance_channel == 0 ? c.x : (g.max_distance_channel == 1 ? c.y : c.z);
-      d->max_distance[i] = g.max_distance * channel;
-    }
-  }
-  for (size_t i = 0; i < n; ++i) {
-    if (holds.held_joint[i] == -2) continue;  // free
-    d->max_distance[i] = kInf;                // held by a joint or a pin: not the skin's
-    d->backstop[i] = kInf;
-  }
-  return Status::Ok();
-}
-
 }  // namespace
 
 const char* ToString(GarmentType type) {
@@ -333,7 +280,7 @@ std::vector<std::string> GarmentRingNames(GarmentType type) {
 }
 
 Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skeleton,
-                      ResolvedGarment* out, const MeshData* body) {
+                      ResolvedGarment* out) {
   *out = ResolvedGarment{};
   if (index >= scene.garments.size())
     return Invalid(scene.source + ": no garment " + std::to_string(index));
@@ -353,8 +300,7 @@ Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skel
     anchor = joint_positions[static_cast<size_t>(j)];
   }
   GarmentMesh mesh;
-  std::vector<Float3> colors;  // an OBJ's vertex colours: the painted max distance
-  DRAPE_RETURN_IF_ERROR(MakeGarmentMesh(prefix, g, anchor, &mesh, &colors));
+  DRAPE_RETURN_IF_ERROR(MakeGarmentMesh(prefix, g, anchor, &mesh, &out->colors));
 
   ClothDescription& d = out->description;
   d.positions = mesh.positions;
@@ -368,9 +314,6 @@ Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skel
   DRAPE_RETURN_IF_ERROR(
       HoldParticles(scene, prefix, g, skeleton, mesh, anchor, out->frame_to_bind, &d, &holds));
   d.tether_stretch = g.tether_stretch;
-  if (g.skinned)
-    DRAPE_RETURN_IF_ERROR(
-        SkinGarment(prefix, g, rest, body, out->frame_to_bind, holds, colors, &d));
 
   // Validate the cloth now, so that a bad garment is refused with its path.
   Cloth check;

@@ -45,7 +45,7 @@ Status GarmentReaches(const Scene& resolved, const CharacterAsset& asset, SceneR
                       std::vector<Held>* held, bool* bounded) {
   for (size_t g = 0; g < resolved.garments.size(); ++g) {
     ResolvedGarment garment;
-    DRAPE_RETURN_IF_ERROR(ResolveGarment(resolved, g, asset.skeleton, &garment, &asset.mesh));
+    DRAPE_RETURN_IF_ERROR(ResolveGarment(resolved, g, asset.skeleton, &garment));
     const ClothDescription& d = garment.description;
     std::vector<float> distance;
     std::vector<uint32_t> nearest;

@@ -250,14 +250,22 @@ struct ResolvedGarment {
   // inverse rest skinning matrix for kRest). A particle p carried by joint j sits at
   // S[j] * frame_to_bind[j] * p at a pose with skinning matrices S.
   std::vector<Mat34> frame_to_bind;
+  std::vector<Float3> colors;  // an OBJ garment's vertex colours (empty: none)
 };
 
 // Builds garment `index` of the scene against the skeleton: generator or OBJ mesh, anchoring,
 // selections (errors name the JSON path: unknown ring, vertex index out of range, empty box,
 // unknown joint, a particle both attached and pinned ...). Allocates.
-// A skinned garment takes its weights from `body` (the asset's mesh; refused when null).
 Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skeleton,
-                      ResolvedGarment* out, const MeshData* body = nullptr);
+                      ResolvedGarment* out);
+
+// The skin of a resolved garment (/garments/i/skin; nothing for an unskinned one): skin weights
+// from the closest point of `body` (the asset's mesh, posed at the rest pose for a garment
+// authored there), smoothed over the garment's mesh, bind positions, and max distance (painted
+// from an OBJ's vertex colours if asked) and backstop for the particles no joint or pin holds.
+// Errors name the JSON path (no body mesh, no vertex colours to paint with). Allocates.
+Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleton,
+                   const MeshData& body, ResolvedGarment* garment);
 
 // Positions of the garment at a pose: every particle moved rigidly by its carrier joint's
 // skinning matrix from the garment frame (S[j] * frame_to_bind[j] * p); particles without one

@@ -1,4 +1,4 @@
-#include "scene/garment_skinning.h"
+#include "garment_skin/garment_skinning.h"
 
 #include <algorithm>
 #include <array>

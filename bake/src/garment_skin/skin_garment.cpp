@@ -1,0 +1,82 @@
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "drape/bake/scene.h"
+#include "drape/runtime/math.h"
+#include "drape/runtime/skeleton_pose.h"
+#include "garment_skin/garment_skinning.h"
+
+namespace drape::bake {
+namespace {
+
+Status Invalid(const std::string& message) { return Status(StatusCode::kInvalidArgument, message); }
+
+// The body's vertices in the garment's frame: the bind positions, or skinned to the rest pose.
+std::vector<Float3> BodyInGarmentFrame(const SceneGarment& g, const SkeletonData& skeleton,
+                                       const MeshData& body) {
+  if (g.frame != GarmentFrame::kRest) return body.positions;
+  SkeletonPose rest;
+  std::vector<Float3> positions(body.positions.size());
+  if (!rest.Init(skeleton).ok()) return body.positions;
+  rest.SetRest();
+  for (size_t v = 0; v < positions.size(); ++v) {
+    Float3 p;
+    for (uint32_t f = body.influence_offsets[v]; f < body.influence_offsets[v + 1]; ++f)
+      p += TransformPoint(rest.skinning()[body.influence_joints[f]], body.positions[v]) *
+           body.influence_weights[f];
+    positions[v] = p;
+  }
+  return positions;
+}
+
+}  // namespace
+
+Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleton,
+                   const MeshData& body, ResolvedGarment* garment) {
+  const SceneGarment& g = scene.garments[index];
+  if (!g.skinned) return Status::Ok();
+  const std::string at = scene.source + ": " + g.path + "/skin";
+  if (body.triangles.empty())
+    return Invalid(at + ": the asset has no body mesh to take weights from");
+  ClothDescription& d = garment->description;
+  if (Status s = detail::TransferSkinWeights(body, BodyInGarmentFrame(g, skeleton, body),
+                                             d.positions, &d.skin);
+      !s.ok())
+    return Invalid(at + ": " + s.message());
+  detail::SmoothSkinWeights(d.triangles, g.skin_smoothing, &d.skin);
+  const size_t n = d.positions.size();
+  d.skin_bind_positions.assign(n, Float3{});
+  for (size_t i = 0; i < n; ++i) {
+    const ClothSkinWeights& w = d.skin[i];
+    for (int k = 0; k < 4; ++k)
+      if (w.weights[k] > 0.f)
+        d.skin_bind_positions[i] +=
+            TransformPoint(garment->frame_to_bind[w.joints[k]], d.positions[i]) * w.weights[k];
+  }
+  d.max_distance.assign(n, g.max_distance);
+  d.backstop.assign(n, g.backstop);
+  if (g.max_distance_channel >= 0) {  // painted: the channel scales max_distance
+    if (garment->colors.size() != n)
+      return Invalid(at +
+                     "/paint: the garment has no vertex colours (an OBJ whose every `v` line has "
+                     "r g b after x y z)");
+    for (size_t i = 0; i < n; ++i) {
+      const Float3 c = garment->colors[i];
+      const float channel =
+          g.max_distance_channel == 0 ? c.x : (g.max_distance_channel == 1 ? c.y : c.z);
+      d.max_distance[i] = g.max_distance * channel;
+    }
+  }
+  // Held by a joint or a pin: not the skin's.
+  constexpr float kUnlimited = std::numeric_limits<float>::infinity();
+  for (const ClothAttachment& a : d.attachments) d.max_distance[a.particle] = kUnlimited;
+  for (const uint32_t p : d.pinned) d.max_distance[p] = kUnlimited;
+  for (const ClothAttachment& a : d.attachments) d.backstop[a.particle] = kUnlimited;
+  for (const uint32_t p : d.pinned) d.backstop[p] = kUnlimited;
+  Cloth check;
+  if (Status s = BuildCloth(d, &check); !s.ok()) return Invalid(at + ": " + s.message());
+  return Status::Ok();
+}
+
+}  // namespace drape::bake
