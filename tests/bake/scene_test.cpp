@@ -441,6 +441,57 @@ TEST_F(SceneTest, SkinnedObjGarmentTakesItsPaintedMaxDistance) {
       << s.message();
 }
 
+// Authored weights from a file (OBJ + weights): kept as written (no smoothing), the four heaviest
+// renormalised; a file naming an unknown joint, or with the wrong line count, is refused naming
+// the file and the line.
+TEST_F(SceneTest, SkinnedGarmentTakesAuthoredWeightsFromAFile) {
+  const std::string dir = ::testing::TempDir();
+  {
+    std::ofstream out(dir + "/triangle.obj");
+    out << "v 0.1 0.9 0.1\nv 0.2 0.9 0.1\nv 0.1 0.8 0.1\nf 1 2 3\n";
+    std::ofstream weights(dir + "/triangle.weights");
+    weights << "# one line per vertex\nhips 1\nhips 0.5 hip_l 1.5\n"
+            << "hip_l 1 hip_r 1 spine 1 chest 1 knee_l 0.5  # five: the lightest dropped\n";
+  }
+  json j = DemoJson();
+  j["garments"][0] = {{"type", "obj"},
+                      {"shape", {{"file", dir + "/triangle.obj"}}},
+                      {"skin", {{"weights_file", dir + "/triangle.weights"}}}};
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  ResolvedGarment garment;
+  ASSERT_TRUE(ResolveGarment(scene, 0, asset().skeleton, &garment).ok());
+  Status s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const std::vector<ClothSkinWeights>& w = garment.description.skin;
+  ASSERT_EQ(w.size(), 3u);
+  const auto joint = [&](const char* name) {
+    return static_cast<uint32_t>(FindJoint(asset().skeleton, name));
+  };
+  EXPECT_EQ(w[0].joints[0], joint("hips"));
+  EXPECT_FLOAT_EQ(w[0].weights[0], 1.f);
+  EXPECT_EQ(w[1].joints[0], joint("hip_l"));
+  EXPECT_FLOAT_EQ(w[1].weights[0], 0.75f);
+  EXPECT_FLOAT_EQ(w[1].weights[1], 0.25f);
+  EXPECT_FLOAT_EQ(w[2].weights[0] + w[2].weights[1] + w[2].weights[2] + w[2].weights[3], 1.f);
+  for (int k = 0; k < 4; ++k) EXPECT_NE(w[2].joints[k], joint("knee_l"));
+  {
+    std::ofstream weights(dir + "/triangle.weights");
+    weights << "hips 1\nhipz 1\nhips 1\n";
+  }
+  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
+  EXPECT_NE(s.message().find("triangle.weights': line 2: no joint named 'hipz' (did you mean"),
+            std::string::npos)
+      << s.message();
+  {
+    std::ofstream weights(dir + "/triangle.weights");
+    weights << "hips 1\nhips 1\n";
+  }
+  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
+  EXPECT_NE(s.message().find("2 weighted vertices for the garment's 3"), std::string::npos)
+      << s.message();
+}
+
 TEST_F(SceneTest, GarmentIsHeldInTheBindFrame) {
   Scene scene;
   ASSERT_TRUE(LoadScene(DemoPath(), &scene).ok());

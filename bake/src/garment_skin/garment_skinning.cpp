@@ -3,10 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <utility>
 
+#include "config/name_suggestions.h"
 #include "drape/bake/mesh_reference.h"
+#include "drape/runtime/skeleton_pose.h"
+#include "scene/scene_messages.h"
 
 namespace drape::bake::detail {
 namespace {
@@ -88,6 +93,58 @@ Status TransferSkinWeights(const MeshData& body, std::span<const Float3> body_po
       out.weights[k] = static_cast<float>(blend[k].second / sum);
     }
   }
+  return Status::Ok();
+}
+
+Status ReadSkinWeightsFile(const std::string& file, const SkeletonData& skeleton, size_t vertices,
+                           std::vector<ClothSkinWeights>* weights) {
+  const auto invalid = [&](const std::string& message) {
+    return Status(StatusCode::kInvalidArgument, "'" + file + "': " + message);
+  };
+  std::ifstream in(file);
+  if (!in) return invalid("cannot open");
+  weights->clear();
+  std::string line;
+  std::vector<std::pair<uint32_t, double>> blend;
+  for (uint32_t number = 1; std::getline(in, line); ++number) {
+    const size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream tokens(line);
+    std::string joint;
+    blend.clear();
+    double sum = 0.0;
+    while (tokens >> joint) {
+      double weight = 0.0;
+      if (!(tokens >> weight) || !std::isfinite(weight) || weight < 0.0)
+        return invalid("line " + std::to_string(number) + ": joint '" + joint +
+                       "' needs a finite weight >= 0 after it");
+      const int32_t j = FindJoint(skeleton, joint);
+      if (j < 0) {
+        const std::vector<std::string> near = NearestNames(joint, skeleton.joint_names, 3);
+        return invalid("line " + std::to_string(number) + ": no joint named '" + joint + "'" +
+                       (near.empty() ? "" : " (did you mean " + JoinNames(near) + "?)"));
+      }
+      blend.emplace_back(static_cast<uint32_t>(j), weight);
+      sum += weight;
+    }
+    if (blend.empty()) continue;  // blank or comment
+    if (!(sum > 0.0)) return invalid("line " + std::to_string(number) + ": the weights sum to 0");
+    std::sort(blend.begin(), blend.end(), [](const auto& a, const auto& b) {
+      return a.second != b.second ? a.second > b.second : a.first < b.first;
+    });
+    const size_t kept = std::min<size_t>(4, blend.size());
+    double kept_sum = 0.0;
+    for (size_t k = 0; k < kept; ++k) kept_sum += blend[k].second;
+    ClothSkinWeights w;
+    for (size_t k = 0; k < kept; ++k) {
+      w.joints[k] = blend[k].first;
+      w.weights[k] = static_cast<float>(blend[k].second / kept_sum);
+    }
+    weights->push_back(w);
+  }
+  if (weights->size() != vertices)
+    return invalid(std::to_string(weights->size()) + " weighted vertices for the garment's " +
+                   std::to_string(vertices) + " (one line per vertex, in order)");
   return Status::Ok();
 }
 

@@ -2,9 +2,11 @@
 // Skin weights for a garment from the body it is worn on (drape-sim's skinned garments).
 
 #include <span>
+#include <string>
 #include <vector>
 
 #include "drape/formats/mesh_data.h"
+#include "drape/formats/skeleton_data.h"
 #include "drape/formats/status.h"
 #include "drape/formats/types.h"
 #include "drape/runtime/cloth.h"
@@ -20,6 +22,13 @@ namespace drape::bake::detail {
 Status TransferSkinWeights(const MeshData& body, std::span<const Float3> body_positions,
                            std::span<const Float3> garment, std::vector<ClothSkinWeights>* weights,
                            std::vector<float>* distances = nullptr);
+
+// Reads a weights file: one line per garment vertex, in order, of `joint weight` pairs (joint
+// names of the skeleton, weights >= 0, at least one > 0); blank lines and `#` comments skipped.
+// The four heaviest are kept and renormalised. Errors name the file, the line and the reason
+// (an unknown joint suggests the nearest names; a count that differs from `vertices`).
+Status ReadSkinWeightsFile(const std::string& file, const SkeletonData& skeleton, size_t vertices,
+                           std::vector<ClothSkinWeights>* weights);
 
 // Averages each particle's weights with its mesh neighbours' `iterations` times (Jacobi, the four
 // heaviest joints kept): a skirt's particles between the legs, which the closest body point gives

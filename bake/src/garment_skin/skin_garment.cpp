@@ -37,14 +37,21 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
   const SceneGarment& g = scene.garments[index];
   if (!g.skinned) return Status::Ok();
   const std::string at = scene.source + ": " + g.path + "/skin";
-  if (body.triangles.empty())
+  if (body.triangles.empty() && g.skin_weights_file.empty())
     return Invalid(at + ": the asset has no body mesh to take weights from");
   ClothDescription& d = garment->description;
-  if (Status s = detail::TransferSkinWeights(body, BodyInGarmentFrame(g, skeleton, body),
-                                             d.positions, &d.skin);
-      !s.ok())
-    return Invalid(at + ": " + s.message());
-  detail::SmoothSkinWeights(d.triangles, g.skin_smoothing, &d.skin);
+  if (!g.skin_weights_file.empty()) {  // authored weights, as they are
+    if (Status s =
+            detail::ReadSkinWeightsFile(g.skin_weights_file, skeleton, d.positions.size(), &d.skin);
+        !s.ok())
+      return Invalid(at + "/weights_file: " + s.message());
+  } else {
+    if (Status s = detail::TransferSkinWeights(body, BodyInGarmentFrame(g, skeleton, body),
+                                               d.positions, &d.skin);
+        !s.ok())
+      return Invalid(at + ": " + s.message());
+    detail::SmoothSkinWeights(d.triangles, g.skin_smoothing, &d.skin);
+  }
   const size_t n = d.positions.size();
   d.skin_bind_positions.assign(n, Float3{});
   for (size_t i = 0; i < n; ++i) {

@@ -240,7 +240,8 @@ const JsonSchema<SceneGarment>& SkinSchema() {
   static const JsonSchema<SceneGarment> schema =
       JsonSchema<SceneGarment>(
           "A skinned garment: each particle takes the skin weights of the closest point of the "
-          "character's body and follows the skinned surface within `max_distance`, never more "
+          "character's body (or the `weights_file`'s) and follows the skinned surface within "
+          "`max_distance`, never more "
           "than `backstop` behind it (along the garment's normal: the side its triangles' "
           "counter-clockwise winding faces, which should face away from the body). Attached "
           "and pinned particles stay held.")
@@ -265,10 +266,16 @@ const JsonSchema<SceneGarment>& SkinSchema() {
                                   "follows the skin exactly)"),
                   [](const JsonAt& at, SceneGarment& g) { return ReadPaintChannel(at, g); })
           .Default("none")
+          .FilePath("weights_file",
+                    "authored skin weights instead of the body's, relative to the scene: one "
+                    "line per garment vertex, in order, of `joint weight` pairs (joint names of "
+                    "the character's skeleton; the four heaviest kept); `#` starts a comment",
+                    [](SceneGarment& g) -> std::string& { return g.skin_weights_file; })
+          .Default("none: from the body")
           .Unsigned<uint32_t>("smoothing", "", 0, 1000,
-                              "passes averaging each particle's weights with its mesh "
-                              "neighbours' (a skirt then follows the hips and both legs, not one "
-                              "leg on each side)",
+                              "passes averaging each particle's weights from the body with its "
+                              "mesh neighbours' (a skirt then follows the hips and both legs, not "
+                              "one leg on each side); authored weights are kept as they are",
                               [](SceneGarment& g) -> uint32_t& { return g.skin_smoothing; });
   return schema;
 }

@@ -82,7 +82,8 @@ struct SceneGarment {
   bool skinned = false;
   float max_distance = 0.05f;                               // metres, >= 0
   float backstop = std::numeric_limits<float>::infinity();  // metres, >= 0
-  uint32_t skin_smoothing = 20;  // passes averaging the weights with the mesh neighbours
+  uint32_t skin_smoothing = 20;   // passes averaging the weights with the mesh neighbours
+  std::string skin_weights_file;  // authored weights, one line per vertex (empty: from the body)
   // -1: max_distance everywhere; 0, 1, 2: an OBJ's vertex colour channel (r, g, b) in [0, 1]
   // scales it per particle (painted 0: the particle follows the skin exactly).
   int32_t max_distance_channel = -1;
