@@ -16,6 +16,46 @@
 namespace drape::bake::detail {
 namespace {
 
+// Joint weights summed by joint (a handful of joints: a linear search), then the four heaviest.
+class JointBlend {
+ public:
+  void Clear() { entries_.clear(); }
+  bool empty() const { return entries_.empty(); }
+  void Add(uint32_t joint, double weight) {
+    for (auto& [j, w] : entries_) {
+      if (j == joint) {
+        w += weight;
+        return;
+      }
+    }
+    entries_.emplace_back(joint, weight);
+  }
+  void Add(const ClothSkinWeights& w, double scale) {
+    for (int k = 0; k < 4; ++k)
+      if (w.weights[k] > 0.f) Add(w.joints[k], w.weights[k] * scale);
+  }
+  // The four heaviest (ties to the lower joint: the same on every machine), renormalised into
+  // *out; false (out untouched) when they weigh nothing.
+  bool Heaviest(ClothSkinWeights* out) {
+    std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) {
+      return a.second != b.second ? a.second > b.second : a.first < b.first;
+    });
+    const size_t kept = std::min<size_t>(4, entries_.size());
+    double sum = 0.0;
+    for (size_t k = 0; k < kept; ++k) sum += entries_[k].second;
+    if (!(sum > 0.0)) return false;
+    *out = ClothSkinWeights{};
+    for (size_t k = 0; k < kept; ++k) {
+      out->joints[k] = entries_[k].first;
+      out->weights[k] = static_cast<float>(entries_[k].second / sum);
+    }
+    return true;
+  }
+
+ private:
+  std::vector<std::pair<uint32_t, double>> entries_;  // (joint, weight)
+};
+
 // Barycentric coordinates of p (on or near the triangle abc), in double; equal thirds for a
 // degenerate triangle.
 std::array<double, 3> Barycentric(const double p[3], Float3 a, Float3 b, Float3 c) {
@@ -48,7 +88,7 @@ Status TransferSkinWeights(const MeshData& body, std::span<const Float3> body_po
   const MeshReference surface(body_positions, body.triangles);
   weights->assign(garment.size(), ClothSkinWeights{});
   if (distances != nullptr) distances->assign(garment.size(), 0.f);
-  std::vector<std::pair<uint32_t, double>> blend;  // (joint, weight), merged by joint
+  JointBlend blend;
   for (size_t i = 0; i < garment.size(); ++i) {
     const double q[3] = {garment[i].x, garment[i].y, garment[i].z};
     double point[3];
@@ -62,36 +102,14 @@ Status TransferSkinWeights(const MeshData& body, std::span<const Float3> body_po
     const uint32_t* corner = &body.triangles[3 * size_t{triangle}];
     const std::array<double, 3> bary = Barycentric(
         point, body_positions[corner[0]], body_positions[corner[1]], body_positions[corner[2]]);
-    blend.clear();
+    blend.Clear();
     for (int k = 0; k < 3; ++k) {
       const uint32_t v = corner[k];
-      for (uint32_t f = body.influence_offsets[v]; f < body.influence_offsets[v + 1]; ++f) {
-        const uint32_t joint = body.influence_joints[f];
-        const double w = bary[k] * body.influence_weights[f];
-        const auto it = std::find_if(blend.begin(), blend.end(),
-                                     [&](const auto& e) { return e.first == joint; });
-        if (it != blend.end())
-          it->second += w;
-        else
-          blend.emplace_back(joint, w);
-      }
+      for (uint32_t f = body.influence_offsets[v]; f < body.influence_offsets[v + 1]; ++f)
+        blend.Add(body.influence_joints[f], bary[k] * body.influence_weights[f]);
     }
-    // The four heaviest, ties by joint index (deterministic), renormalised.
-    std::sort(blend.begin(), blend.end(), [](const auto& a, const auto& b) {
-      return a.second != b.second ? a.second > b.second : a.first < b.first;
-    });
-    double sum = 0.0;
-    const size_t kept = std::min<size_t>(4, blend.size());
-    for (size_t k = 0; k < kept; ++k) sum += blend[k].second;
-    ClothSkinWeights& out = (*weights)[i];
-    if (!(sum > 0.0)) {  // corners without influences: the root carries the particle
-      out.weights[0] = 1.f;
-      continue;
-    }
-    for (size_t k = 0; k < kept; ++k) {
-      out.joints[k] = blend[k].first;
-      out.weights[k] = static_cast<float>(blend[k].second / sum);
-    }
+    // Corners without influences: the root carries the particle.
+    if (!blend.Heaviest(&(*weights)[i])) (*weights)[i].weights[0] = 1.f;
   }
   return Status::Ok();
 }
@@ -105,14 +123,13 @@ Status ReadSkinWeightsFile(const std::string& file, const SkeletonData& skeleton
   if (!in) return invalid("cannot open");
   weights->clear();
   std::string line;
-  std::vector<std::pair<uint32_t, double>> blend;
+  JointBlend blend;
   for (uint32_t number = 1; std::getline(in, line); ++number) {
     const size_t hash = line.find('#');
     if (hash != std::string::npos) line.resize(hash);
     std::istringstream tokens(line);
     std::string joint;
-    blend.clear();
-    double sum = 0.0;
+    blend.Clear();
     while (tokens >> joint) {
       double weight = 0.0;
       if (!(tokens >> weight) || !std::isfinite(weight) || weight < 0.0)
@@ -124,22 +141,12 @@ Status ReadSkinWeightsFile(const std::string& file, const SkeletonData& skeleton
         return invalid("line " + std::to_string(number) + ": no joint named '" + joint + "'" +
                        (near.empty() ? "" : " (did you mean " + JoinNames(near) + "?)"));
       }
-      blend.emplace_back(static_cast<uint32_t>(j), weight);
-      sum += weight;
+      blend.Add(static_cast<uint32_t>(j), weight);
     }
     if (blend.empty()) continue;  // blank or comment
-    if (!(sum > 0.0)) return invalid("line " + std::to_string(number) + ": the weights sum to 0");
-    std::sort(blend.begin(), blend.end(), [](const auto& a, const auto& b) {
-      return a.second != b.second ? a.second > b.second : a.first < b.first;
-    });
-    const size_t kept = std::min<size_t>(4, blend.size());
-    double kept_sum = 0.0;
-    for (size_t k = 0; k < kept; ++k) kept_sum += blend[k].second;
     ClothSkinWeights w;
-    for (size_t k = 0; k < kept; ++k) {
-      w.joints[k] = blend[k].first;
-      w.weights[k] = static_cast<float>(blend[k].second / kept_sum);
-    }
+    if (!blend.Heaviest(&w))
+      return invalid("line " + std::to_string(number) + ": the weights sum to 0");
     weights->push_back(w);
   }
   if (weights->size() != vertices)
@@ -164,37 +171,16 @@ void SmoothSkinWeights(std::span<const uint32_t> triangles, uint32_t iterations,
     list.erase(std::unique(list.begin(), list.end()), list.end());
   }
   std::vector<ClothSkinWeights> next(n);
-  std::vector<std::pair<uint32_t, double>> blend;
+  JointBlend blend;
   for (uint32_t it = 0; it < iterations; ++it) {
     for (size_t i = 0; i < n; ++i) {
-      blend.clear();
-      const auto add = [&](const ClothSkinWeights& w, double scale) {
-        for (int k = 0; k < 4; ++k) {
-          if (!(w.weights[k] > 0.f)) continue;
-          const auto found = std::find_if(blend.begin(), blend.end(),
-                                          [&](const auto& e) { return e.first == w.joints[k]; });
-          if (found != blend.end())
-            found->second += w.weights[k] * scale;
-          else
-            blend.emplace_back(w.joints[k], w.weights[k] * scale);
-        }
-      };
       // Half its own weights, half its neighbours' mean.
-      add((*weights)[i], neighbours[i].empty() ? 1.0 : 0.5);
-      const double share = 0.5 / static_cast<double>(neighbours[i].size());
-      for (const uint32_t j : neighbours[i]) add((*weights)[j], share);
-      std::sort(blend.begin(), blend.end(), [](const auto& a, const auto& b) {
-        return a.second != b.second ? a.second > b.second : a.first < b.first;
-      });
-      const size_t kept = std::min<size_t>(4, blend.size());
-      double sum = 0.0;
-      for (size_t k = 0; k < kept; ++k) sum += blend[k].second;
-      ClothSkinWeights out;
-      for (size_t k = 0; k < kept; ++k) {
-        out.joints[k] = blend[k].first;
-        out.weights[k] = static_cast<float>(blend[k].second / sum);
-      }
-      next[i] = out;
+      blend.Clear();
+      blend.Add((*weights)[i], neighbours[i].empty() ? 1.0 : 0.5);
+      const double share = 0.5 / static_cast<double>(std::max<size_t>(1, neighbours[i].size()));
+      for (const uint32_t j : neighbours[i]) blend.Add((*weights)[j], share);
+      next[i] = (*weights)[i];
+      blend.Heaviest(&next[i]);
     }
     weights->swap(next);
   }
