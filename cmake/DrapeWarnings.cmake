@@ -6,6 +6,10 @@ function(drape_set_warnings target)
     -Wno-restrict)
   # Determinism: no fused multiply-add contraction, so results do not depend on the compiler's choice.
   target_compile_options(${target} PRIVATE -ffp-contract=off)
+  # Without OpenMP its pragmas are comments (the loops run on the calling thread).
+  if(NOT DRAPE_OPENMP)
+    target_compile_options(${target} PRIVATE -Wno-unknown-pragmas)
+  endif()
   if(DRAPE_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-omit-frame-pointer
       -fno-sanitize-recover=all)

@@ -6,8 +6,10 @@
 #     in 4 in a -DDRAPE_BUILD_BAKE=OFF build under sanitizers);
 #  3. cmake --install of that build, and a tiny consumer that find_package(drape)s it;
 #  4. formats + runtime tests again (what an engine links and feeds untrusted .drape files),
-#     under AddressSanitizer + UndefinedBehaviorSanitizer; the bad-model corpus through drape-bake
-#     runs in stage 1 (the model reader runs in a child process there);
+#     under AddressSanitizer + UndefinedBehaviorSanitizer, built without OpenMP
+#     (-DDRAPE_OPENMP=OFF: an engine that links no libgomp; the loops run on the calling thread)
+#     and checked to link no libgomp; the bad-model corpus through drape-bake runs in stage 1
+#     (the model reader runs in a child process there);
 #  5. each libFuzzer target over its seed corpus, reproducibly: a fixed seed and 100 000 inputs
 #     (DRAPE_FUZZ_RUNS; scripts/fuzz.sh alone runs a million, or explores with a random seed).
 set -uo pipefail
@@ -78,10 +80,12 @@ install_consumer() {
 }
 check "installed drape::runtime links into a consumer" install_consumer
 
-echo "== 4. formats + runtime tests under ASan + UBSan"
+echo "== 4. formats + runtime tests under ASan + UBSan, without OpenMP"
 if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     LSAN_OPTIONS=suppressions=$root/tests/tools/lsan_suppressions.txt run_ctest build-sanitize
+  check "the runtime built without OpenMP links no libgomp" \
+    bash -c '! ldd build-sanitize/bin/drape-inspect | grep -q libgomp'
 else
   check "sanitizer build" false
 fi

@@ -3,7 +3,6 @@
 // response, huge coordinates, bilinear depth, rejected data, the quick paths against the walk,
 // and the row-span layout.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
+#include "openmp_shim.h"
 
 namespace drape {
 namespace {

@@ -2,7 +2,6 @@
 // the exact reference, the quick paths and the batch, rejected data, the row-span layout, blends,
 // and the gap flag the lanes read.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
+#include "openmp_shim.h"
 
 namespace drape {
 namespace {

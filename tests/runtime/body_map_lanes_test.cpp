@@ -2,7 +2,6 @@
 // answers every particle bit for bit as Query and the response do, alone and through the batch,
 // at one and two threads.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
+#include "openmp_shim.h"
 
 namespace drape {
 namespace {

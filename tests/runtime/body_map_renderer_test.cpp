@@ -3,7 +3,6 @@
 // reject hostile input with a message and an empty collider.
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <cmath>
 #include <cstring>
@@ -13,6 +12,7 @@
 #include "body_map/body_map_collider_access.h"
 #include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/math.h"
+#include "openmp_shim.h"
 #include "skinned_spheres.h"
 
 namespace drape {

@@ -1,6 +1,5 @@
 // BodyMapSequence: the nearest and the bracketing poses, and blends.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
+#include "openmp_shim.h"
 
 namespace drape {
 namespace {

@@ -3,7 +3,6 @@
 // the character's root, and a Step that allocates nothing with all of it on.
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <atomic>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "cloth_fixtures.h"
+#include "openmp_shim.h"
 #include "walking_legs.h"
 
 #include "drape/runtime/cloth.h"

@@ -3,7 +3,6 @@
 // determinism across thread counts and kernels.
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,6 +21,7 @@
 #include "drape/runtime/garments.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "openmp_shim.h"
 
 namespace drape {
 namespace {

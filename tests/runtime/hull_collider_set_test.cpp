@@ -5,9 +5,9 @@
 // builders).
 
 #include "drape/runtime/hull_collider_set.h"
+#include "openmp_shim.h"
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <array>
 #include <cmath>

@@ -1,7 +1,6 @@
 // The body maps' normal encodings (drape/runtime/normal_encoding.h): oct16's round trip and the
 // colour encoding's decode.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -13,6 +12,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
+#include "openmp_shim.h"
 
 namespace drape {
 namespace {

@@ -3,12 +3,12 @@
 // friction on a slope, the round cone's distance against a brute-force reference, hostile
 // inputs, argument validation, thread-count independence and no allocation on re-adding.
 
+#include "openmp_shim.h"
 #include "rigid_poses.h"
 
 #include "drape/runtime/shape_collider_set.h"
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <algorithm>
 #include <atomic>

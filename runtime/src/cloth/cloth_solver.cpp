@@ -399,7 +399,8 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
 
   const uint32_t count = settings_.substeps;
   const bool verlet = settings_.integrator == ClothIntegrator::kVerlet;
-  const bool parallel = static_cast<int64_t>(state->positions.size()) >= kParallelParticles;
+  [[maybe_unused]] const bool parallel =
+      static_cast<int64_t>(state->positions.size()) >= kParallelParticles;
   for (uint32_t k = 0; k < count; ++k) {
     Substep sub;
     sub.s0 = static_cast<float>(k) / static_cast<float>(count);
@@ -939,7 +940,8 @@ float ClothSolver::MaxStretch(const ClothState& state) const {
   const ClothSpring* springs = cloth.springs().data();
   const Float3* x = state.positions.data();
   float max_stretch = -1.f;  // a spring of length 0 has stretch -1
-  const bool parallel = static_cast<int64_t>(cloth.springs().size()) >= kParallelSprings;
+  [[maybe_unused]] const bool parallel =
+      static_cast<int64_t>(cloth.springs().size()) >= kParallelSprings;
 #pragma omp parallel if (parallel)
   for (const SpringColour& colour : cloth.colours()) {
     if (colour.kind != SpringKind::kStretch) continue;
