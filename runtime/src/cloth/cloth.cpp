@@ -410,8 +410,8 @@ struct Cloth::Builder {
         c.required_joints_ = std::max(c.required_joints_, w.joints[k] + 1);
       }
     }
-    c.skin_bind_ = d.skin_bind_positions.empty() ? d.positions : d.skin_bind_positions;
-    c.rest_normals_ = detail::VertexNormals(c.skin_bind_, c.triangles_);
+    c.skin_bind_ = d.skin_bind_positions;
+    c.rest_normals_ = detail::VertexNormals(c.skin_bind_positions(), c.triangles_);
     constexpr float kUnlimited = std::numeric_limits<float>::infinity();
     c.max_distance_ = d.max_distance.empty() ? std::vector<float>(n, kUnlimited) : d.max_distance;
     c.backstop_ = d.backstop.empty() ? std::vector<float>(n, kUnlimited) : d.backstop;

@@ -12,7 +12,8 @@ namespace drape {
 
 using detail::kParallelParticles;
 
-// Skinned garments: each skinned target's position and normal at the frame's start and end.
+// Skinned garments: each skinned target's position at the frame's start and end, and its normal
+// where it has a backstop.
 void ClothSolver::ComputeSkinnedTargets(const ClothFrame& frame) {
   const Cloth& cloth = *cloth_;
   const int64_t count = static_cast<int64_t>(skin_targets_.size());
@@ -20,6 +21,7 @@ void ClothSolver::ComputeSkinnedTargets(const ClothFrame& frame) {
   const ClothSkinWeights* skin = cloth.skin().data();
   const Float3* rest = cloth.skin_bind_positions().data();
   const Float3* normal = cloth.rest_normals().data();
+  const float* backstop = cloth.backstops().data();
   const Mat34* s0 = frame.skinning_start.data();
   const Mat34* s1 = frame.skinning_end.data();
 #pragma omp parallel for schedule(static) if (count >= kParallelParticles)
@@ -27,6 +29,9 @@ void ClothSolver::ComputeSkinnedTargets(const ClothFrame& frame) {
     const uint32_t i = skin_targets_[k];
     skin_start_[k] = detail::SkinPoint(skin[i], s0, rest[i]);
     skin_end_[k] = detail::SkinPoint(skin[i], s1, rest[i]);
+    // Only a backstop needs the normal (a kinematic particle is placed exactly).
+    if (k < skin_kinematic_count_ || !(backstop[i] < std::numeric_limits<float>::infinity()))
+      continue;
     skin_normal_start_[k] = detail::SkinVector(skin[i], s0, normal[i]);
     skin_normal_end_[k] = detail::SkinVector(skin[i], s1, normal[i]);
   }

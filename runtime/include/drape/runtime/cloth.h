@@ -156,7 +156,10 @@ class Cloth {
   // weighted, the triangles' winding), max distances and backstops (+inf where unlimited).
   bool skinned() const { return !skin_.empty(); }
   std::span<const ClothSkinWeights> skin() const { return skin_; }
-  std::span<const Float3> skin_bind_positions() const { return skin_bind_; }
+  // Bind positions of the skin: the description's, or the rest positions when it gave none.
+  std::span<const Float3> skin_bind_positions() const {
+    return skin_bind_.empty() && !skin_.empty() ? rest_positions() : skin_bind_;
+  }
   std::span<const Float3> rest_normals() const { return rest_normals_; }
   std::span<const float> max_distances() const { return max_distance_; }
   std::span<const float> backstops() const { return backstop_; }
@@ -199,7 +202,7 @@ class Cloth {
   std::vector<ClothAttachment> attachments_;
   std::vector<ClothTether> tethers_;
   std::vector<ClothSkinWeights> skin_;
-  std::vector<Float3> skin_bind_;
+  std::vector<Float3> skin_bind_;  // empty when the skin binds the rest positions
   std::vector<Float3> rest_normals_;
   std::vector<float> max_distance_, backstop_;
   std::vector<uint32_t> constrained_;
