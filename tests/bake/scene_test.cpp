@@ -62,6 +62,12 @@ class SceneTest : public ::testing::Test {
   }
   static const CharacterAsset& asset() { return *asset_; }
 
+  // Garment 0 of the scene resolved and skinned to the mannequin's body.
+  static Status ResolveSkinned(const Scene& scene, ResolvedGarment* garment) {
+    if (Status s = ResolveGarment(scene, 0, asset().skeleton, garment); !s.ok()) return s;
+    return SkinGarment(scene, 0, asset().skeleton, asset().mesh, garment);
+  }
+
   // A mini skirt (25 cm) held at the hips, walking the whole clip.
   static json MiniSkirt() {
     json j = DemoJson();
@@ -347,9 +353,7 @@ TEST_F(SceneTest, SkinnedGarmentTakesItsWeightsFromTheBody) {
   Scene scene;
   ASSERT_TRUE(Parse(j, &scene).ok());
   ResolvedGarment garment;
-  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment);
-  ASSERT_TRUE(s.ok()) << s.message();
-  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
+  Status s = ResolveSkinned(scene, &garment);
   ASSERT_TRUE(s.ok()) << s.message();
   const ClothDescription& d = garment.description;
   ASSERT_EQ(d.skin.size(), d.positions.size());
@@ -418,9 +422,7 @@ TEST_F(SceneTest, SkinnedObjGarmentTakesItsPaintedMaxDistance) {
     ASSERT_TRUE(parsed.ok()) << parsed.message();
   }
   ResolvedGarment garment;
-  Status s = ResolveGarment(scene, 0, asset().skeleton, &garment);
-  ASSERT_TRUE(s.ok()) << s.message();
-  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
+  Status s = ResolveSkinned(scene, &garment);
   ASSERT_TRUE(s.ok()) << s.message();
   const ClothDescription& d = garment.description;
   ASSERT_EQ(d.max_distance.size(), 36u);
@@ -433,8 +435,7 @@ TEST_F(SceneTest, SkinnedObjGarmentTakesItsPaintedMaxDistance) {
     std::ofstream out(obj);
     out << "v 0 1 0\nv 0.1 1 0\nv 0 1 0.1\nf 1 2 3\n";
   }
-  ASSERT_TRUE(ResolveGarment(scene, 0, asset().skeleton, &garment).ok());
-  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
+  s = ResolveSkinned(scene, &garment);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("/garments/0/skin/paint: the garment has no vertex colours"),
             std::string::npos)

@@ -174,6 +174,16 @@ Mat34 Swing(float t) {
   return m;
 }
 
+// Frame f of the swing of joint 0 (holds the matrices the frame points to).
+struct SwingFrame {
+  Mat34 start[1], end[1];
+  ClothFrame frame;
+  explicit SwingFrame(int f) : start{Swing(At(f))}, end{Swing(At(f + 1))} {
+    frame.skinning_start = start;
+    frame.skinning_end = end;
+  }
+};
+
 TEST(SkinnedGarment, StaysWithinMaxDistanceAndOutsideItsBackstop) {
   SkinnedSheet sheet(0.05f, 0.01f);
   ASSERT_TRUE(BuildCloth(sheet.description, &sheet.cloth).ok());
@@ -186,11 +196,9 @@ TEST(SkinnedGarment, StaysWithinMaxDistanceAndOutsideItsBackstop) {
   const std::span<const Float3> rest = sheet.cloth.rest_positions();
   float worst_distance = 0.f, worst_behind = 0.f;
   for (int f = 0; f < 120; ++f) {
-    Mat34 start[1] = {Swing(At(f))}, end[1] = {Swing(At(f + 1))};
-    ClothFrame frame;
-    frame.skinning_start = start;
-    frame.skinning_end = end;
-    ASSERT_TRUE(solver.Step(&state, {}, frame).ok());
+    const SwingFrame swing(f);
+    const Mat34* end = swing.end;
+    ASSERT_TRUE(solver.Step(&state, {}, swing.frame).ok());
     const Float3 normal = TransformVector(end[0], {0.f, 1.f, 0.f});
     for (size_t i = 17; i < rest.size(); ++i) {
       const Float3 skinned = TransformPoint(end[0], rest[i]);
@@ -222,12 +230,9 @@ TEST(SkinnedGarment, MaxDistanceZeroIsAnAttachment) {
   xa.Reset(a);
   xb.Reset(b);
   for (int f = 0; f < 60; ++f) {
-    Mat34 start[1] = {Swing(At(f))}, end[1] = {Swing(At(f + 1))};
-    ClothFrame frame;
-    frame.skinning_start = start;
-    frame.skinning_end = end;
-    ASSERT_TRUE(sa.Step(&xa, {}, frame).ok());
-    ASSERT_TRUE(sb.Step(&xb, {}, frame).ok());
+    const SwingFrame swing(f);
+    ASSERT_TRUE(sa.Step(&xa, {}, swing.frame).ok());
+    ASSERT_TRUE(sb.Step(&xb, {}, swing.frame).ok());
   }
   for (size_t i = 0; i < xa.positions.size(); ++i) {
     ASSERT_EQ(xa.positions[i].x, xb.positions[i].x) << i;
