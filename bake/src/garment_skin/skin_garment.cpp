@@ -5,6 +5,7 @@
 #include "drape/bake/scene.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
+#include "drape/runtime/skinning.h"
 #include "garment_skin/garment_skinning.h"
 
 namespace drape::bake {
@@ -12,22 +13,16 @@ namespace {
 
 Status Invalid(const std::string& message) { return Status(StatusCode::kInvalidArgument, message); }
 
-// The body's vertices in the garment's frame: the bind positions, or skinned to the rest pose.
-std::vector<Float3> BodyInGarmentFrame(const SceneGarment& g, const SkeletonData& skeleton,
-                                       const MeshData& body) {
-  if (g.frame != GarmentFrame::kRest) return body.positions;
+// The body's vertices in the garment's frame: the bind positions, or skinned to the rest pose
+// (SkinMesh, the runtime's linear blend skinning).
+Status BodyInGarmentFrame(const SceneGarment& g, const SkeletonData& skeleton, const MeshData& body,
+                          std::vector<Float3>* positions) {
+  *positions = body.positions;
+  if (g.frame != GarmentFrame::kRest) return Status::Ok();
   SkeletonPose rest;
-  std::vector<Float3> positions(body.positions.size());
-  if (!rest.Init(skeleton).ok()) return body.positions;
+  if (Status s = rest.Init(skeleton); !s.ok()) return s;
   rest.SetRest();
-  for (size_t v = 0; v < positions.size(); ++v) {
-    Float3 p;
-    for (uint32_t f = body.influence_offsets[v]; f < body.influence_offsets[v + 1]; ++f)
-      p += TransformPoint(rest.skinning()[body.influence_joints[f]], body.positions[v]) *
-           body.influence_weights[f];
-    positions[v] = p;
-  }
-  return positions;
+  return SkinMesh(body, rest.skinning(), *positions);
 }
 
 }  // namespace
@@ -46,9 +41,10 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
         !s.ok())
       return Invalid(at + "/weights_file: " + s.message());
   } else {
-    if (Status s = detail::TransferSkinWeights(body, BodyInGarmentFrame(g, skeleton, body),
-                                               d.positions, &d.skin);
-        !s.ok())
+    std::vector<Float3> body_positions;
+    if (Status s = BodyInGarmentFrame(g, skeleton, body, &body_positions); !s.ok())
+      return Invalid(at + ": the body at the rest pose: " + s.message());
+    if (Status s = detail::TransferSkinWeights(body, body_positions, d.positions, &d.skin); !s.ok())
       return Invalid(at + ": " + s.message());
     detail::SmoothSkinWeights(d.triangles, g.skin_smoothing, &d.skin);
   }
