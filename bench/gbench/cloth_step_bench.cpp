@@ -1,9 +1,10 @@
 // One 1/60 s frame of a 10 100-particle skirt (100 segments x 101 rings, waistband attached to
 // the hips) on a walking pair of legs made of 20 colliders (4 box hulls: thighs and shins; 16
 // joint spheres: hips, belly, thighs, knees, shins), with continuous collision and friction.
-// Arguments: OpenMP threads, substeps, colliders on (1) or off (0: the solver alone, the skirt
+// Arguments: workers (1: the serial task system; 2: drape's std::thread pool of 2, or OpenMP's
+// team of 2 with openmp = 1), substeps, colliders on (1) or off (0: the solver alone, the skirt
 // then falls freely below its waistband), engine defaults (1: long-range tethers and the 10 %
-// strain limit; 0: paper B's solver); 5 spring-correction iterations per substep (Verlet).
+// strain limit; 0: paper B's solver), openmp; 5 spring-correction iterations per substep (Verlet).
 // max_stretch_pct: the worst stretch spring over the timed frames.
 // BM_BulletSkirt is the peer: Bullet's soft body (bench/peers) on the same skirt
 // mesh, masses and waistband, against the same 4 boxes (btConvexHullShape of their 8 corners)
@@ -15,7 +16,9 @@
 //        --benchmark_report_aggregates_only=true
 
 #include <benchmark/benchmark.h>
+#if defined(_OPENMP)
 #include <omp.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -34,6 +37,7 @@
 #include "drape/runtime/garments.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "drape/runtime/task_system.h"
 
 namespace drape {
 namespace {
@@ -92,13 +96,23 @@ struct PenetrationCounters {
 };
 
 void BM_ClothStep(benchmark::State& state) {
-  const int threads = static_cast<int>(state.range(0));
-  omp_set_num_threads(threads);
+  const uint32_t workers = static_cast<uint32_t>(state.range(0));
+  ThreadPoolTaskSystem pool(workers);
+  TaskSystem* tasks = workers == 1 ? &SerialTaskSystem() : &pool;
+  if (state.range(4) != 0) {
+    tasks = OpenMpTaskSystem();
+    if (tasks == nullptr) return state.SkipWithError("built without OpenMP");
+#if defined(_OPENMP)
+    omp_set_num_threads(static_cast<int>(workers));
+#endif
+  }
+  SetTaskSystem(tasks);
   Scene& scene = GetScene();
   ClothSolverSettings settings = ClothSolverSettings::PaperB();
   settings.iterations = 5;
   settings.substeps = static_cast<uint32_t>(state.range(1));
   settings.damping = 0.2f;
+  settings.measure_stages = true;
   if (state.range(3) != 0) {
     const ClothSolverSettings engine;
     settings.tethers = engine.tethers;
@@ -119,6 +133,7 @@ void BM_ClothStep(benchmark::State& state) {
   int step = 0;
   uint64_t contacts = 0;
   float worst_stretch = 0.f;
+  ClothStageSeconds stages;
   const auto advance = [&]() {
     WalkPose(static_cast<float>(step) * kFrame, start);
     WalkPose(static_cast<float>(step + 1) * kFrame, end);
@@ -129,6 +144,11 @@ void BM_ClothStep(benchmark::State& state) {
       return false;
     }
     contacts += stats.contacts;
+    stages.integrate += stats.stage_seconds.integrate;
+    stages.springs += stats.stage_seconds.springs;
+    stages.constraints += stats.stage_seconds.constraints;
+    stages.collide += stats.stage_seconds.collide;
+    stages.bookkeeping += stats.stage_seconds.bookkeeping;
     worst_stretch = std::max(worst_stretch, stats.max_stretch);
     ++step;
     return true;
@@ -137,6 +157,7 @@ void BM_ClothStep(benchmark::State& state) {
     if (!advance()) return;  // one second: the skirt settles onto the legs
   contacts = 0;
   worst_stretch = 0.f;
+  stages = ClothStageSeconds{};
   int timed = 0;
   PenetrationCounters penetration;
   for (auto _ : state) {
@@ -151,19 +172,30 @@ void BM_ClothStep(benchmark::State& state) {
   state.counters["colliders"] = static_cast<double>(scene.collider_count);
   state.counters["contacts_per_frame"] = timed > 0 ? static_cast<double>(contacts) / timed : 0.0;
   state.counters["max_stretch_pct"] = 100.0 * worst_stretch;
+  // Stage times, ms per frame (ClothSolverSettings::measure_stages).
+  const double per_frame_ms = timed > 0 ? 1e3 / timed : 0.0;
+  state.counters["integrate_ms"] = stages.integrate * per_frame_ms;
+  state.counters["springs_ms"] = stages.springs * per_frame_ms;
+  state.counters["constraints_ms"] = stages.constraints * per_frame_ms;
+  state.counters["collide_ms"] = stages.collide * per_frame_ms;
+  state.counters["bookkeeping_ms"] = stages.bookkeeping * per_frame_ms;
   penetration.Report(state);
+  SetTaskSystem(nullptr);
 }
 BENCHMARK(BM_ClothStep)
-    ->ArgNames({"omp_threads", "substeps", "colliders", "engine"})
-    ->Args({1, 1, 1, 0})
-    ->Args({2, 1, 1, 0})
-    ->Args({1, 2, 1, 0})
-    ->Args({2, 2, 1, 0})
-    ->Args({1, 1, 0, 0})
-    ->Args({2, 1, 0, 0})
-    ->Args({1, 1, 1, 1})
-    ->Args({2, 1, 1, 1})
-    ->Args({1, 1, 0, 1})
+    ->ArgNames({"workers", "substeps", "colliders", "engine", "openmp"})
+    ->Args({1, 1, 1, 0, 0})
+    ->Args({2, 1, 1, 0, 0})
+    ->Args({2, 1, 1, 0, 1})
+    ->Args({1, 2, 1, 0, 0})
+    ->Args({2, 2, 1, 0, 0})
+    ->Args({1, 1, 0, 0, 0})
+    ->Args({2, 1, 0, 0, 0})
+    ->Args({2, 1, 0, 0, 1})
+    ->Args({1, 1, 1, 1, 0})
+    ->Args({2, 1, 1, 1, 0})
+    ->Args({1, 1, 0, 1, 0})
+    ->Args({2, 1, 0, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -24,7 +24,9 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", options.out_dir, "output directory (created)");
   app.add_option("--frames", options.frames, "frames to simulate (overrides the scene's duration)")
       ->check(CLI::Range(int64_t{1}, int64_t{10000000}));
-  app.add_option("--threads", options.threads, "OpenMP threads (default: all)")
+  app.add_option("--threads", options.threads,
+                 "worker threads: the cloth step's task pool and the bake's OpenMP team (default: "
+                 "all cores)")
       ->check(CLI::Range(1, 1024));
   app.add_flag("--dump-scene-reference", dump_reference,
                "print the scenes reference (docs/SCENES.md) as markdown and exit");

@@ -13,6 +13,7 @@
 
 #include "drape/runtime/math.h"
 #include "drape/runtime/skinning.h"
+#include "drape/runtime/task_system.h"
 
 namespace drape::sim {
 namespace {
@@ -360,44 +361,56 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
   // selected; the next Step poses it afresh).
   if (has_hull_set_) (void)hulls_.SelectSubstep(1.f, 1.f);
   const HullColliderSet* hulls = has_hull_set_ ? &hulls_ : nullptr;
-  for (const auto& g : garments_) {
-    const ClothState& state = g->state;
-    const auto n = static_cast<int64_t>(state.positions.size());
-    // The queries are const and thread-safe; the reductions (a count, a max, an AND) do not
-    // depend on the order, so the figures are the same at any thread count.
-    uint32_t inside_count = 0;
+  // The queries are const and thread-safe; they run in chunks of 1024 particles on the
+  // runtime's task system, each chunk's figures in its own slot, combined in chunk order.
+  struct ChunkFigures {
+    uint32_t inside = 0;
     float deepest = 0.f;
-    bool all_finite = true;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : inside_count) \
-    reduction(max : deepest) reduction(&& : all_finite)
-    for (int64_t i = 0; i < n; ++i) {
-      const Float3 p = state.positions[static_cast<size_t>(i)];
-      if (!Finite(p) || !Finite(state.velocities[static_cast<size_t>(i)])) {
-        all_finite = false;
+    bool finite = true;
+  };
+  struct Job {
+    const ClothState* state;
+    const HullColliderSet* hulls;
+    const BodyMapCollider* body_map;
+    std::vector<ChunkFigures> chunks;
+  };
+  constexpr size_t kChunk = 1024;
+  const TaskFunction measure_chunk = [](void* context, uint32_t chunk) {
+    Job& job = *static_cast<Job*>(context);
+    const ClothState& state = *job.state;
+    const size_t end = std::min(state.positions.size(), (size_t{chunk} + 1) * kChunk);
+    ChunkFigures& figures = job.chunks[chunk];
+    for (size_t i = size_t{chunk} * kChunk; i < end; ++i) {
+      const Float3 p = state.positions[i];
+      if (!Finite(p) || !Finite(state.velocities[i])) {
+        figures.finite = false;
         continue;
       }
-      bool inside = false;
-      float depth = 0.f;
-      if (hulls != nullptr) {
-        const ContactQuery q = hulls->Query(p, p);
-        if (q.inside_end) {
-          inside = true;
-          depth = std::max(depth, q.depth);
-        }
+      float depth = -1.f;  // < 0: outside every collider
+      if (job.hulls != nullptr) {
+        const ContactQuery q = job.hulls->Query(p, p);
+        if (q.inside_end) depth = std::max(depth, q.depth);
       }
-      if (body_map != nullptr) {
-        const ContactQuery q = body_map->Query(p, p);
-        if (q.inside_end) {
-          inside = true;
-          depth = std::max(depth, q.depth);
-        }
+      if (job.body_map != nullptr) {
+        const ContactQuery q = job.body_map->Query(p, p);
+        if (q.inside_end) depth = std::max(depth, q.depth);
       }
-      if (inside) ++inside_count;
-      deepest = std::max(deepest, depth);
+      if (depth < 0.f) continue;
+      ++figures.inside;
+      figures.deepest = std::max(figures.deepest, depth);
     }
-    stats->inside_particles += inside_count;
-    stats->max_penetration = std::max(stats->max_penetration, deepest);
-    stats->finite = stats->finite && all_finite;
+  };
+  for (const auto& g : garments_) {
+    Job job{&g->state, hulls, body_map, {}};
+    job.chunks.resize((g->state.positions.size() + kChunk - 1) / kChunk);
+    const auto count = static_cast<uint32_t>(job.chunks.size());
+    if (count == 1) measure_chunk(&job, 0);
+    if (count > 1) GetTaskSystem().ParallelFor(count, measure_chunk, &job);
+    for (const ChunkFigures& figures : job.chunks) {
+      stats->inside_particles += figures.inside;
+      stats->max_penetration = std::max(stats->max_penetration, figures.deepest);
+      stats->finite = stats->finite && figures.finite;
+    }
   }
 }
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
-#include "openmp_shim.h"
+#include "workers.h"
 
 namespace drape {
 namespace {
@@ -424,9 +424,8 @@ TEST(BodyMapCollider, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
   std::vector<Float3> result_positions[2], result_velocities[2];
   std::vector<uint8_t> result_flags[2];
   uint32_t contacts[2] = {0, 0};
-  const int saved_threads = omp_get_max_threads();
   for (int run = 0; run < 2; ++run) {
-    omp_set_num_threads(run + 1);
+    test::UseWorkers(run + 1);
     result_positions[run] = positions;
     result_velocities[run] = velocities;
     result_flags[run].assign(kCount, 0);
@@ -434,7 +433,7 @@ TEST(BodyMapCollider, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
                                result_flags[run], params, &contacts[run])
                     .ok());
   }
-  omp_set_num_threads(saved_threads);
+  test::UseDefaultWorkers();
   EXPECT_GT(contacts[0], 1000u);
   EXPECT_EQ(contacts[0], contacts[1]);
   EXPECT_EQ(0, std::memcmp(result_positions[0].data(), result_positions[1].data(),

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
-#include "openmp_shim.h"
+#include "workers.h"
 
 namespace drape {
 namespace {
@@ -175,9 +175,8 @@ TEST(BodyMapGaps, QuickPathsAndBatchAnswerAsTheWalkAtAnyThreadCount) {
     EXPECT_GT(contacts, 3000);
     std::vector<Float3> out_positions[2], out_velocities[2];
     std::vector<uint8_t> flags[2];
-    const int saved_threads = omp_get_max_threads();
     for (int run = 0; run < 2; ++run) {
-      omp_set_num_threads(run + 1);
+      test::UseWorkers(run + 1);
       out_positions[run] = positions;
       out_velocities[run] = velocities;
       flags[run].assign(kCount, 0);
@@ -185,7 +184,7 @@ TEST(BodyMapGaps, QuickPathsAndBatchAnswerAsTheWalkAtAnyThreadCount) {
                                  ResponseParams{})
                       .ok());
     }
-    omp_set_num_threads(saved_threads);
+    test::UseDefaultWorkers();
     EXPECT_EQ(
         0, std::memcmp(out_positions[0].data(), out_positions[1].data(), kCount * sizeof(Float3)));
     EXPECT_EQ(flags[0], flags[1]);

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
-#include "openmp_shim.h"
+#include "workers.h"
 
 namespace drape {
 namespace {
@@ -258,14 +258,13 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
       const InstructionSet lanes = kEveryLanes[run / 2];
       if (!UseLanes(&c, lanes)) continue;
       SCOPED_TRACE(::testing::Message() << threads << " thread(s), " << LanesName(lanes));
-      const int saved_threads = omp_get_max_threads();
-      omp_set_num_threads(threads);
+      test::UseWorkers(threads);
       std::vector<Float3> got_positions = positions, got_velocities = velocities;
       std::vector<uint8_t> got_flags(kCount, 0xee);
       uint32_t got_contacts = 0;
       const Status status =
           c.CollideBatch(previous, got_positions, got_velocities, got_flags, params, &got_contacts);
-      omp_set_num_threads(saved_threads);
+      test::UseDefaultWorkers();
       ASSERT_TRUE(status.ok()) << status.message();
       EXPECT_EQ(got_contacts, want_contacts);
       int differing = 0;

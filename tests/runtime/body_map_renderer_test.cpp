@@ -12,8 +12,8 @@
 #include "body_map/body_map_collider_access.h"
 #include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/math.h"
-#include "openmp_shim.h"
 #include "skinned_spheres.h"
+#include "workers.h"
 
 namespace drape {
 namespace {
@@ -143,10 +143,9 @@ TEST(BodyMapRenderer, IdenticalBitsAtAnyThreadCount) {
   const Mat34 pose[2] = {
       Mat34{}, Multiply(Translation(-0.3f, 0.05f, 0.04f),
                         Mat34{{0.8f, -0.6f, 0.f, 0.f, 0.6f, 0.8f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f}})};
-  const int saved = omp_get_max_threads();
   std::vector<float> reference;
   for (int threads : {1, 2, 3, 4}) {
-    omp_set_num_threads(threads);
+    test::UseWorkers(threads);
     BodyMapCollider maps;
     ASSERT_TRUE(renderer.Render(pose, &maps).ok());
     const std::vector<float> texels = Texels(maps);
@@ -158,7 +157,7 @@ TEST(BodyMapRenderer, IdenticalBitsAtAnyThreadCount) {
     EXPECT_EQ(std::memcmp(texels.data(), reference.data(), texels.size() * sizeof(float)), 0)
         << threads << " threads";
   }
-  omp_set_num_threads(saved);
+  test::UseDefaultWorkers();
 }
 
 TEST(BodyMapRenderer, AllocatesOnlyWhenTheWindowGrows) {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "cloth_fixtures.h"
-#include "openmp_shim.h"
 #include "walking_legs.h"
+#include "workers.h"
 
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
@@ -479,7 +479,7 @@ TEST(ClothSolverAllocations, StepAllocatesNothingWithEveryFeatureOn) {
     ASSERT_TRUE(skinned.Step(&xk, colliders, frame).ok());
   };
   for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
+    test::UseWorkers(threads);
     step(0);  // the thread pool starts
     const uint64_t before = g_allocations.load();
     for (int f = 1; f < 10; ++f) step(f);

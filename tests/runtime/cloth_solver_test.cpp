@@ -21,7 +21,7 @@
 #include "drape/runtime/garments.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
-#include "openmp_shim.h"
+#include "workers.h"
 
 namespace drape {
 namespace {
@@ -96,7 +96,7 @@ using test::SheetDescription;
 // ThreadCountDoesNotChangeResults sets the thread count itself.
 class SingleThreadEnvironment : public ::testing::Environment {
  public:
-  void SetUp() override { omp_set_num_threads(1); }
+  void SetUp() override { test::UseWorkers(1); }
 };
 [[maybe_unused]] const ::testing::Environment* const kSingleThread =
     ::testing::AddGlobalTestEnvironment(new SingleThreadEnvironment);
@@ -575,10 +575,11 @@ TEST(ClothSolver, RejectsBadFramesAndSettings) {
 // ---- Determinism -----------------------------------------------------------------------------
 
 // Runs `frames` frames of a 72 x 72 sheet (5184 particles, above every parallel threshold of the
-// solver) falling onto a sphere that rises, with wind and drag, on `threads` OpenMP threads.
-ClothState RunSheetScene(const Cloth& cloth, const ClothSolverSettings& settings, int threads,
-                         int frames, uint32_t* contacts = nullptr) {
-  omp_set_num_threads(threads);
+// solver) falling onto a sphere that rises, with wind and drag, under the given task system.
+ClothState RunSheetScene(const Cloth& cloth, const ClothSolverSettings& settings,
+                         const test::TaskSystemCase& tasks, int frames,
+                         uint32_t* contacts = nullptr) {
+  tasks.Use();
   HullColliderSet hulls;
   BuildSphere({0.f, 0.f, 0.f}, 0.3f, &hulls);
   ClothSolver solver;
@@ -595,7 +596,7 @@ ClothState RunSheetScene(const Cloth& cloth, const ClothSolverSettings& settings
     EXPECT_TRUE(s.ok()) << s.message();
     if (contacts != nullptr) *contacts += stats.hull_contacts;
   }
-  omp_set_num_threads(1);
+  test::UseWorkers(1);
   return state;
 }
 
@@ -607,9 +608,19 @@ void ExpectBitwiseEqual(const ClothState& a, const ClothState& b) {
   EXPECT_EQ(std::memcmp(a.previous_positions.data(), b.previous_positions.data(), bytes), 0);
 }
 
-// The same scene on one and on two OpenMP threads gives bitwise identical states, for both
-// integrators (explicit Euler on a heavier sheet so that few substeps are stable).
-TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
+// The same scene serially, on the std::thread pool at 2 and 4 workers and on OpenMP's team
+// gives bitwise identical states, for both integrators (explicit Euler on a heavier sheet so that
+// few substeps are stable).
+TEST(ClothSolver, TaskSystemDoesNotChangeResults) {
+  const std::vector<test::TaskSystemCase> systems = test::AllTaskSystems();
+  const test::TaskSystemCase& serial = systems.front();
+  const auto expect_same_under_every_system = [&](const Cloth& c, const ClothSolverSettings& s,
+                                                  int frames, const ClothState& reference) {
+    for (size_t k = 1; k < systems.size(); ++k) {
+      SCOPED_TRACE(systems[k].name);
+      ExpectBitwiseEqual(reference, RunSheetScene(c, s, systems[k], frames));
+    }
+  };
   ClothDescription d = SheetDescription(71, 1.2f, {0.f, 0.33f, 0.f});
   Cloth cloth;
   ASSERT_TRUE(BuildCloth(d, &cloth).ok());
@@ -619,9 +630,9 @@ TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
   verlet.drag = 0.5f;
   verlet.wind = {1.f, 0.f, 0.f};
   uint32_t contacts = 0;
-  const ClothState one = RunSheetScene(cloth, verlet, 1, 6, &contacts);
+  const ClothState one = RunSheetScene(cloth, verlet, serial, 6, &contacts);
   EXPECT_GT(contacts, 100u);  // the sheet reached the sphere
-  ExpectBitwiseEqual(one, RunSheetScene(cloth, verlet, 2, 6));
+  expect_same_under_every_system(cloth, verlet, 6, one);
 
   // The same sheet with its particles numbered in a shuffled order (a fixed permutation): most
   // springs are then "far" (between distant index chunks) and take the coloured path.
@@ -638,9 +649,9 @@ TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
   Cloth shuffled_cloth;
   ASSERT_TRUE(BuildCloth(shuffled, &shuffled_cloth).ok());
   contacts = 0;
-  const ClothState shuffled_one = RunSheetScene(shuffled_cloth, verlet, 1, 6, &contacts);
+  const ClothState shuffled_one = RunSheetScene(shuffled_cloth, verlet, serial, 6, &contacts);
   EXPECT_GT(contacts, 100u);
-  ExpectBitwiseEqual(shuffled_one, RunSheetScene(shuffled_cloth, verlet, 2, 6));
+  expect_same_under_every_system(shuffled_cloth, verlet, 6, shuffled_one);
 
   d = SheetDescription(71, 1.2f, {0.f, 0.305f, 0.f});
   d.density = 3.f;
@@ -653,9 +664,9 @@ TEST(ClothSolver, ThreadCountDoesNotChangeResults) {
   euler.drag = 0.5f;
   euler.wind = {1.f, 0.f, 0.f};
   contacts = 0;
-  const ClothState euler_one = RunSheetScene(heavy, euler, 1, 2, &contacts);
+  const ClothState euler_one = RunSheetScene(heavy, euler, serial, 2, &contacts);
   EXPECT_GT(contacts, 100u);
-  ExpectBitwiseEqual(euler_one, RunSheetScene(heavy, euler, 2, 2));
+  expect_same_under_every_system(heavy, euler, 2, euler_one);
 }
 
 // The spring kernel in SSE2 and in the scalar reference pack gives the same bits, with and without
@@ -667,9 +678,9 @@ TEST(ClothSolver, SimdAndScalarKernelsAgree) {
     ClothSolverSettings settings = ClothSolverSettings::PaperB();
     settings.buckling = buckling;
     settings.instruction_set = InstructionSet::kAvx2;
-    const ClothState simd = RunSheetScene(cloth, settings, 1, 20);
+    const ClothState simd = RunSheetScene(cloth, settings, test::AllTaskSystems().front(), 20);
     settings.instruction_set = InstructionSet::kScalar;
-    ExpectBitwiseEqual(simd, RunSheetScene(cloth, settings, 1, 20));
+    ExpectBitwiseEqual(simd, RunSheetScene(cloth, settings, test::AllTaskSystems().front(), 20));
   }
 }
 

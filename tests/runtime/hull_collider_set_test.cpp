@@ -5,7 +5,7 @@
 // builders).
 
 #include "drape/runtime/hull_collider_set.h"
-#include "openmp_shim.h"
+#include "workers.h"
 
 #include <gtest/gtest.h>
 
@@ -562,9 +562,9 @@ TEST(HullColliderTest, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
     std::vector<Float3> p1 = positions, v1 = velocities, p2 = positions, v2 = velocities;
     std::vector<uint8_t> f1(positions.size()), f2(positions.size());
     uint32_t c1 = 0, c2 = 0;
-    omp_set_num_threads(1);
+    test::UseWorkers(1);
     ASSERT_TRUE(set.CollideBatch(previous, p1, v1, f1, params, s0, s1, &c1).ok());
-    omp_set_num_threads(2);
+    test::UseWorkers(2);
     ASSERT_TRUE(set.CollideBatch(previous, p2, v2, f2, params, s0, s1, &c2).ok());
     EXPECT_EQ(c1, c2);
     EXPECT_GT(c1, 1000u);

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "body_map_test_fixtures.h"
-#include "openmp_shim.h"
+#include "workers.h"
 
 namespace drape {
 namespace {

@@ -3,8 +3,8 @@
 // friction on a slope, the round cone's distance against a brute-force reference, hostile
 // inputs, argument validation, thread-count independence and no allocation on re-adding.
 
-#include "openmp_shim.h"
 #include "rigid_poses.h"
+#include "workers.h"
 
 #include "drape/runtime/shape_collider_set.h"
 
@@ -536,12 +536,11 @@ TEST(ShapeColliderSetTest, SameBitsAtOneAndTwoThreads) {
     x1[i] = x0[i] + Float3{step(rng), step(rng), step(rng)};
     v[i] = {step(rng) * 60.f, step(rng) * 60.f, step(rng) * 60.f};
   }
-  const int saved = omp_get_max_threads();
   std::vector<Float3> results_x[2], results_v[2];
   std::vector<uint8_t> results_flags[2];
   uint32_t contacts[2] = {0, 0};
   for (int threads = 1; threads <= 2; ++threads) {
-    omp_set_num_threads(threads);
+    test::UseWorkers(threads);
     std::vector<Float3> x = x1, vel = v;
     std::vector<uint8_t> flags(n);
     ASSERT_TRUE(set.CollideBatch(x0, x, vel, flags, ResponseParams{}, 0.25f, 0.5f, 0.25f * kFrame,
@@ -551,7 +550,7 @@ TEST(ShapeColliderSetTest, SameBitsAtOneAndTwoThreads) {
     results_v[threads - 1] = vel;
     results_flags[threads - 1] = flags;
   }
-  omp_set_num_threads(saved);
+  test::UseDefaultWorkers();
   EXPECT_GT(contacts[0], n / 20);
   EXPECT_EQ(contacts[0], contacts[1]);
   EXPECT_EQ(std::memcmp(results_x[0].data(), results_x[1].data(), n * sizeof(Float3)), 0);

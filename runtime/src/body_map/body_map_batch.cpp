@@ -7,6 +7,7 @@
 #include <string>
 
 #include "drape/runtime/body_map_collider.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 namespace {
@@ -129,16 +130,13 @@ Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span
   // answer depends on that particle alone, so the schedule does not change a bit.
   const int64_t count = static_cast<int64_t>(n);
   constexpr int64_t kChunk = 1024;
-  const int64_t chunks = (count + kChunk - 1) / kChunk;
-  uint32_t contacts = 0;  // an integer sum: the same at any thread count
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : contacts) if (chunks > 1)
-  for (int64_t chunk = 0; chunk < chunks; ++chunk) {
-    const size_t begin = static_cast<size_t>(chunk * kChunk);
-    const size_t end = std::min(static_cast<size_t>(count), begin + static_cast<size_t>(kChunk));
-    contacts += CollideRange(previous.data() + begin, positions.data() + begin,
-                             velocities.data() + begin, flags.data() + begin, end - begin, params);
-  }
-  if (contact_count != nullptr) *contact_count = contacts;
+  detail::ChunkSum contacts;  // an integer sum: the same at any thread count
+  detail::ParallelRanges(count, kChunk, [&](int64_t begin, int64_t end) {
+    contacts.Add(CollideRange(previous.data() + begin, positions.data() + begin,
+                              velocities.data() + begin, flags.data() + begin,
+                              static_cast<size_t>(end - begin), params));
+  });
+  if (contact_count != nullptr) *contact_count = contacts.total();
   return Status::Ok();
 }
 
@@ -169,21 +167,18 @@ Status BodyMapCollider::InsideBatch(std::span<const Float3> points,
   }
   const int64_t count = static_cast<int64_t>(points.size());
   if (sampling_ != DepthSampling::kNearest || gap_layers_ != 0) {
-#pragma omp parallel for schedule(static) if (count > 16384)
-    for (int64_t k = 0; k < count; ++k) inside[k] = IsInside(points[k]) ? 1 : 0;
+    detail::ParallelFor(count, count > 16384 ? 4096 : count,
+                        [&](int64_t k) { inside[k] = IsInside(points[k]) ? 1 : 0; });
     return Status::Ok();
   }
-  // Chunks of 4096 points, each through InsideRange: inside an OpenMP region every shared
-  // variable is read through a pointer and the uint8_t stores may alias it, so a plain loop
-  // reloads the map's fields for every point (measured 2x slower).
+  // Chunks of 4096 points (one below 5 of them), each through InsideRange: in a loop over shared
+  // variables the uint8_t stores may alias them, so a plain loop reloads the map's fields for
+  // every point (measured 2x slower).
   constexpr int64_t kChunk = 4096;
-  const int64_t chunks = (count + kChunk - 1) / kChunk;
-#pragma omp parallel for schedule(static) if (chunks > 4)
-  for (int64_t chunk = 0; chunk < chunks; ++chunk) {
-    const int64_t begin = chunk * kChunk;
-    const int64_t end = std::min(count, begin + kChunk);
-    InsideRange(points.data() + begin, inside.data() + begin, static_cast<size_t>(end - begin));
-  }
+  detail::ParallelRanges(
+      count, count > 4 * kChunk ? kChunk : count, [&](int64_t begin, int64_t end) {
+        InsideRange(points.data() + begin, inside.data() + begin, static_cast<size_t>(end - begin));
+      });
   return Status::Ok();
 }
 

@@ -14,9 +14,8 @@
 #include "drape/runtime/normal_encoding.h"
 #include "drape/runtime/skinning.h"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "drape/runtime/task_system.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 namespace {
@@ -26,6 +25,8 @@ constexpr uint32_t kNoFace = std::numeric_limits<uint32_t>::max();
 // Init reserves this much more than the bind pose's window in each dimension: a pose that
 // spreads the limbs needs a wider window.
 constexpr double kReserveGrowth = 1.5;
+// Vertices or triangles per chunk of the per-vertex stages.
+constexpr int64_t kVertexGrain = 4096;
 
 Status Invalid(const std::string& message) {
   return Status(StatusCode::kInvalidArgument, "BodyMapRenderer: " + message);
@@ -286,13 +287,13 @@ Status BodyMapRenderer::SkinAndOffset(std::span<const Mat34> skinning) {
   }
   if (Status s = SkinMesh(*mesh_, skinning, posed_); !s.ok()) return Invalid(s.message());
   const int64_t vertices = static_cast<int64_t>(posed_.size());
+  // Beyond 1e15 m the window arithmetic loses every texel: a hostile matrix, not a pose. The
+  // check is cheap next to the skinning: one pass on the calling thread.
   int64_t first_bad = vertices;
-#pragma omp parallel for schedule(static) reduction(min : first_bad)
-  for (int64_t v = 0; v < vertices; ++v) {
-    // Beyond 1e15 m the window arithmetic loses every texel: a hostile matrix, not a pose.
+  for (int64_t v = 0; v < vertices && first_bad == vertices; ++v) {
     const Float3 p = posed_[v];
     const bool sane = std::fabs(p.x) < 1e15f && std::fabs(p.y) < 1e15f && std::fabs(p.z) < 1e15f;
-    if (!sane) first_bad = std::min(first_bad, v);
+    if (!sane) first_bad = v;
   }
   if (first_bad < vertices) {
     return Invalid("skinned vertex " + std::to_string(first_bad) +
@@ -300,8 +301,8 @@ Status BodyMapRenderer::SkinAndOffset(std::span<const Mat34> skinning) {
   }
   ComputeNormals();
   const float epsilon = options_.epsilon;
-#pragma omp parallel for schedule(static)
-  for (int64_t v = 0; v < vertices; ++v) offset_[v] = posed_[v] + normals_[v] * epsilon;
+  detail::ParallelFor(vertices, kVertexGrain,
+                      [&](int64_t v) { offset_[v] = posed_[v] + normals_[v] * epsilon; });
   return Status::Ok();
 }
 
@@ -309,20 +310,18 @@ Status BodyMapRenderer::SkinAndOffset(std::span<const Mat34> skinning) {
 void BodyMapRenderer::ComputeNormals() {
   const uint32_t* tri = mesh_->triangles.data();
   const int64_t triangles = static_cast<int64_t>(face_normals_.size());
-#pragma omp parallel for schedule(static)
-  for (int64_t t = 0; t < triangles; ++t) {
+  detail::ParallelFor(triangles, kVertexGrain, [&](int64_t t) {
     const Float3 a = posed_[tri[3 * t]], b = posed_[tri[3 * t + 1]], c = posed_[tri[3 * t + 2]];
     face_normals_[t] = Cross(b - a, c - a);
-  }
+  });
   const int64_t vertices = static_cast<int64_t>(posed_.size());
-#pragma omp parallel for schedule(static)
-  for (int64_t v = 0; v < vertices; ++v) {
+  detail::ParallelFor(vertices, kVertexGrain, [&](int64_t v) {
     Float3 sum{0.f, 0.f, 0.f};
     for (uint32_t k = vertex_triangle_offsets_[v]; k < vertex_triangle_offsets_[v + 1]; ++k) {
       sum += face_normals_[vertex_triangles_[k]];
     }
     normals_[v] = NormalizeOr(sum, Float3{0.f, 0.f, 0.f});
-  }
+  });
 }
 
 // Stage 2: the triangles whose offset box meets the region, ascending.
@@ -420,17 +419,13 @@ void BodyMapRenderer::Reserve(size_t texels) {
 // by one band only and the result does not depend on the banding.
 void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   const int64_t width = window.width, height = window.height;
-  int bands = 1;
-#ifdef _OPENMP
-  bands = 4 * omp_get_max_threads();
-#endif
+  const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};  // balance, not results
   const int64_t rows_per_band = std::max<int64_t>(8, (height + bands - 1) / bands);
   const int64_t band_count = (height + rows_per_band - 1) / rows_per_band;
   const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
   const uint32_t* tri = mesh_->triangles.data();
   BodyMapCollider::Slab* slabs = maps->slabs_.data();
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int64_t band = 0; band < band_count; ++band) {
+  detail::ParallelFor(band_count, 1, [&](int64_t band) {
     const int64_t row_begin = band * rows_per_band;
     const int64_t row_end = std::min(height, row_begin + rows_per_band);
     for (uint32_t t : drawn_) {
@@ -477,7 +472,7 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
         }
       }
     }
-  }
+  });
 }
 
 // Stage 5: the outward normal of each covered texel's front and back surfaces, oct16.
@@ -486,8 +481,7 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
   const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
   const uint32_t* tri = mesh_->triangles.data();
   const std::array<uint16_t, 2> up = EncodeOct16({0.f, 0.f, 1.f});
-#pragma omp parallel for schedule(static)
-  for (int64_t j = 0; j < height; ++j) {
+  detail::ParallelFor(height, 8, [&](int64_t j) {
     const double py = static_cast<double>(j) + 0.5;
     NormalInterpolator front, back;
     for (int64_t i = 0; i < width; ++i) {
@@ -511,7 +505,7 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
       const std::array<uint16_t, 2> b = EncodeOct16(back.At(px, py));
       out = {{a[0], a[1]}, {b[0], b[1]}};
     }
-  }
+  });
 }
 
 Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps,
@@ -541,8 +535,7 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
   maps->slabs_.resize(texels);  // capacity kept from earlier grids
   maps->normals_.resize(texels);
   const int64_t count = static_cast<int64_t>(texels);
-#pragma omp parallel for schedule(static) if (count > 65536)
-  for (int64_t k = 0; k < count; ++k) {
+  detail::ParallelFor(count, count > 65536 ? 16384 : count, [&](int64_t k) {
     const float top = view.front_z[k], bottom = view.back_z[k];
     const bool body = std::isfinite(top) && std::isfinite(bottom) && top >= bottom;
     maps->slabs_[k] =
@@ -551,7 +544,7 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
     const std::array<uint16_t, 2> back =
         EncodeOct16(IsFinite(view.back_normals[k]) ? view.back_normals[k] : Float3{0.f, 0.f, -1.f});
     maps->normals_[k] = {{front[0], front[1]}, {back[0], back[1]}};
-  }
+  });
   maps->width_ = view.width;
   maps->height_ = view.height;
   maps->width_f_ = static_cast<float>(view.width);

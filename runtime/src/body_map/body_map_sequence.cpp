@@ -7,6 +7,8 @@
 #include <limits>
 #include <string>
 
+#include "tasks/parallel_for.h"
+
 namespace drape {
 namespace {
 
@@ -92,8 +94,7 @@ const BodyMapCollider& BodyMapSequence::At(float time, BodyMapCollider* scratch)
   out.slabs_.resize(n);  // allocates only when the scratch has never held this grid size
   out.normals_.resize(n);
   const int64_t count = static_cast<int64_t>(n);
-#pragma omp parallel for schedule(static) if (count > 65536)
-  for (int64_t k = 0; k < count; ++k) {
+  detail::ParallelFor(count, count > 65536 ? 16384 : count, [&](int64_t k) {
     const BodyMapCollider::Slab sa = a.slabs_[k], sb = b.slabs_[k];
     const bool valid_a = sa.top >= sa.bottom, valid_b = sb.top >= sb.bottom;
     BodyMapCollider::Slab slab{-kInf, kInf};
@@ -106,7 +107,7 @@ const BodyMapCollider& BodyMapSequence::At(float time, BodyMapCollider* scratch)
     }
     out.slabs_[k] = slab;
     out.normals_[k] = nearer.normals_[k];
-  }
+  });
   BlendGaps(a, b, w, &out);
   out.Finish();
   return out;

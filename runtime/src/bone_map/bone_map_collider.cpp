@@ -8,6 +8,7 @@
 #include <string>
 
 #include "drape/runtime/math.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 namespace {
@@ -190,14 +191,17 @@ Status BoneMapCollider::CollideBatch(std::span<const Float3> previous, std::span
                   " (friction in [0, 1], static_friction in [0, 4], restitution in [0, 1], "
                   "separation finite and >= 0)");
   }
-  uint32_t contacts = 0;
-  const int64_t count = static_cast<int64_t>(n);
-#pragma omp parallel for schedule(static) reduction(+ : contacts)
-  for (int64_t i = 0; i < count; ++i) {
-    flags[i] = CollideOne(previous[i], &positions[i], &velocities[i], params);
-    contacts += (flags[i] & kCollisionContact) != 0 ? 1u : 0u;
-  }
-  if (contact_count != nullptr) *contact_count = contacts;
+  // Chunks of 256 particles (a particle costs up to microseconds here); integer contact sums.
+  detail::ChunkSum contacts;
+  detail::ParallelRanges(static_cast<int64_t>(n), 256, [&](int64_t begin, int64_t end) {
+    uint32_t chunk_contacts = 0;
+    for (int64_t i = begin; i < end; ++i) {
+      flags[i] = CollideOne(previous[i], &positions[i], &velocities[i], params);
+      chunk_contacts += (flags[i] & kCollisionContact) != 0 ? 1u : 0u;
+    }
+    contacts.Add(chunk_contacts);
+  });
+  if (contact_count != nullptr) *contact_count = contacts.total();
   return Status::Ok();
 }
 

@@ -7,10 +7,12 @@
 #include "cloth/cloth_solver_internal.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/math.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 
-using detail::kParallelParticles;
+using detail::kParticleGrain;
+using detail::ParallelFor;
 
 // Skinned garments: each skinned target's position at the frame's start and end, and its normal
 // where it has a backstop.
@@ -24,17 +26,16 @@ void ClothSolver::ComputeSkinnedTargets(const ClothFrame& frame) {
   const float* backstop = cloth.backstops().data();
   const Mat34* s0 = frame.skinning_start.data();
   const Mat34* s1 = frame.skinning_end.data();
-#pragma omp parallel for schedule(static) if (count >= kParallelParticles)
-  for (int64_t k = 0; k < count; ++k) {
+  ParallelFor(count, kParticleGrain, [&](int64_t k) {
     const uint32_t i = skin_targets_[k];
     skin_start_[k] = detail::SkinPoint(skin[i], s0, rest[i]);
     skin_end_[k] = detail::SkinPoint(skin[i], s1, rest[i]);
     // Only a backstop needs the normal (a kinematic particle is placed exactly).
     if (k < skin_kinematic_count_ || !(backstop[i] < std::numeric_limits<float>::infinity()))
-      continue;
+      return;
     skin_normal_start_[k] = detail::SkinVector(skin[i], s0, normal[i]);
     skin_normal_end_[k] = detail::SkinVector(skin[i], s1, normal[i]);
-  }
+  });
 }
 
 // Each tethered particle is pulled back onto the sphere of its tether's length around its anchor
@@ -47,17 +48,16 @@ void ClothSolver::ApplyTethers(ClothState* state, const Substep& sub) {
   Float3* v = state->velocities.data();
   const bool euler = settings_.integrator == ClothIntegrator::kExplicitEuler;
   const float inv_h = 1.f / sub.h;
-#pragma omp for schedule(static)
-  for (int64_t k = 0; k < count; ++k) {
+  ParallelFor(count, kParticleGrain, [&](int64_t k) {
     const ClothTether& t = tethers[k];
     const Float3 anchor = x[t.anchor];
     const Float3 d = x[t.particle] - anchor;
     const float squared = Dot(d, d);
-    if (!(squared > t.length * t.length)) continue;
+    if (!(squared > t.length * t.length)) return;
     const Float3 moved = anchor + d * (t.length / std::sqrt(squared));
     if (euler) v[t.particle] += (moved - x[t.particle]) * inv_h;  // Verlet re-derives it
     x[t.particle] = moved;
-  }
+  });
 }
 
 // Skinned garments: a particle farther than its max distance from its skinned position is pulled
@@ -73,8 +73,8 @@ void ClothSolver::ApplySkinConstraints(ClothState* state, const Substep& sub) {
   const bool euler = settings_.integrator == ClothIntegrator::kExplicitEuler;
   const float inv_h = 1.f / sub.h;
   const float s = sub.s1;
-#pragma omp for schedule(static)
-  for (int64_t k = begin; k < end; ++k) {
+  ParallelFor(end - begin, kParticleGrain, [&](int64_t offset) {
+    const int64_t k = begin + offset;
     const uint32_t i = skin_targets_[k];
     const Float3 target = skin_start_[k] * (1.f - s) + skin_end_[k] * s;
     Float3 p = x[i];
@@ -90,7 +90,7 @@ void ClothSolver::ApplySkinConstraints(ClothState* state, const Substep& sub) {
     }
     if (euler) v[i] += (p - x[i]) * inv_h;
     x[i] = p;
-  }
+  });
 }
 
 }  // namespace drape

@@ -10,12 +10,12 @@
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 
 using detail::Finite;
 using detail::InvalidArgument;
-using detail::kParallelParticles;
 
 // The root's world rotation and position at the frame's start and end; the carried share of its
 // motion is applied per substep by CarryWithRoot, the centrifugal push in Integrate.
@@ -44,10 +44,10 @@ ClothSolver::RootMotion ClothSolver::ComputeRootMotion(const ClothFrame& frame) 
   return root;
 }
 
-// Moves every particle (and turns its velocity) by the carried share of the root's motion over
-// the substep: a rotation by (1 - angular_inertia) of the root's turn about its position, then
-// (1 - linear_inertia) of its translation.
-void ClothSolver::CarryWithRoot(ClothState* state, const RootMotion& root, const Substep& sub) {
+// The carried share of the root's motion over the substep, which BeginSubstep applies to every
+// particle (and its velocity): a rotation by (1 - angular_inertia) of the root's turn about its
+// position, then (1 - linear_inertia) of its translation.
+Mat34 ClothSolver::CarriedMotion(const RootMotion& root, const Substep& sub) const {
   const float carry_linear = 1.f - settings_.linear_inertia;
   const float carry_angular = 1.f - settings_.angular_inertia;
   const Quat identity;
@@ -63,14 +63,7 @@ void ClothSolver::CarryWithRoot(ClothState* state, const RootMotion& root, const
   m.m[3] = pivot.x - moved.x + shift.x;
   m.m[7] = pivot.y - moved.y + shift.y;
   m.m[11] = pivot.z - moved.z + shift.z;
-  Float3* x = state->positions.data();
-  Float3* v = state->velocities.data();
-  const int64_t n = static_cast<int64_t>(state->positions.size());
-#pragma omp for schedule(static) nowait
-  for (int64_t i = 0; i < n; ++i) {
-    x[i] = TransformPoint(m, x[i]);
-    v[i] = TransformVector(m, v[i]);
-  }
+  return m;
 }
 
 // ---- Teleport and reset ------------------------------------------------------------------------
@@ -90,13 +83,12 @@ Status ClothSolver::Teleport(ClothState* state, const Mat34& transform) const {
             "Teleport: the transform is not rigid (a rotation and a translation)");
     }
   }
-  const int64_t n = static_cast<int64_t>(state->positions.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelParticles)
-  for (int64_t i = 0; i < n; ++i) {
-    state->positions[i] = TransformPoint(transform, state->positions[i]);
-    state->previous_positions[i] = TransformPoint(transform, state->previous_positions[i]);
-    state->velocities[i] = TransformVector(transform, state->velocities[i]);
-  }
+  detail::ParallelFor(
+      static_cast<int64_t>(state->positions.size()), detail::kParticleGrain, [&](int64_t i) {
+        state->positions[i] = TransformPoint(transform, state->positions[i]);
+        state->previous_positions[i] = TransformPoint(transform, state->previous_positions[i]);
+        state->velocities[i] = TransformVector(transform, state->velocities[i]);
+      });
   return Status::Ok();
 }
 

@@ -4,7 +4,9 @@
 #include "cloth/spring_colouring.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -15,6 +17,7 @@
 
 #include "common/lanes/scalar_lanes.h"
 #include "common/lanes/sse2_lanes.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 namespace {
@@ -26,12 +29,35 @@ using internal::SpringRun;
 
 using detail::Finite;
 using detail::InvalidArgument;
-using detail::kParallelParticles;
+using detail::kParticleGrain;
+using detail::ParallelFor;
+using detail::ParallelRanges;
 
 constexpr uint32_t kNoParticle = std::numeric_limits<uint32_t>::max();
 constexpr uint32_t kMaxSubsteps = 256;
 constexpr uint32_t kMaxIterations = 256;
-constexpr int64_t kParallelSprings = 4096;  // springs: see kParallelParticles
+// Blocks of four springs per chunk of a run shared among the workers (the far springs), and
+// springs per chunk of the stretch measure.
+constexpr int64_t kBlockGrain = 256;
+constexpr int64_t kSpringGrain = 4096;
+
+// Adds the time since the last lap to a stage's seconds, when on (measure_stages).
+class StageClock {
+ public:
+  StageClock(bool on, ClothStageSeconds* out)
+      : out_(on ? out : nullptr), last_(on ? Clock::now() : Clock::time_point{}) {}
+  void Lap(double ClothStageSeconds::*stage) {
+    if (out_ == nullptr) return;
+    const Clock::time_point now = Clock::now();
+    out_->*stage += std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  ClothStageSeconds* out_;
+  Clock::time_point last_;
+};
 
 // Which sign of the length error a spring acts on (paper A's buckling model restricts it).
 enum class SpringSide { kBoth, kStretched, kCompressed };
@@ -116,13 +142,13 @@ void CorrectRunSequential(const SpringBlock* blocks, const SpringRun& run, const
   for (uint32_t k = run.begin; k < run.end; ++k) CorrectFour<side>(blocks[k], c, p);
 }
 
-// The blocks of one run shared among the threads of the enclosing parallel region.
+// The blocks of one run shared among the workers (chunks of kBlockGrain blocks).
 template <SpringSide side>
 void CorrectRunShared(const SpringBlock* blocks, const SpringRun& run, const Correction& c,
                       Particle4* p) {
-  const int64_t begin = run.begin, end = run.end;
-#pragma omp for schedule(static)
-  for (int64_t k = begin; k < end; ++k) CorrectFour<side>(blocks[k], c, p);
+  const int64_t begin = run.begin;
+  ParallelFor(int64_t{run.end} - begin, kBlockGrain,
+              [&](int64_t k) { CorrectFour<side>(blocks[begin + k], c, p); });
 }
 
 // Appends `springs` (pairwise disjoint: one colour) as blocks of four, in order. The lanes of the
@@ -172,13 +198,12 @@ void AccumulateRunLanes(const SpringBlock* blocks, const SpringRun& run, bool sh
   const int64_t begin = run.begin, end = run.end;
   const auto block_forces = [&](int64_t k) {
     for (uint32_t lane = 0; lane < 4; ++lane)
-      AccumulateSpring<side>(blocks[k], lane, stiffness, damping, x, v, forces);
+      AccumulateSpring<side>(blocks[begin + k], lane, stiffness, damping, x, v, forces);
   };
   if (shared) {
-#pragma omp for schedule(static)
-    for (int64_t k = begin; k < end; ++k) block_forces(k);
+    ParallelFor(end - begin, kBlockGrain, block_forces);
   } else {
-    for (int64_t k = begin; k < end; ++k) block_forces(k);
+    for (int64_t k = 0; k < end - begin; ++k) block_forces(k);
   }
 }
 
@@ -251,10 +276,10 @@ Status ClothSolver::SetSettings(const ClothSolverSettings& s) {
 // is "far". Each group's springs are coloured (first fit, stretch then bend, in (a, b) order) and
 // each colour is one run of blocks of four: the blocks of a run are independent, so the CPU
 // overlaps their square roots and divisions. SolveSprings then runs per iteration: all chunks in
-// parallel (one thread per chunk, its runs in order), the even zones in parallel, the odd zones
+// parallel (one task per chunk, its runs in order), the even zones in parallel, the odd zones
 // in parallel (zone c touches chunks c and c + 1 only, so zones two apart share no particle),
-// then the far runs one by one, each shared among the threads. Meshes numbered row by row (every
-// generated garment, most scanned meshes) have no far springs: three barriers per iteration.
+// then the far runs one by one, each shared among the workers. Meshes numbered row by row (every
+// generated garment, most scanned meshes) have no far springs: three ParallelFors per iteration.
 void ClothSolver::BuildSpringGroups(const Cloth& cloth) {
   const uint32_t n = cloth.particle_count();
   // Chunks of at least 256 particles and longer than 99 % of the springs' index spans |a - b| (so
@@ -374,47 +399,52 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
   ClothStepStats local_stats;
   ClothStepStats& st = stats != nullptr ? *stats : local_stats;
   st = ClothStepStats{};
+  StageClock setup_clock(settings_.measure_stages, &st.stage_seconds);
   if (Status s = ValidateFrame(*state, colliders, frame); !s.ok()) return s;
   if (const uint32_t bad = FirstNonFinite(*state); bad != kNoParticle)
     return Status(StatusCode::kInvalidState,
                   "ClothSolver::Step: input state of particle " + std::to_string(bad) +
                       " is not finite (position or velocity); nothing was simulated");
+  setup_clock.Lap(&ClothStageSeconds::bookkeeping);
   if (colliders.hulls != nullptr) {
     if (Status s = colliders.hulls->SetPose(frame.skinning_start, frame.skinning_end); !s.ok())
       return s;
   }
+  setup_clock.Lap(&ClothStageSeconds::collide);
   const RootMotion root = ComputeRootMotion(frame);
   ComputeSkinnedTargets(frame);
+  setup_clock.Lap(&ClothStageSeconds::constraints);
 
   const uint32_t count = settings_.substeps;
   const bool verlet = settings_.integrator == ClothIntegrator::kVerlet;
-  [[maybe_unused]] const bool parallel =
-      static_cast<int64_t>(state->positions.size()) >= kParallelParticles;
   for (uint32_t k = 0; k < count; ++k) {
     Substep sub;
     sub.s0 = static_cast<float>(k) / static_cast<float>(count);
     sub.s1 = static_cast<float>(k + 1) / static_cast<float>(count);  // exactly 1 at the end
     sub.h = frame.dt / static_cast<float>(count);
 
-    // The solver's own stages share one parallel region: each holds `omp for` loops bound to it.
-#pragma omp parallel if (parallel)
-    {
-      BeginSubstep(state);
-      if (root.carry) CarryWithRoot(state, root, sub);
-      if (!verlet) AccumulateSpringForces(*state);
-      Integrate(state, sub, root);
-      ApplyAttachments(state, frame, sub);
-      if (verlet) SolveSprings(state);
-      ApplyTethers(state, sub);
-      ApplySkinConstraints(state, sub);
-      UpdateVelocities(state, sub);
-    }
-    // The colliders parallelise their batches themselves.
+    // Each stage hands its chunks to the task system and returns when they are done.
+    StageClock clock(settings_.measure_stages, &st.stage_seconds);
+    BeginSubstep(state, root, sub);
+    clock.Lap(&ClothStageSeconds::integrate);
+    if (!verlet) AccumulateSpringForces(*state);
+    clock.Lap(&ClothStageSeconds::springs);
+    Integrate(state, sub, root);
+    ApplyAttachments(state, frame, sub);
+    clock.Lap(&ClothStageSeconds::integrate);
+    if (verlet) SolveSprings(state);
+    clock.Lap(&ClothStageSeconds::springs);
+    ApplyTethers(state, sub);
+    ApplySkinConstraints(state, sub);
+    clock.Lap(&ClothStageSeconds::constraints);
+    UpdateVelocities(state, sub);
+    clock.Lap(&ClothStageSeconds::integrate);
     if (Status s = Collide(state, colliders, sub, &st); !s.ok()) {
       RestoreBackup(state);
       return s;
     }
     RestoreKinematic(state);
+    clock.Lap(&ClothStageSeconds::collide);
     if (const uint32_t bad = FirstNonFinite(*state); bad != kNoParticle) {
       RestoreBackup(state);
       st.contacts = 0;
@@ -427,8 +457,11 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
     }
     st.contacts = CountContacts();
     ++st.substeps;
+    clock.Lap(&ClothStageSeconds::bookkeeping);
   }
+  StageClock clock(settings_.measure_stages, &st.stage_seconds);
   st.max_stretch = MaxStretch(*state);
+  clock.Lap(&ClothStageSeconds::bookkeeping);
   return Status::Ok();
 }
 
@@ -464,22 +497,31 @@ Status ClothSolver::ValidateFrame(const ClothState& state, const ClothColliders&
 }
 
 // ---- Stages ------------------------------------------------------------------------------------
-// BeginSubstep .. UpdateVelocities run inside Step's parallel region (their `omp for` loops bind
-// to it; called outside one they run on the calling thread). Loops over all particles use the
-// same static schedule, so a thread sees its own writes of the previous such loop without a
-// barrier; loops that read other particles come after a barrier.
+// Each stage is one or more ParallelFors (tasks/parallel_for.h): per-particle stages in chunks of
+// kParticleGrain particles, the springs by group. A ParallelFor returns when all its chunks are
+// done, so a stage sees every write of the stages before it.
 
-void ClothSolver::BeginSubstep(ClothState* state) {
-  const Float3* x = state->positions.data();
-  const Float3* v = state->velocities.data();
+// The state's backup (restored if the substep fails), then the carried share of the root's
+// motion, in one pass over the particles.
+void ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub) {
+  Float3* x = state->positions.data();
+  Float3* v = state->velocities.data();
   Float3* backup_x = backup_positions_.data();
   Float3* backup_v = backup_velocities_.data();
-  const int64_t n = static_cast<int64_t>(state->positions.size());
-#pragma omp for schedule(static) nowait
-  for (int64_t i = 0; i < n; ++i) {
-    backup_x[i] = x[i];
-    backup_v[i] = v[i];
-  }
+  const bool carry = root.carry;
+  const Mat34 carried = carry ? CarriedMotion(root, sub) : Mat34{};
+  ParallelRanges(static_cast<int64_t>(state->positions.size()), kParticleGrain,
+                 [&](int64_t begin, int64_t end) {
+                   for (int64_t i = begin; i < end; ++i) {
+                     backup_x[i] = x[i];
+                     backup_v[i] = v[i];
+                   }
+                   if (!carry) return;
+                   for (int64_t i = begin; i < end; ++i) {
+                     x[i] = TransformPoint(carried, x[i]);
+                     v[i] = TransformVector(carried, v[i]);
+                   }
+                 });
 }
 
 // The same traversal as SolveSprings (chunks, even zones, odd zones, far runs): every spring
@@ -489,22 +531,14 @@ void ClothSolver::AccumulateSpringForces(const ClothState& state) {
   const Float3* v = state.velocities.data();
   Float3* forces = forces_.data();
   const int64_t n = static_cast<int64_t>(forces_.size());
-  // The barrier after this loop also orders the springs after every thread's root motion.
-#pragma omp for schedule(static)
-  for (int64_t i = 0; i < n; ++i) forces[i] = Float3{};
+  ParallelFor(n, kParticleGrain, [&](int64_t i) { forces[i] = Float3{}; });
   const auto group_forces = [&](const SpringGroup& group) {
     for (uint32_t r = group.run_begin; r < group.run_end; ++r)
       AccumulateRun(runs_[r], false, x, v, forces);
   };
-  const int64_t chunk_count = static_cast<int64_t>(chunk_groups_.size());
-  const int64_t even_count = static_cast<int64_t>(even_zones_.size());
-  const int64_t odd_count = static_cast<int64_t>(odd_zones_.size());
-#pragma omp for schedule(static)
-  for (int64_t g = 0; g < chunk_count; ++g) group_forces(chunk_groups_[g]);
-#pragma omp for schedule(static)
-  for (int64_t g = 0; g < even_count; ++g) group_forces(even_zones_[g]);
-#pragma omp for schedule(static)
-  for (int64_t g = 0; g < odd_count; ++g) group_forces(odd_zones_[g]);
+  for (const std::vector<SpringGroup>* groups : {&chunk_groups_, &even_zones_, &odd_zones_})
+    ParallelFor(static_cast<int64_t>(groups->size()), 1,
+                [&](int64_t g) { group_forces((*groups)[g]); });
   for (uint32_t r = far_runs_.run_begin; r < far_runs_.run_end; ++r)
     AccumulateRun(runs_[r], true, x, v, forces);
 }
@@ -554,13 +588,11 @@ void ClothSolver::Integrate(ClothState* state, const Substep& sub, const RootMot
   const Float3 pivot = Lerp(root.pivot0, root.pivot1, sub.s0);
   const float centrifugal_scale = (1.f - settings_.angular_inertia) * settings_.centrifugal_inertia;
   const int64_t n = static_cast<int64_t>(state->positions.size());
-  // Barrier at the end: ApplyAttachments writes particles other threads read here.
-#pragma omp for schedule(static)
-  for (int64_t i = 0; i < n; ++i) {
+  ParallelFor(n, kParticleGrain, [&](int64_t i) {
     const Float3 xi = x[i];
     x_start[i] = xi;
     const float w = inverse_mass[i];
-    if (w == 0.f) continue;  // pinned or attached: moved by the caller or ApplyAttachments
+    if (w == 0.f) return;  // pinned or attached: moved by the caller or ApplyAttachments
     const float drag_rate = drag * area[i] * w;  // 1/s
     const float rate = damping + drag_rate;
     Float3 a = g + wind * drag_rate;
@@ -571,7 +603,7 @@ void ClothSolver::Integrate(ClothState* state, const Substep& sub, const RootMot
     // re-estimated from positions after the spring correction. Euler: v' and x + h v'.
     if (!verlet) v[i] = v_new;
     x[i] = xi + v_new * h;
-  }
+  });
 }
 
 void ClothSolver::ApplyAttachments(ClothState* state, const ClothFrame& frame, const Substep& sub) {
@@ -579,19 +611,16 @@ void ClothSolver::ApplyAttachments(ClothState* state, const ClothFrame& frame, c
   Float3* x = state->positions.data();
   const ClothAttachment* attachments = cloth_->attachments().data();
   const int64_t count = static_cast<int64_t>(cloth_->attachments().size());
-#pragma omp for schedule(static)
-  for (int64_t k = 0; k < count; ++k) {
+  ParallelFor(count, kParticleGrain, [&](int64_t k) {
     const ClothAttachment& a = attachments[k];
     const size_t j = static_cast<size_t>(a.joint);
     const Float3 start = TransformPoint(frame.skinning_start[j], a.bind_position);
     const Float3 end = TransformPoint(frame.skinning_end[j], a.bind_position);
     x[a.particle] = start * (1.f - s) + end * s;  // exactly `end` at s = 1
-  }
-  const int64_t skinned = skin_kinematic_count_;
-  if (skinned == 0) return;  // no barrier for an empty loop
-#pragma omp for schedule(static)
-  for (int64_t k = 0; k < skinned; ++k)
+  });
+  ParallelFor(skin_kinematic_count_, kParticleGrain, [&](int64_t k) {
     x[skin_targets_[k]] = skin_start_[k] * (1.f - s) + skin_end_[k] * s;
+  });
 }
 
 // Works on the solver's copy of the positions (16-byte aligned particles for the SSE loads),
@@ -600,31 +629,19 @@ void ClothSolver::SolveSprings(ClothState* state) {
   Float3* x = state->positions.data();
   Particle4* p = solver_positions_.data();
   const int64_t n = static_cast<int64_t>(state->positions.size());
-  const SpringGroup* chunks = chunk_groups_.data();
-  const SpringGroup* even = even_zones_.data();
-  const SpringGroup* odd = odd_zones_.data();
-  const int64_t chunk_count = static_cast<int64_t>(chunk_groups_.size());
-  const int64_t even_count = static_cast<int64_t>(even_zones_.size());
-  const int64_t odd_count = static_cast<int64_t>(odd_zones_.size());
-#pragma omp for schedule(static)
-  for (int64_t i = 0; i < n; ++i) p[i] = Particle4{x[i].x, x[i].y, x[i].z, 0.f};
+  ParallelFor(n, kParticleGrain, [&](int64_t i) { p[i] = Particle4{x[i].x, x[i].y, x[i].z, 0.f}; });
   // The iterations, then the strain limit's pass over the stretch springs.
   const bool limit_stretch = settings_.max_stretch < std::numeric_limits<float>::infinity();
   const uint32_t passes = settings_.iterations + (limit_stretch ? 1 : 0);
   for (uint32_t it = 0; it < passes; ++it) {
     const bool limit = it == settings_.iterations;
-#pragma omp for schedule(static)
-    for (int64_t g = 0; g < chunk_count; ++g) CorrectGroup(chunks[g], limit, p);
-#pragma omp for schedule(static)
-    for (int64_t g = 0; g < even_count; ++g) CorrectGroup(even[g], limit, p);
-#pragma omp for schedule(static)
-    for (int64_t g = 0; g < odd_count; ++g) CorrectGroup(odd[g], limit, p);
+    for (const std::vector<SpringGroup>* groups : {&chunk_groups_, &even_zones_, &odd_zones_})
+      ParallelFor(static_cast<int64_t>(groups->size()), 1,
+                  [&](int64_t g) { CorrectGroup((*groups)[g], limit, p); });
     for (uint32_t r = far_runs_.run_begin; r < far_runs_.run_end; ++r)
       CorrectRun(runs_[r], true, limit, p);
   }
-  // A barrier after: the tethers read their anchors, which other threads copy back.
-#pragma omp for schedule(static)
-  for (int64_t i = 0; i < n; ++i) x[i] = Float3{p[i].x, p[i].y, p[i].z};
+  ParallelFor(n, kParticleGrain, [&](int64_t i) { x[i] = Float3{p[i].x, p[i].y, p[i].z}; });
 }
 
 void ClothSolver::CorrectGroup(const SpringGroup& group, bool limit, Particle4* p) const {
@@ -632,7 +649,7 @@ void ClothSolver::CorrectGroup(const SpringGroup& group, bool limit, Particle4* 
 }
 
 // One run of springs of one kind: sequentially on the calling thread, or shared among the
-// threads of the enclosing region.
+// workers.
 void ClothSolver::CorrectRun(const SpringRun& run, bool shared, bool limit, Particle4* p) const {
   const SpringBlock* blocks = blocks_.data();
   Correction c;
@@ -668,16 +685,14 @@ void ClothSolver::UpdateVelocities(ClothState* state, const Substep& sub) {
   const float inv_h = 1.f / sub.h;
   if (settings_.integrator == ClothIntegrator::kVerlet) {
     const int64_t n = static_cast<int64_t>(state->positions.size());
-#pragma omp for schedule(static)
-    for (int64_t i = 0; i < n; ++i) v[i] = (x[i] - x_start[i]) * inv_h;
+    ParallelFor(n, kParticleGrain, [&](int64_t i) { v[i] = (x[i] - x_start[i]) * inv_h; });
   } else {
     const uint32_t* kinematic = cloth_->kinematic_particles().data();
     const int64_t count = static_cast<int64_t>(cloth_->kinematic_particles().size());
-#pragma omp for schedule(static)
-    for (int64_t k = 0; k < count; ++k) {
+    ParallelFor(count, kParticleGrain, [&](int64_t k) {
       const uint32_t i = kinematic[k];
       v[i] = (x[i] - x_start[i]) * inv_h;
-    }
+    });
   }
 }
 
@@ -753,15 +768,18 @@ uint32_t ClothSolver::FirstNonFinite(const ClothState& state) const {
   const int64_t n = static_cast<int64_t>(state.positions.size());
   // a - a is +0 for every finite a and NaN for infinities and NaN, so the sum below is 0 exactly
   // when all six components are finite (an integer OR: the same in any order).
-  uint32_t any_bad = 0;
-#pragma omp parallel for schedule(static) reduction(| : any_bad) if (n >= kParallelParticles)
-  for (int64_t i = 0; i < n; ++i) {
-    const Float3 p = x[i], u = v[i];
-    const float zero =
-        (((p.x - p.x) + (p.y - p.y)) + ((p.z - p.z) + (u.x - u.x))) + ((u.y - u.y) + (u.z - u.z));
-    any_bad |= static_cast<uint32_t>(!(zero == 0.f));
-  }
-  if (any_bad == 0) return kNoParticle;
+  detail::ChunkSum bad_count;
+  ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
+    uint32_t bad = 0;
+    for (int64_t i = begin; i < end; ++i) {
+      const Float3 p = x[i], u = v[i];
+      const float zero =
+          (((p.x - p.x) + (p.y - p.y)) + ((p.z - p.z) + (u.x - u.x))) + ((u.y - u.y) + (u.z - u.z));
+      bad |= static_cast<uint32_t>(!(zero == 0.f));
+    }
+    if (bad != 0) bad_count.Add(1);
+  });
+  if (bad_count.total() == 0) return kNoParticle;
   for (int64_t i = 0; i < n; ++i)  // rare: the first one in order
     if (!IsFinite(x[i]) || !IsFinite(v[i])) return static_cast<uint32_t>(i);
   return kNoParticle;
@@ -773,14 +791,17 @@ uint32_t ClothSolver::CountContacts() {
   const uint8_t* shapes = shape_flags_.data();
   const bool merge_body_map = (merge_flags_ & 1) != 0, merge_shapes = (merge_flags_ & 2) != 0;
   const int64_t n = static_cast<int64_t>(flags_.size());
-  uint32_t contacts = 0;
-#pragma omp parallel for schedule(static) reduction(+ : contacts) if (n >= kParallelParticles)
-  for (int64_t i = 0; i < n; ++i) {
-    if (merge_body_map) flags[i] = static_cast<uint8_t>(flags[i] | body_map[i]);
-    if (merge_shapes) flags[i] = static_cast<uint8_t>(flags[i] | shapes[i]);
-    contacts += flags[i] & kCollisionContact;
-  }
-  return contacts;
+  detail::ChunkSum contacts;
+  ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
+    uint32_t count = 0;
+    for (int64_t i = begin; i < end; ++i) {
+      if (merge_body_map) flags[i] = static_cast<uint8_t>(flags[i] | body_map[i]);
+      if (merge_shapes) flags[i] = static_cast<uint8_t>(flags[i] | shapes[i]);
+      count += flags[i] & kCollisionContact;
+    }
+    contacts.Add(count);
+  });
+  return contacts.total();
 }
 
 void ClothSolver::RestoreBackup(ClothState* state) {
@@ -796,28 +817,28 @@ float ClothSolver::MaxStretch(const ClothState& state) const {
   if (cloth.spring_count(SpringKind::kStretch) == 0) return 0.f;
   const ClothSpring* springs = cloth.springs().data();
   const Float3* x = state.positions.data();
-  float max_stretch = -1.f;  // a spring of length 0 has stretch -1
-  [[maybe_unused]] const bool parallel =
-      static_cast<int64_t>(cloth.springs().size()) >= kParallelSprings;
-#pragma omp parallel if (parallel)
-  for (const SpringColour& colour : cloth.colours()) {
-    if (colour.kind != SpringKind::kStretch) continue;
-    const int64_t begin = colour.begin, end = colour.end;
-    // Float max is exact and order-independent. Each thread skips the square root and division
-    // for springs clearly below its running max (L^2 < (R (1 + max))^2 (1 - 1e-5): a margin far
-    // above the rounding of the test), so the result is the exact max at any thread count. The
-    // private copies start at -FLT_MAX (OpenMP's identity for max), hence the clamp to -1.
-#pragma omp for schedule(static) reduction(max : max_stretch)
-    for (int64_t k = begin; k < end; ++k) {
-      const ClothSpring& s = springs[k];
-      const Float3 d = x[s.b] - x[s.a];
-      const float length_squared = Dot(d, d);
-      const float bound = s.rest_length * (1.f + std::max(max_stretch, -1.f));
-      if (length_squared < bound * bound * (1.f - 1e-5f)) continue;
-      max_stretch = std::max(max_stretch, std::sqrt(length_squared) / s.rest_length - 1.f);
-    }
-  }
-  return max_stretch;
+  // Float max is exact and order-independent: each chunk's max, then the max of those. A chunk
+  // skips the square root and division for springs clearly below its running max (L^2 <
+  // (R (1 + max))^2 (1 - 1e-5): a margin far above the rounding of the test), so the result is
+  // the exact max however the springs are chunked. A spring of length 0 has stretch -1.
+  std::atomic<float> max_stretch{-1.f};
+  // The stretch springs are the first spring_count(kStretch) springs (Cloth::springs()).
+  ParallelRanges(
+      cloth.spring_count(SpringKind::kStretch), kSpringGrain, [&](int64_t begin, int64_t end) {
+        float chunk_max = -1.f;
+        for (int64_t k = begin; k < end; ++k) {
+          const ClothSpring& s = springs[k];
+          const Float3 d = x[s.b] - x[s.a];
+          const float length_squared = Dot(d, d);
+          const float bound = s.rest_length * (1.f + chunk_max);
+          if (length_squared < bound * bound * (1.f - 1e-5f)) continue;
+          chunk_max = std::max(chunk_max, std::sqrt(length_squared) / s.rest_length - 1.f);
+        }
+        float seen = max_stretch.load(std::memory_order_relaxed);
+        while (chunk_max > seen && !max_stretch.compare_exchange_weak(seen, chunk_max)) {
+        }
+      });
+  return max_stretch.load();
 }
 
 }  // namespace drape

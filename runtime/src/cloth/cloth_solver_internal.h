@@ -10,10 +10,6 @@
 
 namespace drape::detail {
 
-// Below this many particles a solver loop runs on one thread: forking costs more than it
-// saves. The result is the same either way (per-index writes).
-constexpr int64_t kParallelParticles = 2048;
-
 inline Status InvalidArgument(const std::string& message) {
   return Status(StatusCode::kInvalidArgument, "ClothSolver: " + message);
 }

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "drape/runtime/math.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 
@@ -15,12 +16,11 @@ Status SkinMesh(const MeshData& mesh, std::span<const Mat34> skinning, std::span
   }
   const bool skinned = mesh.influence_offsets.size() == count + 1;
   const int64_t n = static_cast<int64_t>(count);
-#pragma omp parallel for schedule(static)
-  for (int64_t v = 0; v < n; ++v) {
+  detail::ParallelFor(n, detail::kParticleGrain, [&](int64_t v) {
     const Float3 bind = mesh.positions[v];
     if (!skinned || mesh.influence_offsets[v] == mesh.influence_offsets[v + 1]) {
       posed[v] = bind;
-      continue;
+      return;
     }
     Float3 sum{0.f, 0.f, 0.f};
     for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k) {
@@ -29,7 +29,7 @@ Status SkinMesh(const MeshData& mesh, std::span<const Mat34> skinning, std::span
       sum += TransformPoint(skinning[joint], bind) * mesh.influence_weights[k];
     }
     posed[v] = sum;
-  }
+  });
   return Status::Ok();
 }
 

@@ -19,6 +19,7 @@
 #include "shapes/shape_distance.h"
 #include "shapes/shape_response.h"
 #include "shapes/shape_sweep.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 
@@ -445,20 +446,24 @@ Status ShapeColliderSet::CollideBatch(std::span<const Float3> x_start, std::span
     return Status(StatusCode::kInvalidArgument,
                   "ShapeColliderSet::CollideBatch: substep_seconds is not finite and > 0");
   const int64_t blocks = static_cast<int64_t>((n + kBlock - 1) / kBlock);
-  uint32_t contacts = 0;
-  // Blocks write only their own particles: the same bits at any thread count. Each thread poses
-  // the shapes on its own stack, once when they fit one chunk.
-#pragma omp parallel reduction(+ : contacts) if (n >= 2048)
-  {
-    Frames frames;
-#pragma omp for schedule(static)
-    for (int64_t b = 0; b < blocks; ++b) {
-      const size_t first = static_cast<size_t>(b) * kBlock;
-      contacts += CollideBlock(&frames, first, std::min(n, first + kBlock), x_start, x_end,
-                               velocities, flags, params, s0, s1, substep_seconds);
-    }
-  }
-  if (contact_count != nullptr) *contact_count = contacts;
+  // Blocks write only their own particles: the same bits under any task system. A chunk of
+  // blocks poses the shapes on its own stack, once when they fit one chunk of shapes; below 2048
+  // particles everything runs on the calling thread.
+  const int64_t blocks_per_chunk =
+      std::max<int64_t>(1, detail::kParticleGrain / static_cast<int64_t>(kBlock));
+  detail::ChunkSum contacts;
+  detail::ParallelRanges(
+      blocks, n >= 2048 ? blocks_per_chunk : blocks, [&](int64_t begin, int64_t end) {
+        Frames frames;
+        uint32_t chunk_contacts = 0;
+        for (int64_t b = begin; b < end; ++b) {
+          const size_t first = static_cast<size_t>(b) * kBlock;
+          chunk_contacts += CollideBlock(&frames, first, std::min(n, first + kBlock), x_start,
+                                         x_end, velocities, flags, params, s0, s1, substep_seconds);
+        }
+        contacts.Add(chunk_contacts);
+      });
+  if (contact_count != nullptr) *contact_count = contacts.total();
   return Status::Ok();
 }
 

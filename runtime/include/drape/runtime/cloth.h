@@ -146,6 +146,7 @@ class Cloth {
   }  // m^2 per particle (a third of each
      // adjacent triangle): fluid drag
   std::span<const uint32_t> triangles() const { return triangles_; }  // kept triangles
+  // Stretch springs first (spring_count(kStretch) of them), then bend springs; by colour.
   std::span<const ClothSpring> springs() const { return springs_; }
   std::span<const SpringColour> colours() const { return colours_; }
   // Particles with inverse mass 0 (pinned or attached), ascending.

@@ -60,6 +60,9 @@ struct ClothSolverSettings {
   // The widest instruction set the spring kernel may use (narrowed to the CPU's): four springs
   // per instruction in SSE2 (AVX2 too), or the scalar reference pack. The same bits (tested).
   InstructionSet instruction_set = InstructionSet::kAvx2;
+  // Time each stage of Step into ClothStepStats::stage_seconds (two steady_clock reads per stage
+  // and substep; no effect on the results).
+  bool measure_stages = false;
 
   // Paper A: explicit Euler with the buckling model. substeps must still satisfy the stability
   // bound of the cloth (see RecommendedEulerSubsteps).
@@ -121,13 +124,23 @@ struct ClothFrame {
   std::span<const Mat34> skinning_end;
 };
 
+// Where a step's time goes, in seconds summed over its substeps (measure_stages on).
+struct ClothStageSeconds {
+  double integrate = 0.0;    // backup, root motion, integration, attachments, velocities
+  double springs = 0.0;      // spring correction (Verlet) or forces (Euler), strain limit
+  double constraints = 0.0;  // tethers, skinned targets, max distance and backstop
+  double collide = 0.0;      // every collider's batch
+  double bookkeeping = 0.0;  // finite check, contact count, stretch measure
+};
+
 struct ClothStepStats {
-  uint32_t substeps = 0;           // substeps completed
-  uint32_t contacts = 0;           // particles with a contact in the last substep
-  uint32_t hull_contacts = 0;      // sum over substeps of the hulls' contact counts
-  uint32_t body_map_contacts = 0;  // sum over substeps of the body map's contact counts
-  uint32_t shape_contacts = 0;     // sum over substeps of the engine shapes' contact counts
-  float max_stretch = 0.f;         // after the step: max over stretch springs of L / R - 1
+  uint32_t substeps = 0;            // substeps completed
+  uint32_t contacts = 0;            // particles with a contact in the last substep
+  uint32_t hull_contacts = 0;       // sum over substeps of the hulls' contact counts
+  uint32_t body_map_contacts = 0;   // sum over substeps of the body map's contact counts
+  uint32_t shape_contacts = 0;      // sum over substeps of the engine shapes' contact counts
+  float max_stretch = 0.f;          // after the step: max over stretch springs of L / R - 1
+  ClothStageSeconds stage_seconds;  // zeros unless ClothSolverSettings::measure_stages
 };
 
 class ClothSolver {
@@ -173,8 +186,6 @@ class ClothSolver {
 
   Status ValidateFrame(const ClothState& state, const ClothColliders& colliders,
                        const ClothFrame& frame) const;
-  // The stages of one substep, in order.
-  void BeginSubstep(ClothState* state);
   // The root's motion over the frame and the share of it each substep carries the cloth.
   struct RootMotion {
     bool carry = false;        // linear or angular inertia below 1
@@ -184,7 +195,10 @@ class ClothSolver {
     Float3 omega;              // rad/s: the root's angular velocity
   };
   RootMotion ComputeRootMotion(const ClothFrame& frame) const;
-  void CarryWithRoot(ClothState* state, const RootMotion& root, const Substep& sub);
+  // The carried share of the root's motion over a substep, as a rigid transform.
+  Mat34 CarriedMotion(const RootMotion& root, const Substep& sub) const;
+  // The stages of one substep, in order.
+  void BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub);
   void ComputeSkinnedTargets(const ClothFrame& frame);
   void ApplyTethers(ClothState* state, const Substep& sub);
   void ApplySkinConstraints(ClothState* state, const Substep& sub);
