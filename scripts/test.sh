@@ -73,12 +73,13 @@ install_consumer() {
   cmake --install build-runtime --prefix "$prefix" >/dev/null &&
     cmake -S tests/install_consumer -B "$consumer" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null &&
     cmake --build "$consumer" -j "$jobs" >/dev/null &&
-    "$consumer/consumer" "$root/tests/golden/mannequin_v1.drape"
+    "$consumer/consumer" "$root/tests/golden/mannequin_v1.drape" &&
+    "$consumer/consumer_c" "$root/tests/golden/mannequin_v1.drape"
   local rc=$?
   rm -rf "$prefix" "$consumer"
   return $rc
 }
-check "installed drape::runtime links into a consumer" install_consumer
+check "installed drape::runtime links into a C++ and a C consumer" install_consumer
 
 echo "== 4. formats + runtime tests under ASan + UBSan, without OpenMP"
 if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
