@@ -3,7 +3,8 @@
 // file's first clip, standing in for the engine's animation system) and step a skirt skinned to
 // the root joint (its waistband follows the skin exactly, the rest within 15 cm of it) against
 // the hull and sphere colliders and the engine's own shapes: a floor and a capsule (a staff the
-// engine swings through the skirt).   Usage: engine_sample FILE.drape
+// engine swings through the skirt). drape runs its stages on the engine's own job system
+// (engine_jobs.h: two threads here) through drape::TaskSystem.   Usage: engine_sample FILE.drape
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -14,6 +15,8 @@
 #include "drape/runtime/math.h"
 #include "drape/runtime/shape_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
+#include "drape/runtime/task_system.h"
+#include "engine_jobs.h"
 
 static bool Check(const drape::Status& s) {
   if (!s.ok()) std::fprintf(stderr, "engine_sample: %s\n", s.message().c_str());
@@ -25,6 +28,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: engine_sample FILE.drape\n");
     return 2;
   }
+  // At start-up: drape runs in parallel only through the engine's job system.
+  EngineJobs jobs(2);
+  drape::SetTaskSystem(&jobs);
+  struct Unset {
+    ~Unset() { drape::SetTaskSystem(nullptr); }  // before `jobs` goes
+  } unset;
   drape::CharacterAsset asset;
   if (!Check(drape::ReadAssetFile(argv[1], &asset))) return 1;
   if (asset.clips.empty()) {
