@@ -156,31 +156,48 @@ def cloth(doc, gb, sections):
     if p in gb:
         doc.add("`bench_cloth_step`: one 1/60 s frame of a 10 100-particle skirt on a walking "
                 "pair of legs (4 box hulls, 16 joint spheres), 5 Verlet iterations per substep, "
-                "continuous collision, friction 0.3; ms per frame, median of 3. Bullet's soft "
-                "body (the peer) steps the same skirt against the same shapes, one thread; depth: "
-                "the mean over frames of the deepest particle inside a collider; worst spring: the "
-                "largest L / R − 1 over the timed frames (tethers + strain limit: the engine "
-                "defaults of `ClothSolverSettings{}`, off in paper B's).", "",
-                "| setup | 1 thread | 2 threads | speed-up | depth mm | worst spring |",
-                "|---|---|---|---|---|---|")
+                "continuous collision, friction 0.3; ms per frame, median of 3. 1 worker: the "
+                "serial task system; 2 workers: `ThreadPoolTaskSystem(2)`; OpenMP: its team of 2 "
+                "with `OMP_WAIT_POLICY=passive`. Bullet's soft body (the peer) steps the same "
+                "skirt against the same shapes, one thread; depth: the mean over frames of the "
+                "deepest particle inside a collider; worst spring: the largest L / R − 1 over the "
+                "timed frames (tethers + strain limit: the engine defaults of "
+                "`ClothSolverSettings{}`, off in paper B's).", "",
+                "| setup | 1 worker | 2 workers | speed-up | OpenMP, 2 threads | depth mm | "
+                "worst spring |",
+                "|---|---|---|---|---|---|---|")
         for label, substeps, colliders, engine in (
                 ("1 substep, with colliders", 1, 1, 0), ("1 substep, solver alone", 1, 0, 0),
+                ("2 substeps, with colliders", 2, 1, 0),
                 ("1 substep, with colliders, tethers + strain limit", 1, 1, 1),
                 ("1 substep, solver alone, tethers + strain limit", 1, 0, 1)):
             args = (substeps, colliders, engine)
-            one = value(gb, p, "BM_ClothStep", (1,) + args, "real_time")
-            two = value(gb, p, "BM_ClothStep", (2,) + args, "real_time")
-            depth = value(gb, p, "BM_ClothStep", (1,) + args, "frame_max_depth_mm")
-            stretch = value(gb, p, "BM_ClothStep", (1,) + args, "max_stretch_pct")
+            one = value(gb, p, "BM_ClothStep", (1,) + args + (0,), "real_time")
+            two = value(gb, p, "BM_ClothStep", (2,) + args + (0,), "real_time")
+            omp = value(gb, p, "BM_ClothStep", (2,) + args + (1,), "real_time")
+            depth = value(gb, p, "BM_ClothStep", (1,) + args + (0,), "frame_max_depth_mm")
+            stretch = value(gb, p, "BM_ClothStep", (1,) + args + (0,), "max_stretch_pct")
             up = f"{one / two:.2f}x" if one and two else "-"
-            doc.add(f"| drape, {label} | {mm(one, 2)} | {mm(two, 2)} | {up} | "
+            doc.add(f"| drape, {label} | {mm(one, 2)} | {mm(two, 2)} | {up} | {mm(omp, 2)} | "
                     f"{mm(depth, 2) if colliders else '-'} | "
                     f"{f'{stretch:.0f} %' if stretch is not None else '-'} |")
         for substeps in (1,):
             t = value(gb, p, "BM_BulletSkirt", (substeps,), "real_time")
             depth = value(gb, p, "BM_BulletSkirt", (substeps,), "frame_max_depth_mm")
             doc.add(f"| Bullet btSoftBody, {substeps} substep{'s' if substeps > 1 else ''} | "
-                    f"{mm(t, 2)} | - | - | {mm(depth, 2)} | - |")
+                    f"{mm(t, 2)} | - | - | - | {mm(depth, 2)} | - |")
+        doc.add("", "By stage (`ClothSolverSettings::measure_stages`), ms per frame: integrate "
+                "(backup, root motion, integration, attachments, velocities), springs (the 5 "
+                "passes), constraints (tethers, skinning), collide (every collider's batch), "
+                "bookkeeping (finite checks, contact count, stretch measure).", "",
+                "| setup | workers | integrate | springs | constraints | collide | bookkeeping |",
+                "|---|---|---|---|---|---|---|")
+        for label, colliders in (("with colliders", 1), ("solver alone", 0)):
+            for workers in (1, 2):
+                args = (workers, 1, colliders, 0, 0)
+                cells = [mm(value(gb, p, "BM_ClothStep", args, f"{k}_ms"), 3) for k in
+                         ("integrate", "springs", "constraints", "collide", "bookkeeping")]
+                doc.add(f"| 1 substep, {label} | {workers} | " + " | ".join(cells) + " |")
         source(doc, p)
     if title in sections:
         doc.add("The same comparison on the walking mannequin, penetration measured against the "

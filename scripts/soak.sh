@@ -10,13 +10,12 @@
 # memory figures from out/soak/stats.json, and exits non-zero when a check fails.
 #
 #   SOAK_FRAMES=10000    frames to simulate (the scene plays 10 000)
-#   SOAK_THREADS=2       OpenMP threads
+#   SOAK_THREADS=2       worker threads (drape-sim --threads)
 #   SOAK_BUILD_DIR=build the build directory: `build` (the default preset) or any other, which is
 #                        configured Release without tests when it has no CMakeCache.txt
 #   SOAK_OUT=out/soak    the output directory
-#   OMP_WAIT_POLICY      passive unless set: on a shared machine, threads spinning at the
-#                        solver's barriers while a neighbour holds a core make steps many times
-#                        slower (see docs/SCENES.md, "The soak scene")
+#   OMP_WAIT_POLICY      passive unless set (the bake's OpenMP loops; the step runs on the
+#                        runtime's thread pool; see docs/SCENES.md, "The soak scene")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${SOAK_FRAMES:-10000}

@@ -125,7 +125,7 @@ page size; 0 where it cannot be read). Settle frames are not listed.
 
 | key | meaning |
 |---|---|
-| `frames`, `frames_written`, `particles`, `threads` | frames simulated, pictures written, particles of all garments, OpenMP threads |
+| `frames`, `frames_written`, `particles`, `threads` | frames simulated, pictures written, particles of all garments, worker threads (the step's task pool and the bake's OpenMP team) |
 | `step_ms_total`, `step_ms_mean`, `step_ms_median`, `step_ms_p99`, `step_ms_max` | the frames' `step_ms`: sum, mean, median and p99 (nearest rank), max |
 | `step_ms_tenths` | mean `step_ms` of each tenth of the run, frames [i n/10, (i+1) n/10) (10 numbers; fewer only for runs under 10 frames) |
 | `measure_ms_mean` | mean `measure_ms` |
@@ -167,9 +167,9 @@ figures from `out/soak/stats.json`, and exits non-zero when
 Environment: `SOAK_FRAMES` (10000), `SOAK_THREADS` (2), `SOAK_BUILD_DIR` (`build`, configured by
 the default preset; another directory is configured Release without tests when it has no
 `CMakeCache.txt`), `SOAK_OUT` (`out/soak`), `DRAPE_JOBS` (build jobs, 2) and `OMP_WAIT_POLICY`
-(`passive` unless set: with libgomp's default spinning, the solver's many short parallel loops
-run 8-12 times slower while another process holds one of the two cores; passive waiting costs
-10-20 % per step on an idle machine, so set `OMP_WAIT_POLICY=active` there for the best figure).
+(`passive` unless set; it now concerns the bake's OpenMP loops only: drape-sim runs the step on
+the runtime's std::thread pool, whose idle workers poll for 200 µs and then sleep, so a
+neighbour holding a core no longer multiplies the step time).
 
 The scene: the mannequin walks (clip `walk`, looped: 1 s, so 10 000 frames are 167 cycles) in
 one skirt of 1000 segments x 100 rings of particles (`rings` 99) = 100 000 particles, 0.65 m
