@@ -90,10 +90,11 @@ def body_map_queries(doc, gb):
             f"| IsInside, shuffled | {shapes('BM_Inside', (1,))} |",
             f"| InsideBatch | {shapes('BM_InsideBatch', (), threads=True)} |")
     motions = (("resting", 2), ("sliding", 0), ("stepping", 1))
-    for label, m in motions:
-        doc.add(f"| Query, nearest, {label} | {shapes('BM_Continuous', (0, m))} |")
-    for label, m in motions:
-        doc.add(f"| Query, bilinear, {label} | {shapes('BM_Continuous', (1, m))} |")
+    for sampling, code in (("nearest", 0), ("bilinear", 1)):
+        per_n = [[shapes('BM_Continuous', (code, m)).split(" | ")[k] for _, m in motions]
+                 for k in (0, 1)]
+        doc.add(f"| Query, {sampling}, resting / sliding / stepping | "
+                f"{' / '.join(per_n[0])} | {' / '.join(per_n[1])} |")
     for lanes_count, lanes_name in ((8, "eight AVX2 lanes"), (4, "four SSE2 lanes")):
         for label, m in motions:
             doc.add(f"| CollideBatch, {lanes_name}, {label} | "
@@ -168,7 +169,6 @@ def cloth(doc, gb, sections):
                 "|---|---|---|---|---|---|---|")
         for label, substeps, colliders, engine in (
                 ("1 substep, with colliders", 1, 1, 0), ("1 substep, solver alone", 1, 0, 0),
-                ("2 substeps, with colliders", 2, 1, 0),
                 ("1 substep, with colliders, tethers + strain limit", 1, 1, 1),
                 ("1 substep, solver alone, tethers + strain limit", 1, 0, 1)):
             args = (substeps, colliders, engine)
@@ -186,18 +186,17 @@ def cloth(doc, gb, sections):
             depth = value(gb, p, "BM_BulletSkirt", (substeps,), "frame_max_depth_mm")
             doc.add(f"| Bullet btSoftBody, {substeps} substep{'s' if substeps > 1 else ''} | "
                     f"{mm(t, 2)} | - | - | - | {mm(depth, 2)} | - |")
-        doc.add("", "By stage (`ClothSolverSettings::measure_stages`), ms per frame: integrate "
-                "(backup, root motion, integration, attachments, velocities), springs (the 5 "
-                "passes), constraints (tethers, skinning), collide (every collider's batch), "
-                "bookkeeping (finite checks, contact count, stretch measure).", "",
-                "| setup | workers | integrate | springs | constraints | collide | bookkeeping |",
-                "|---|---|---|---|---|---|---|")
-        for label, colliders in (("with colliders", 1), ("solver alone", 0)):
-            for workers in (1, 2):
-                args = (workers, 1, colliders, 0, 0)
-                cells = [mm(value(gb, p, "BM_ClothStep", args, f"{k}_ms"), 3) for k in
-                         ("integrate", "springs", "constraints", "collide", "bookkeeping")]
-                doc.add(f"| 1 substep, {label} | {workers} | " + " | ".join(cells) + " |")
+        stages = ("integrate", "springs", "constraints", "collide", "bookkeeping")
+        per_workers = []
+        for workers in (1, 2):
+            args = (workers, 1, 1, 0, 0)
+            per_workers.append(", ".join(
+                f"{k} {mm(value(gb, p, 'BM_ClothStep', args, f'{k}_ms'), 3)}" for k in stages))
+        doc.add("", "By stage (`ClothSolverSettings::measure_stages`; integrate: backup, root "
+                "motion, integration, attachments, velocities; springs: the 5 passes; "
+                "constraints: tethers, skinning; collide: every collider's batch; bookkeeping: "
+                "finite checks, contact count, stretch measure), ms per frame, 1 substep with "
+                f"colliders: 1 worker {per_workers[0]}; 2 workers {per_workers[1]}.")
         source(doc, p)
     if title in sections:
         doc.add("The same comparison on the walking mannequin, penetration measured against the "
