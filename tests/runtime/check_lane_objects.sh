@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # tests/runtime/check_lane_objects.sh LIBRARY: fails when an object of drape_runtime compiled for
-# AVX2 (the body-map lanes, the hull plane kernels) could hand its code to another path.
+# AVX2 (the body-map lanes, the hull plane kernels, the spring kernel) could hand its code to
+# another path.
 #
 # lanes_avx2.cpp and plane_kernels_avx2.cpp compile only their own region for AVX2 (target
 # pragmas after every #include). A function such an object defines weakly (COMDAT: inline
@@ -15,7 +16,7 @@ library=$(realpath "$1")
 scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 status=0
-for member in lanes_avx2.cpp.o plane_kernels_avx2.cpp.o; do
+for member in lanes_avx2.cpp.o plane_kernels_avx2.cpp.o spring_kernels_avx2.cpp.o; do
   if ! (cd "$scratch" && ar x "$library" "$member"); then
     echo "FAIL: no $member in $library"
     exit 1

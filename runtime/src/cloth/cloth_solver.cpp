@@ -2,6 +2,7 @@
 
 #include "cloth/cloth_solver_internal.h"
 #include "cloth/spring_colouring.h"
+#include "cloth/spring_kernels.h"
 
 #include <algorithm>
 #include <atomic>
@@ -59,8 +60,7 @@ class StageClock {
   Clock::time_point last_;
 };
 
-// Which sign of the length error a spring acts on (paper A's buckling model restricts it).
-enum class SpringSide { kBoth, kStretched, kCompressed };
+using detail::SpringSide;
 
 SpringSide SideOf(SpringKind kind, bool buckling) {
   if (!buckling) return SpringSide::kBoth;
@@ -118,6 +118,50 @@ inline void CorrectBlock(const SpringBlock& block, float correction, float rest_
   P::StoreRows4(b, bx, by, bz, bw);
 }
 
+#if defined(__SSE2__)
+// CorrectBlock's operations for SSE2 with the particles kept as rows: the four differences
+// b - a are formed row by row and only they are transposed to x/y/z lanes (7 shuffles), and each
+// end moves by its row times its lane's scale broadcast (8 shuffles), where transposing the
+// eight particles in and out takes 32: the shuffle port bounded the kernel. Per x, y and z lane
+// the same IEEE operations in the same order as CorrectBlock, so the same bits (the w lanes,
+// which nothing reads, become w + (w_b - w_a) s instead of staying as they were).
+template <SpringSide side>
+inline void CorrectBlockRows(const SpringBlock& block, float correction, float rest_scale,
+                             Particle4* p) {
+  __m128 ra[4], rb[4], rd[4];
+  for (int k = 0; k < 4; ++k) {
+    ra[k] = _mm_load_ps(&p[block.a[k]].x);
+    rb[k] = _mm_load_ps(&p[block.b[k]].x);
+    rd[k] = _mm_sub_ps(rb[k], ra[k]);
+  }
+  const __m128 t0 = _mm_unpacklo_ps(rd[0], rd[1]);  // x0 x1 y0 y1
+  const __m128 t1 = _mm_unpacklo_ps(rd[2], rd[3]);  // x2 x3 y2 y3
+  const __m128 t2 = _mm_unpackhi_ps(rd[0], rd[1]);  // z0 z1 w0 w1
+  const __m128 t3 = _mm_unpackhi_ps(rd[2], rd[3]);  // z2 z3 w2 w3
+  const __m128 dx = _mm_movelh_ps(t0, t1), dy = _mm_movehl_ps(t1, t0);
+  const __m128 dz = _mm_movelh_ps(t2, t3);
+  const __m128 length = _mm_sqrt_ps(
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz)));
+  __m128 error =
+      _mm_sub_ps(length, _mm_mul_ps(_mm_load_ps(block.rest_length), _mm_set1_ps(rest_scale)));
+  if constexpr (side == SpringSide::kStretched) error = detail::StdMax(_mm_setzero_ps(), error);
+  if constexpr (side == SpringSide::kCompressed) error = detail::StdMin(_mm_setzero_ps(), error);
+  const __m128 valid = _mm_cmpgt_ps(length, _mm_set1_ps(1e-20f));
+  const __m128 scale =
+      _mm_and_ps(valid, _mm_div_ps(_mm_mul_ps(_mm_set1_ps(correction), error), length));
+  const __m128 sa = _mm_mul_ps(scale, _mm_load_ps(block.weight_a));
+  const __m128 sb = _mm_mul_ps(scale, _mm_load_ps(block.weight_b));
+  const __m128 sa_lane[4] = {_mm_shuffle_ps(sa, sa, 0x00), _mm_shuffle_ps(sa, sa, 0x55),
+                             _mm_shuffle_ps(sa, sa, 0xAA), _mm_shuffle_ps(sa, sa, 0xFF)};
+  const __m128 sb_lane[4] = {_mm_shuffle_ps(sb, sb, 0x00), _mm_shuffle_ps(sb, sb, 0x55),
+                             _mm_shuffle_ps(sb, sb, 0xAA), _mm_shuffle_ps(sb, sb, 0xFF)};
+  for (int k = 0; k < 4; ++k) {
+    _mm_store_ps(&p[block.a[k]].x, _mm_add_ps(ra[k], _mm_mul_ps(rd[k], sa_lane[k])));
+    _mm_store_ps(&p[block.b[k]].x, _mm_sub_ps(rb[k], _mm_mul_ps(rd[k], sb_lane[k])));
+  }
+}
+#endif
+
 // How a run's blocks are corrected: the material's correction and the rest-length scale.
 struct Correction {
   float fraction = 1.f;    // of the length error removed, in [0, 1]
@@ -129,26 +173,39 @@ template <SpringSide side>
 inline void CorrectFour(const SpringBlock& block, const Correction& c, Particle4* p) {
 #if defined(__SSE2__)
   if (c.set != InstructionSet::kScalar) {
-    CorrectBlock<detail::Sse2Lanes, side>(block, c.fraction, c.rest_scale, p);
+    CorrectBlockRows<side>(block, c.fraction, c.rest_scale, p);
     return;
   }
 #endif
   CorrectBlock<detail::ScalarLanes, side>(block, c.fraction, c.rest_scale, p);
 }
 
+// Blocks [begin, end) of one run: two at a time in AVX2, else one by one.
+template <SpringSide side>
+void CorrectBlockRange(const SpringBlock* blocks, uint32_t begin, uint32_t end, const Correction& c,
+                       Particle4* p) {
+  if (c.set == InstructionSet::kAvx2) {
+    detail::CorrectBlocksAvx2(blocks, begin, end, side, c.fraction, c.rest_scale, p);
+    return;
+  }
+  for (uint32_t k = begin; k < end; ++k) CorrectFour<side>(blocks[k], c, p);
+}
+
 template <SpringSide side>
 void CorrectRunSequential(const SpringBlock* blocks, const SpringRun& run, const Correction& c,
                           Particle4* p) {
-  for (uint32_t k = run.begin; k < run.end; ++k) CorrectFour<side>(blocks[k], c, p);
+  CorrectBlockRange<side>(blocks, run.begin, run.end, c, p);
 }
 
 // The blocks of one run shared among the workers (chunks of kBlockGrain blocks).
 template <SpringSide side>
 void CorrectRunShared(const SpringBlock* blocks, const SpringRun& run, const Correction& c,
                       Particle4* p) {
-  const int64_t begin = run.begin;
-  ParallelFor(int64_t{run.end} - begin, kBlockGrain,
-              [&](int64_t k) { CorrectFour<side>(blocks[begin + k], c, p); });
+  const uint32_t first = run.begin;
+  ParallelRanges(int64_t{run.end} - first, kBlockGrain, [&](int64_t begin, int64_t end) {
+    CorrectBlockRange<side>(blocks, first + static_cast<uint32_t>(begin),
+                            first + static_cast<uint32_t>(end), c, p);
+  });
 }
 
 // Appends `springs` (pairwise disjoint: one colour) as blocks of four, in order. The lanes of the
