@@ -691,5 +691,34 @@ TEST(ClothSolver, SimdAndScalarKernelsAgree) {
   }
 }
 
+// The stretch measure and the stage timing are reports only: off or on, the same bits.
+TEST(ClothSolver, MeasuresAreOptionalAndChangeNothing) {
+  ClothDescription hung = SheetDescription(71, 1.2f, {0.f, 0.45f, 0.f});
+  hung.pinned = {0};  // held by a corner: the sheet stretches as it falls
+  Cloth cloth;
+  ASSERT_TRUE(BuildCloth(hung, &cloth).ok());
+  ClothSolverSettings measured;
+  measured.measure_stages = true;
+  ClothSolverSettings unmeasured;
+  unmeasured.measure_stretch = false;
+  const test::TaskSystemCase serial = test::AllTaskSystems().front();
+  ExpectBitwiseEqual(RunSheetScene(cloth, measured, serial, 5),
+                     RunSheetScene(cloth, unmeasured, serial, 5));
+  ClothSolver solver;
+  ASSERT_TRUE(solver.Init(cloth, unmeasured).ok());
+  ClothState state;
+  state.Reset(cloth);
+  ClothFrame frame;
+  ClothStepStats stats;
+  ASSERT_TRUE(solver.Step(&state, ClothColliders{}, frame, &stats).ok());
+  EXPECT_EQ(stats.max_stretch, 0.f);
+  EXPECT_EQ(stats.stage_seconds.springs, 0.0);
+  ASSERT_TRUE(solver.SetSettings(measured).ok());
+  ASSERT_TRUE(solver.Step(&state, ClothColliders{}, frame, &stats).ok());
+  EXPECT_GT(stats.max_stretch, 0.f);  // a falling sheet stretches a little
+  EXPECT_GT(stats.stage_seconds.springs, 0.0);
+  EXPECT_GE(stats.stage_seconds.integrate, 0.0);
+}
+
 }  // namespace
 }  // namespace drape

@@ -141,6 +141,7 @@ drape::ClothSolverSettings SolverSettings(const drape_solver_settings& s) {
   c.linear_inertia = s.linear_inertia;
   c.angular_inertia = s.angular_inertia;
   c.centrifugal_inertia = s.centrifugal_inertia;
+  c.measure_stretch = s.measure_stretch != 0;
   return c;
 }
 
@@ -377,6 +378,7 @@ void drape_solver_settings_default(drape_solver_settings* settings) {
   settings->static_friction = r.static_friction;
   settings->restitution = r.restitution;
   settings->separation = r.separation;
+  settings->measure_stretch = s.measure_stretch ? 1 : 0;
 }
 
 drape_status drape_cloth_create(const drape_cloth_desc* desc, const drape_solver_settings* settings,

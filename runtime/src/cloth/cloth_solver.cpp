@@ -517,7 +517,7 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
     clock.Lap(&ClothStageSeconds::bookkeeping);
   }
   StageClock clock(settings_.measure_stages, &st.stage_seconds);
-  st.max_stretch = MaxStretch(*state);
+  if (settings_.measure_stretch) st.max_stretch = MaxStretch(*state);
   clock.Lap(&ClothStageSeconds::bookkeeping);
   return Status::Ok();
 }
