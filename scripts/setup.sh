@@ -7,7 +7,7 @@ profile=${1:-all}
 runtime_packages=(g++ cmake make pkg-config libcereal-dev libgtest-dev libgmock-dev)
 bake_packages=(libassimp-dev libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libosmesa6-dev
   nlohmann-json3-dev libcli11-dev libstb-dev libbenchmark-dev ccache clang libclang-rt-14-dev
-  libfcl-dev libbullet-dev gnuplot-nox python3)
+  libfcl-dev libbullet-dev gnuplot-nox python3 ninja-build)
 packages=("${runtime_packages[@]}")
 [ "$profile" = runtime ] || packages+=("${bake_packages[@]}")
 

@@ -1,5 +1,5 @@
 // drape-bake INPUT -o OUT.drape [--config FILE.json] [--scene SCENE.json] [--report REPORT.json]
-//            [--preview DIR] [--strict]
+//            [--preview DIR] [--strict] [--depfile OUT.d]
 // drape-bake --dump-config
 // On any error: one line on stderr naming the input and the reason, exit code 1, no output file.
 // Warnings (what was assumed or repaired, colliders that fit the body badly) go to stderr, one
@@ -8,10 +8,13 @@
 
 #include <unistd.h>
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "drape/bake/bake_config.h"
 #include "drape/bake/bake_pipeline.h"
@@ -24,12 +27,38 @@ int Fail(const std::string& message) {
   return 1;
 }
 
+// A path in a Makefile rule (what Ninja and Make read from a depfile): spaces and '#' escaped
+// with a backslash, '$' doubled.
+std::string MakeEscaped(const std::string& path) {
+  std::string out;
+  for (const char c : path) {
+    if (c == ' ' || c == '#') out += '\\';
+    if (c == '$') out += '$';
+    out += c;
+  }
+  return out;
+}
+
+// "OUTPUT: input ...": the model and what it names, the config, the scene and its garment
+// meshes, each once.
+std::string DepfileRule(const std::string& output, std::vector<std::string> inputs) {
+  std::string rule = MakeEscaped(output) + ":";
+  std::vector<std::string> written;
+  for (const std::string& input : inputs) {
+    if (input.empty() || std::find(written.begin(), written.end(), input) != written.end())
+      continue;
+    written.push_back(input);
+    rule += " \\\n  " + MakeEscaped(input);
+  }
+  return rule + "\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
       "drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
-  std::string input, output, config_path, scene_path, report_path, preview_dir;
+  std::string input, output, config_path, scene_path, report_path, preview_dir, depfile_path;
   bool dump_config = false, list_formats = false, strict = false;
   app.add_option("INPUT", input, "character file (anything assimp reads)");
   app.add_option("-o,--output", output, "the .drape file to write");
@@ -38,6 +67,9 @@ int main(int argc, char** argv) {
   app.add_option("--report", report_path, "JSON report of the bake");
   app.add_option("--preview", preview_dir, "directory for preview pictures");
   app.add_flag("--strict", strict, "fail the bake on any warning (for pipelines)");
+  app.add_option("--depfile", depfile_path,
+                 "write a Makefile-syntax dependency file (for Ninja and Make): the output and "
+                 "every file the bake read");
   app.add_flag("--dump-config", dump_config, "print every parameter with default, unit and range");
   app.add_flag("--formats", list_formats, "print the file extensions the bake reads, one a line");
   try {
@@ -97,15 +129,28 @@ int main(int argc, char** argv) {
   result.report["output_bytes"] = bytes.size();
   result.report["timings"]["total_ms"] =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  // Report first (atomically), then the asset: a failure at either step leaves no asset behind.
+  // The dependency file first, then the report (each atomically), then the asset: a failure at
+  // any step leaves no asset behind.
+  if (!depfile_path.empty()) {
+    std::vector<std::string> inputs = {input};
+    inputs.insert(inputs.end(), result.input_files.begin(), result.input_files.end());
+    inputs.push_back(config_path);
+    inputs.push_back(scene_path);
+    if (drape::Status s = drape::WriteFileAtomically(depfile_path, DepfileRule(output, inputs));
+        !s.ok()) {
+      return Fail(s.message());
+    }
+  }
   if (!report_path.empty()) {
     if (drape::Status s = drape::WriteFileAtomically(report_path, result.report.dump(2) + "\n");
         !s.ok()) {
+      if (!depfile_path.empty()) std::remove(depfile_path.c_str());
       return Fail(s.message());
     }
   }
   if (drape::Status s = drape::WriteAssetFile(output, result.asset); !s.ok()) {
     if (!report_path.empty()) std::remove(report_path.c_str());
+    if (!depfile_path.empty()) std::remove(depfile_path.c_str());
     return Fail(s.message());
   }
   // What was assumed or repaired, one line each (also the report's "warnings").

@@ -12,6 +12,7 @@
 #include "import/header_prescan.h"
 #include "import/import_messages.h"
 #include "import/mesh_import.h"
+#include "import/recording_io_system.h"
 #include "import/skeleton_import.h"
 #include "import/source_scene.h"
 
@@ -74,6 +75,7 @@ void RecordSourceInfo(const std::string& path, const detail::AssetFrame& frame,
 // The import's stages, in this process.
 Status ImportStages(const std::string& path, const ImportOptions& options, Character* character) {
   Assimp::Importer importer;  // owns the scene the stages read
+  importer.SetIOHandler(new detail::RecordingIOSystem(&character->source_files));  // it owns it
   detail::SourceScene source;
   if (Status s = detail::ReadSourceScene(path, &importer, &source, &character->warnings); !s.ok())
     return s;

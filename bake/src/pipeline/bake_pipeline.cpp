@@ -683,6 +683,11 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
   Character character;
   if (Status s = ImportCharacter(input, config.import, &character); !s.ok()) return s;
   timings["import_ms"] = MillisecondsSince(start);
+  result->input_files = character.source_files;
+  if (scene != nullptr) {  // the scene's reach analysis reads its garment meshes
+    for (const SceneGarment& g : scene->garments)
+      if (g.type == GarmentType::kObj) result->input_files.push_back(g.obj_file);
+  }
   std::vector<MapPoseRequest> map_requests;
   if (config.maps_enabled) {
     if (Status s = MapPoseRequests(input, config, character, &map_requests); !s.ok()) return s;

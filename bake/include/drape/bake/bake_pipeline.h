@@ -15,6 +15,10 @@ namespace drape::bake {
 struct BakeResult {
   CharacterAsset asset;
   nlohmann::json report;
+  // Every file the bake read besides its config and scene files: the model and what it names
+  // (buffers, materials, textures), then the scene's garment meshes. For build-system
+  // dependency files (drape-bake --depfile).
+  std::vector<std::string> input_files;
 };
 
 // preview_dir: where preview pictures go (must exist), or empty for none. scene: when given, the

@@ -18,6 +18,9 @@ struct Character {
   // Where the unit scale and up axis came from (config, file metadata, format default): the
   // report's "frame". A warning too when it was assumed rather than read.
   std::string frame_provenance;
+  // Every file the import read: the model, then what it names (buffers, materials, textures),
+  // as the loader named them.
+  std::vector<std::string> source_files;
 };
 
 }  // namespace drape::bake

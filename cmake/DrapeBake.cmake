@@ -1,0 +1,74 @@
+# The bake as a step of an asset build (installed with the drape package; find_package(drape)
+# includes it when the install has drape-bake):
+#
+#   drape_add_bake(TARGET hero INPUT hero.fbx OUTPUT hero.drape
+#                  [CONFIG bake.json] [SCENE scene.json] [REPORT hero.json] [PREVIEW dir] [STRICT])
+#
+# adds a target `hero` (built by default) whose one command bakes INPUT into OUTPUT. drape-bake
+# writes a dependency file (--depfile) naming every file it read (the model, its external
+# buffers, materials and textures, the config, the scene and its garment meshes), so Ninja and
+# Make re-bake exactly when one of them, or drape-bake itself, changes. Relative INPUT, CONFIG
+# and SCENE resolve against the calling CMakeLists.txt's directory; relative OUTPUT, REPORT and
+# PREVIEW against its build directory. STRICT fails the bake on any warning.
+#
+# DRAPE_BAKE_EXECUTABLE names the drape-bake to run (set by the package).
+include_guard(GLOBAL)
+
+function(drape_add_bake)
+  cmake_parse_arguments(PARSE_ARGV 0 ARG "STRICT" "TARGET;INPUT;OUTPUT;CONFIG;SCENE;REPORT;PREVIEW"
+                        "")
+  if(ARG_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "drape_add_bake: unknown arguments ${ARG_UNPARSED_ARGUMENTS}")
+  endif()
+  foreach(required TARGET INPUT OUTPUT)
+    if(NOT ARG_${required})
+      message(FATAL_ERROR "drape_add_bake: ${required} is required")
+    endif()
+  endforeach()
+  if(NOT DRAPE_BAKE_EXECUTABLE OR (NOT TARGET "${DRAPE_BAKE_EXECUTABLE}"
+                                   AND NOT EXISTS "${DRAPE_BAKE_EXECUTABLE}"))
+    message(FATAL_ERROR "drape_add_bake(${ARG_TARGET}): no drape-bake in this drape package "
+                        "(DRAPE_BAKE_EXECUTABLE='${DRAPE_BAKE_EXECUTABLE}'; a runtime-only "
+                        "install, -DDRAPE_BUILD_BAKE=OFF, has none)")
+  endif()
+  set(bake "${DRAPE_BAKE_EXECUTABLE}")
+  if(TARGET "${DRAPE_BAKE_EXECUTABLE}")
+    set(bake "$<TARGET_FILE:${DRAPE_BAKE_EXECUTABLE}>")
+  endif()
+
+  get_filename_component(input "${ARG_INPUT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+  get_filename_component(output "${ARG_OUTPUT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
+  set(arguments "${input}" -o "${output}" --depfile "${output}.d")
+  set(depends "${input}")
+  set(outputs "${output}")
+  foreach(option CONFIG SCENE)
+    if(ARG_${option})
+      get_filename_component(file "${ARG_${option}}" ABSOLUTE BASE_DIR
+                             "${CMAKE_CURRENT_SOURCE_DIR}")
+      string(TOLOWER "${option}" flag)
+      list(APPEND arguments "--${flag}" "${file}")
+      list(APPEND depends "${file}")
+    endif()
+  endforeach()
+  if(ARG_REPORT)
+    get_filename_component(report "${ARG_REPORT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
+    list(APPEND arguments --report "${report}")
+    list(APPEND outputs "${report}")
+  endif()
+  if(ARG_PREVIEW)
+    get_filename_component(preview "${ARG_PREVIEW}" ABSOLUTE BASE_DIR
+                           "${CMAKE_CURRENT_BINARY_DIR}")
+    list(APPEND arguments --preview "${preview}")
+  endif()
+  if(ARG_STRICT)
+    list(APPEND arguments --strict)
+  endif()
+  list(APPEND depends "${DRAPE_BAKE_EXECUTABLE}")  # a new drape-bake re-bakes
+  add_custom_command(OUTPUT ${outputs}
+                     COMMAND "${bake}" ${arguments}
+                     DEPENDS ${depends}
+                     DEPFILE "${output}.d"
+                     COMMENT "drape-bake ${ARG_TARGET}: ${ARG_INPUT}"
+                     VERBATIM)
+  add_custom_target(${ARG_TARGET} ALL DEPENDS ${outputs})
+endfunction()

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# drape-bake as a build action: --depfile names the output and every file the bake read (a
+# glTF's external buffer, the config), in Makefile syntax; the output bytes depend on the
+# declared inputs only (not the working directory, absolute paths, time zone, locale or user);
+# a failed bake leaves no depfile behind.
+set -u
+BAKE=$1 SOURCE=$2
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+failures=0 passed=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+pass() { passed=$((passed + 1)); }
+
+# The mannequin with its buffer in an external .bin, in a directory whose name has a space.
+mkdir -p "$WORK/first dir" "$WORK/second" "$WORK/elsewhere"
+python3 - "$SOURCE/samples/mannequin/mannequin.gltf" "$WORK/first dir" <<'PY'
+import base64, json, sys
+gltf = json.load(open(sys.argv[1]))
+uri = gltf["buffers"][0]["uri"]
+open(sys.argv[2] + "/mannequin.bin", "wb").write(base64.b64decode(uri.split(",", 1)[1]))
+gltf["buffers"][0]["uri"] = "mannequin.bin"
+json.dump(gltf, open(sys.argv[2] + "/mannequin.gltf", "w"))
+PY
+echo '{"maps": {"resolution": 128}}' >"$WORK/first dir/bake.json"
+
+# --- The dependency file, from a relative invocation.
+(cd "$WORK" && "$BAKE" "first dir/mannequin.gltf" -o out.drape --config "first dir/bake.json" \
+  --depfile out.d 2>/dev/null) || fail "bake with --depfile failed"
+expected=$(printf 'out.drape: \\\n  first\\ dir/mannequin.gltf \\\n  first\\ dir/mannequin.bin \\\n  first\\ dir/bake.json')
+if [ "$(cat "$WORK/out.d" 2>/dev/null)" = "$expected" ]; then pass; else
+  fail "depfile differs: got [$(cat "$WORK/out.d" 2>/dev/null)] expected [$expected]"
+fi
+
+# --- Hermetic: the same inputs copied elsewhere, absolute paths, another working directory,
+# time zone, locale and user name give the same bytes.
+cp "$WORK/first dir/"* "$WORK/second/"
+(cd "$WORK/elsewhere" && TZ=Pacific/Chatham LANG=de_DE.UTF-8 LC_ALL=de_DE.UTF-8 USER=someone \
+  HOME=/nonexistent "$BAKE" "$WORK/second/mannequin.gltf" -o "$WORK/elsewhere/copy.drape" \
+  --config "$WORK/second/bake.json" 2>/dev/null) || fail "bake of the copy failed"
+if cmp -s "$WORK/out.drape" "$WORK/elsewhere/copy.drape"; then pass; else
+  fail "the copied inputs baked from elsewhere gave different bytes"
+fi
+
+# --- A failing bake writes no depfile.
+echo 'not json' >"$WORK/bad.json"
+if (cd "$WORK" && "$BAKE" "first dir/mannequin.gltf" -o bad.drape --config bad.json \
+  --depfile bad.d 2>/dev/null); then fail "a bad config baked"; fi
+if [ -e "$WORK/bad.d" ] || [ -e "$WORK/bad.drape" ]; then fail "a failed bake left a depfile or asset"; else pass; fi
+
+echo "pipeline_cli_test: $passed passed, $failures failed"
+[ "$failures" -eq 0 ]
