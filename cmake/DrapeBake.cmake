@@ -72,3 +72,47 @@ function(drape_add_bake)
                      VERBATIM)
   add_custom_target(${ARG_TARGET} ALL DEPENDS ${outputs})
 endfunction()
+
+#   drape_add_golden_test(NAME hero.golden INPUT hero.fbx GOLDEN golden/hero.drape
+#                         [CONFIG bake.json] [SCENE scene.json] [TOLERANCE tolerance.json])
+#
+# adds a CTest test that bakes INPUT into the build directory and compares the result with the
+# GOLDEN asset by meaning (drape-diff: skeleton, clips, mesh, hull planes, spheres, body-map
+# depths): it fails, with drape-diff's summary in the test log, when a difference is beyond the
+# TOLERANCE file's limits (drape-diff --help lists the keys; default limits are 0.01 mm).
+# DRAPE_DIFF_EXECUTABLE names the drape-diff to run (set by the package).
+set(_DRAPE_GOLDEN_SCRIPT "${CMAKE_CURRENT_LIST_DIR}/DrapeGoldenTest.cmake")
+
+function(drape_add_golden_test)
+  cmake_parse_arguments(PARSE_ARGV 0 ARG "" "NAME;INPUT;GOLDEN;CONFIG;SCENE;TOLERANCE" "")
+  if(ARG_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "drape_add_golden_test: unknown arguments ${ARG_UNPARSED_ARGUMENTS}")
+  endif()
+  foreach(required NAME INPUT GOLDEN)
+    if(NOT ARG_${required})
+      message(FATAL_ERROR "drape_add_golden_test: ${required} is required")
+    endif()
+  endforeach()
+  foreach(tool BAKE DIFF)
+    set(executable "${DRAPE_${tool}_EXECUTABLE}")
+    if(NOT executable OR (NOT TARGET "${executable}" AND NOT EXISTS "${executable}"))
+      message(FATAL_ERROR "drape_add_golden_test(${ARG_NAME}): DRAPE_${tool}_EXECUTABLE "
+                          "('${executable}') is not a drape tool of this package")
+    endif()
+    if(TARGET "${executable}")
+      set(executable "$<TARGET_FILE:${executable}>")
+    endif()
+    set(${tool} "${executable}")
+  endforeach()
+  set(definitions -DBAKE=${BAKE} -DDIFF=${DIFF})
+  foreach(option INPUT GOLDEN CONFIG SCENE TOLERANCE)
+    if(ARG_${option})
+      get_filename_component(file "${ARG_${option}}" ABSOLUTE BASE_DIR
+                             "${CMAKE_CURRENT_SOURCE_DIR}")
+      list(APPEND definitions "-D${option}=${file}")
+    endif()
+  endforeach()
+  string(MAKE_C_IDENTIFIER "${ARG_NAME}" file_name)
+  list(APPEND definitions "-DOUTPUT=${CMAKE_CURRENT_BINARY_DIR}/golden_tests/${file_name}.drape")
+  add_test(NAME ${ARG_NAME} COMMAND ${CMAKE_COMMAND} ${definitions} -P "${_DRAPE_GOLDEN_SCRIPT}")
+endfunction()

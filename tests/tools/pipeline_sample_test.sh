@@ -3,7 +3,8 @@
 #  - a project baking two characters builds, then has no work to do;
 #  - touching the external buffer of one (a file only its dependency file names) plans exactly
 #    that character's bake;
-#  - samples/pipeline (the sample a studio copies) configures and builds against the install.
+#  - samples/pipeline (the sample a studio copies) configures, builds and passes its golden test
+#    (drape-diff) against the install.
 # Usage: pipeline_sample_test.sh CMAKE BUILD_DIR SOURCE_DIR SHARED_DIR
 set -u
 CMAKE=$1 BUILD=$2 SOURCE=$3 SHARED=$4
@@ -60,6 +61,10 @@ if "$CMAKE" -S "$SOURCE/samples/pipeline" -B "$WORK/sample" -G Ninja -DCMAKE_PRE
   pass
 else
   fail "samples/pipeline did not build: $(tail -5 "$WORK/sample.log" 2>/dev/null)"
+fi
+# Its golden test, through the installed drape-diff.
+if (cd "$WORK/sample" && ctest --output-on-failure >"$WORK/golden.log" 2>&1); then pass; else
+  fail "samples/pipeline's golden test failed: $(tail -8 "$WORK/golden.log")"
 fi
 
 echo "pipeline_sample_test: $passed passed, $failures failed"
