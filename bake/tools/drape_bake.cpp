@@ -1,5 +1,6 @@
 // drape-bake INPUT -o OUT.drape [--config FILE.json] [--scene SCENE.json] [--report REPORT.json]
 //            [--preview DIR] [--strict] [--depfile OUT.d]
+// drape-bake --batch MANIFEST.json [-j N] [--report SUMMARY.json] [--strict]
 // drape-bake --dump-config
 // On any error: one line on stderr naming the input and the reason, exit code 1, no output file.
 // Warnings (what was assumed or repaired, colliders that fit the body badly) go to stderr, one
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bake_batch.h"
 #include "drape/bake/bake_config.h"
 #include "drape/bake/bake_pipeline.h"
 #include "drape/formats/asset_file.h"
@@ -60,6 +62,8 @@ int main(int argc, char** argv) {
       "drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
   std::string input, output, config_path, scene_path, report_path, preview_dir, depfile_path;
   bool dump_config = false, list_formats = false, strict = false;
+  std::string batch_manifest;
+  unsigned jobs = 1;
   app.add_option("INPUT", input, "character file (anything assimp reads)");
   app.add_option("-o,--output", output, "the .drape file to write");
   app.add_option("--config", config_path, "JSON bake parameters (see --dump-config)");
@@ -70,6 +74,12 @@ int main(int argc, char** argv) {
   app.add_option("--depfile", depfile_path,
                  "write a Makefile-syntax dependency file (for Ninja and Make): the output and "
                  "every file the bake read");
+  app.add_option("--batch", batch_manifest,
+                 "bake every item of a JSON manifest ({\"items\": [{\"input\", \"output\", "
+                 "\"config\", \"scene\", \"report\", \"depfile\", \"strict\"}]}, paths relative "
+                 "to it), each in its own process; --report writes one summary");
+  app.add_option("-j,--jobs", jobs, "with --batch: items baked at once")
+      ->check(CLI::Range(1u, 256u));
   app.add_flag("--dump-config", dump_config, "print every parameter with default, unit and range");
   app.add_flag("--formats", list_formats, "print the file extensions the bake reads, one a line");
   try {
@@ -85,6 +95,16 @@ int main(int argc, char** argv) {
     for (const std::string& extension : drape::bake::ReadableExtensions())
       std::printf("%s\n", extension.c_str());
     return 0;
+  }
+  if (!batch_manifest.empty()) {
+    if (!input.empty() || !output.empty() || !config_path.empty() || !scene_path.empty() ||
+        !preview_dir.empty() || !depfile_path.empty())
+      return Fail(batch_manifest +
+                  ": --batch takes its inputs, outputs, configs and scenes from the manifest");
+    std::error_code error;
+    const std::string self = std::filesystem::read_symlink("/proc/self/exe", error).string();
+    return drape::bake_tool::RunBatch(
+        {batch_manifest, jobs, report_path, strict, error ? std::string(argv[0]) : self});
   }
   if (input.empty()) return Fail("no INPUT given (usage: drape-bake INPUT -o OUT.drape)");
   if (output.empty()) return Fail(input + ": no output given (-o OUT.drape)");
