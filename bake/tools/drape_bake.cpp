@@ -1,5 +1,5 @@
 // drape-bake INPUT -o OUT.drape [--config FILE.json] [--scene SCENE.json] [--report REPORT.json]
-//            [--preview DIR] [--strict] [--depfile OUT.d]
+//            [--preview DIR] [--strict] [--depfile OUT.d] [--gltf OUT.gltf|.glb]
 // drape-bake --batch MANIFEST.json [-j N] [--report SUMMARY.json] [--strict]
 // drape-bake --dump-config
 // On any error: one line on stderr naming the input and the reason, exit code 1, no output file.
@@ -20,6 +20,7 @@
 #include "bake_batch.h"
 #include "drape/bake/bake_config.h"
 #include "drape/bake/bake_pipeline.h"
+#include "drape/bake/gltf_export.h"
 #include "drape/formats/asset_file.h"
 
 namespace {
@@ -62,7 +63,7 @@ int main(int argc, char** argv) {
       "drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
   std::string input, output, config_path, scene_path, report_path, preview_dir, depfile_path;
   bool dump_config = false, list_formats = false, strict = false;
-  std::string batch_manifest;
+  std::string batch_manifest, gltf_path;
   unsigned jobs = 1;
   app.add_option("INPUT", input, "character file (anything assimp reads)");
   app.add_option("-o,--output", output, "the .drape file to write");
@@ -71,6 +72,9 @@ int main(int argc, char** argv) {
   app.add_option("--report", report_path, "JSON report of the bake");
   app.add_option("--preview", preview_dir, "directory for preview pictures");
   app.add_flag("--strict", strict, "fail the bake on any warning (for pipelines)");
+  app.add_option("--gltf", gltf_path,
+                 "also write the asset as glTF 2.0 (.glb: binary) to look at: the skinned body, "
+                 "the hulls and joint spheres on their joints, the clips");
   app.add_option("--depfile", depfile_path,
                  "write a Makefile-syntax dependency file (for Ninja and Make): the output and "
                  "every file the bake read");
@@ -98,7 +102,7 @@ int main(int argc, char** argv) {
   }
   if (!batch_manifest.empty()) {
     if (!input.empty() || !output.empty() || !config_path.empty() || !scene_path.empty() ||
-        !preview_dir.empty() || !depfile_path.empty())
+        !preview_dir.empty() || !depfile_path.empty() || !gltf_path.empty())
       return Fail(batch_manifest +
                   ": --batch takes its inputs, outputs, configs and scenes from the manifest");
     std::error_code error;
@@ -149,30 +153,33 @@ int main(int argc, char** argv) {
   result.report["output_bytes"] = bytes.size();
   result.report["timings"]["total_ms"] =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  // The dependency file first, then the report (each atomically), then the asset: a failure at
-  // any step leaves no asset behind.
-  if (!depfile_path.empty()) {
-    std::vector<std::string> inputs = {input};
-    inputs.insert(inputs.end(), result.input_files.begin(), result.input_files.end());
-    inputs.push_back(config_path);
-    inputs.push_back(scene_path);
-    if (drape::Status s = drape::WriteFileAtomically(depfile_path, DepfileRule(output, inputs));
-        !s.ok()) {
-      return Fail(s.message());
+  // The glTF view, the dependency file and the report (each atomically), then the asset: a
+  // failure at any step removes what was written before it, so no asset is left behind.
+  std::vector<std::string> written;
+  const auto write = [&](const std::string& path, const auto& write_file) {
+    if (path.empty()) return true;
+    if (drape::Status s = write_file(); !s.ok()) {
+      for (const std::string& w : written) std::remove(w.c_str());
+      Fail(s.message());
+      return false;
     }
-  }
-  if (!report_path.empty()) {
-    if (drape::Status s = drape::WriteFileAtomically(report_path, result.report.dump(2) + "\n");
-        !s.ok()) {
-      if (!depfile_path.empty()) std::remove(depfile_path.c_str());
-      return Fail(s.message());
-    }
-  }
-  if (drape::Status s = drape::WriteAssetFile(output, result.asset); !s.ok()) {
-    if (!report_path.empty()) std::remove(report_path.c_str());
-    if (!depfile_path.empty()) std::remove(depfile_path.c_str());
-    return Fail(s.message());
-  }
+    written.push_back(path);
+    return true;
+  };
+  std::vector<std::string> inputs = {input};
+  inputs.insert(inputs.end(), result.input_files.begin(), result.input_files.end());
+  inputs.push_back(config_path);
+  inputs.push_back(scene_path);
+  const bool ok =
+      write(gltf_path, [&] { return drape::bake::WriteAssetGltf(result.asset, gltf_path); }) &&
+      write(
+          depfile_path,
+          [&] { return drape::WriteFileAtomically(depfile_path, DepfileRule(output, inputs)); }) &&
+      write(
+          report_path,
+          [&] { return drape::WriteFileAtomically(report_path, result.report.dump(2) + "\n"); }) &&
+      write(output, [&] { return drape::WriteAssetFile(output, result.asset); });
+  if (!ok) return 1;
   // What was assumed or repaired, one line each (also the report's "warnings").
   for (const auto& warning : warnings)
     std::fprintf(stderr, "drape-bake: warning: %s: %s\n", input.c_str(),
