@@ -28,6 +28,10 @@ int main(int argc, char** argv) {
                  "worker threads: the cloth step's task pool and the bake's OpenMP team (default: "
                  "all cores)")
       ->check(CLI::Range(1, 1024));
+  app.add_option("--gltf", options.gltf_path,
+                 "also write the run as one animated glTF 2.0 (.glb: binary): the body skinned by "
+                 "the played poses, each garment's frames as morph targets (at most 300 frames, "
+                 "evenly spread over the written ones)");
   app.add_flag("--dump-scene-reference", dump_reference,
                "print the scenes reference (docs/SCENES.md) as markdown and exit");
   try {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "asset_cache.h"
+#include "drape/bake/gltf_export.h"
 #include "drape/bake/scene.h"
 #include "drape/runtime/task_system.h"
 #include "frame_renderer.h"
@@ -120,7 +121,28 @@ struct FrameLoop {
   int64_t written = 0;  // pictures written
   std::vector<Thumbnail> thumbnails;
   Status failure = Status::Ok();  // the step that failed, if one did
+  // --gltf: every record_every-th written frame (0: none recorded).
+  int64_t record_every = 0;
+  bake::SimulationRecording recording;
 };
+
+// The glTF recording keeps at most this many frames (each holds every particle).
+constexpr int64_t kMaxRecordedFrames = 300;
+
+void RecordFrame(const bake::Scene& scene, const SceneSimulation& sim, FrameLoop* loop) {
+  bake::SimulationRecording& r = loop->recording;
+  r.skinning.emplace_back(sim.skinning().begin(), sim.skinning().end());
+  r.garments.resize(sim.garment_count());
+  for (size_t g = 0; g < sim.garment_count(); ++g) {
+    if (r.garments[g].name.empty()) {
+      r.garments[g].name = scene.garments[g].name;
+      r.garments[g].triangles.assign(sim.garment_triangles(g).begin(),
+                                     sim.garment_triangles(g).end());
+    }
+    r.garments[g].positions.emplace_back(sim.garment_positions(g).begin(),
+                                         sim.garment_positions(g).end());
+  }
+}
 
 // Writes the picture of simulation frame `frame` (and its OBJ meshes), named by the frame,
 // keeping a thumbnail when the contact sheet shows it (sheet_frames counts pictures).
@@ -137,6 +159,8 @@ Status WriteFrameOutputs(const bake::Scene& scene, const std::string& dir, int64
     t.rgb = Downscale(rgb, w, h, 240, &t.width, &t.height);
     loop->thumbnails.push_back(std::move(t));
   }
+  if (loop->record_every > 0 && loop->written % loop->record_every == 0)
+    RecordFrame(scene, sim, loop);
   if (scene.output.obj) {
     for (size_t g = 0; g < sim.garment_count(); ++g) {
       std::snprintf(name, sizeof(name), "_%04lld.obj", static_cast<long long>(frame));
@@ -156,6 +180,11 @@ Status SimulateFrames(const bake::Scene& scene, const std::string& dir, SceneSim
   const int64_t frames = scene.frame_count;
   const uint32_t every = scene.output.every;
   const int64_t written_total = (frames + every - 1) / every;
+  if (loop->record_every > 0) {
+    loop->record_every = (written_total + kMaxRecordedFrames - 1) / kMaxRecordedFrames;
+    loop->recording.frame_seconds =
+        scene.dt * static_cast<float>(every) * static_cast<float>(loop->record_every);
+  }
   // Frames for the contact sheet: up to 16, evenly spread.
   const int64_t sheet_count = std::min<int64_t>(16, written_total);
   std::vector<int64_t> sheet_frames;
@@ -238,8 +267,13 @@ int RunScene(const RunOptions& options) {
   json settle;
   if (Status s = Settle(&sim, &settle); !s.ok()) return Fail(s.message());
   FrameLoop loop;
+  loop.record_every = options.gltf_path.empty() ? 0 : 1;
   if (Status s = SimulateFrames(scene, dir, &sim, &renderer, &loop); !s.ok())
     return Fail(s.message());
+  if (!options.gltf_path.empty()) {
+    if (Status s = bake::WriteSimulationGltf(asset, loop.recording, options.gltf_path); !s.ok())
+      return Fail(s.message());
+  }
   const int64_t simulated = static_cast<int64_t>(loop.frames.size());
   // Read before stats.json is built: the peak of the bake, setup and simulation.
   const uint64_t rss_peak = PeakResidentSetBytes();

@@ -9,8 +9,9 @@ namespace drape::sim {
 
 struct RunOptions {
   std::string scene_path, out_dir;
-  int64_t frames = 0;  // > 0: overrides the scene's frame count
-  int threads = 0;     // > 0: worker threads (the step's task pool, the bake's OpenMP team)
+  int64_t frames = 0;     // > 0: overrides the scene's frame count
+  int threads = 0;        // > 0: worker threads (the step's task pool, the bake's OpenMP team)
+  std::string gltf_path;  // non-empty: also write the run as an animated glTF (.glb: binary)
 };
 
 // Returns the process exit code: 0, or 1 after printing one line naming the input and the reason.

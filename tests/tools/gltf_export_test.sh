@@ -2,9 +2,10 @@
 # drape-bake --gltf: the asset as glTF 2.0 (.gltf and .glb) that the Khronos validator passes with
 # no error, holding the skeleton, the skinned body, a node per hull and joint sphere on its joint
 # and the clips; an export that cannot be written fails the bake and leaves nothing.
-# Usage: gltf_export_test.sh BAKE SOURCE SHARED NODE_DIR
+# With drape-sim (SIM): a short run of the demo scene as an animated glTF passes too.
+# Usage: gltf_export_test.sh BAKE SOURCE SHARED NODE_DIR [SIM]
 set -u
-BAKE=$1 SOURCE=$2 SHARED=$3 NODE_DIR=$4
+BAKE=$1 SOURCE=$2 SHARED=$3 NODE_DIR=$4 SIM=${5:-}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 failures=0 passed=0
@@ -29,6 +30,12 @@ else
   "$BAKE" "$SOURCE/samples/mannequin/mannequin.gltf" -o "$WORK/m2.drape" --config "$WORK/bake.json" \
     --gltf "$WORK/m2.glb" 2>/dev/null
   files+=("$WORK/m2.glb")
+fi
+if [ -n "$SIM" ]; then
+  "$SIM" "$SOURCE/samples/scenes/demo.json" -o "$WORK/sim" --frames 24 --threads 1 \
+    --gltf "$WORK/sim/demo.glb" >/dev/null 2>&1
+  check [ $? -eq 0 ]
+  files+=("$WORK/sim/demo.glb")
 fi
 NODE_PATH="$NODE_DIR/node_modules" node "$(dirname "$0")/validate_gltf.js" "${files[@]}" >"$WORK/validator.txt" 2>&1
 check [ $? -eq 0 ]

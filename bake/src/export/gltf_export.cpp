@@ -291,38 +291,200 @@ void AddClip(const ClipData& clip, uint32_t joint_count, Builder* b) {
   b->model.animations.push_back(animation);
 }
 
-}  // namespace
+// The skeleton, skin and skinned body; returns the body's node.
+int AddCharacter(const CharacterAsset& asset, Builder* b) {
+  AddSkeleton(asset.skeleton, b);
+  const int skin = AddSkin(asset.skeleton, b);
+  return AddBody(asset.mesh, skin, b);
+}
 
-Status WriteAssetGltf(const CharacterAsset& asset, const std::string& path) {
-  const auto invalid = [&](const std::string& why) {
-    return Status(StatusCode::kInvalidArgument, path + ": " + why);
-  };
-  const SkeletonData& skeleton = asset.skeleton;
-  if (skeleton.joint_count() == 0) return invalid("the asset has no skeleton to export");
-  Builder b;
-  AddSkeleton(skeleton, &b);
-  const int skin = AddSkin(skeleton, &b);
-  const int body = AddBody(asset.mesh, skin, &b);
-  AddHulls(asset, &b);
-  AddJointSpheres(asset, &b);
-  for (const ClipData& clip : asset.clips)
-    if (clip.frame_count > 1 &&
-        clip.keys.size() == size_t{clip.frame_count} * skeleton.joint_count())
-      AddClip(clip, skeleton.joint_count(), &b);
+Status Write(const CharacterAsset& asset, const std::vector<int>& extra_roots,
+             const std::string& path, Builder* b) {
   tinygltf::Scene scene;
   scene.name = asset.info.source_name;
-  for (uint32_t j = 0; j < skeleton.joint_count(); ++j)
-    if (skeleton.parents[j] < 0) scene.nodes.push_back(static_cast<int>(j));
-  scene.nodes.push_back(body);
-  b.model.scenes.push_back(scene);
-  b.model.defaultScene = 0;
-  b.model.buffers[0].data.resize((b.model.buffers[0].data.size() + 3) / 4 * 4, 0);
+  for (uint32_t j = 0; j < asset.skeleton.joint_count(); ++j)
+    if (asset.skeleton.parents[j] < 0) scene.nodes.push_back(static_cast<int>(j));
+  scene.nodes.insert(scene.nodes.end(), extra_roots.begin(), extra_roots.end());
+  b->model.scenes.push_back(scene);
+  b->model.defaultScene = 0;
+  b->model.buffers[0].data.resize((b->model.buffers[0].data.size() + 3) / 4 * 4, 0);
   const bool binary = path.size() >= 4 && path.compare(path.size() - 4, 4, ".glb") == 0;
   std::ostringstream out;
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToStream(&b.model, out, /*prettyPrint=*/!binary, binary))
-    return invalid("the glTF writer failed");
+  if (!writer.WriteGltfSceneToStream(&b->model, out, /*prettyPrint=*/!binary, binary))
+    return Status(StatusCode::kInvalidArgument, path + ": the glTF writer failed");
   return WriteFileAtomically(path, out.str());
+}
+
+// A matrix as translation, rotation and scale (columns' lengths; a mirror goes into the x scale).
+Transform Decompose(const Mat34& m) {
+  Transform t;
+  t.translation = {m.m[3], m.m[7], m.m[11]};
+  Float3 c[3];
+  float s[3];
+  for (int k = 0; k < 3; ++k) {
+    c[k] = {m.m[k], m.m[4 + k], m.m[8 + k]};
+    s[k] = Length(c[k]);
+    c[k] = s[k] > 0.f ? c[k] * (1.f / s[k]) : Float3{};
+  }
+  if (Dot(Cross(c[0], c[1]), c[2]) < 0.f) s[0] = -s[0], c[0] = c[0] * -1.f;
+  t.scale = {s[0], s[1], s[2]};
+  // Rotation matrix (columns c) to a quaternion (Shepperd's method).
+  const double r00 = c[0].x, r11 = c[1].y, r22 = c[2].z, trace = r00 + r11 + r22;
+  double x, y, z, w;
+  if (trace > 0.0) {
+    const double q = 2.0 * std::sqrt(1.0 + trace);
+    w = 0.25 * q, x = (c[1].z - c[2].y) / q, y = (c[2].x - c[0].z) / q, z = (c[0].y - c[1].x) / q;
+  } else if (r00 > r11 && r00 > r22) {
+    const double q = 2.0 * std::sqrt(1.0 + r00 - r11 - r22);
+    w = (c[1].z - c[2].y) / q, x = 0.25 * q, y = (c[1].x + c[0].y) / q, z = (c[2].x + c[0].z) / q;
+  } else if (r11 > r22) {
+    const double q = 2.0 * std::sqrt(1.0 + r11 - r00 - r22);
+    w = (c[2].x - c[0].z) / q, x = (c[1].x + c[0].y) / q, y = 0.25 * q, z = (c[2].y + c[1].z) / q;
+  } else {
+    const double q = 2.0 * std::sqrt(1.0 + r22 - r00 - r11);
+    w = (c[0].y - c[1].x) / q, x = (c[2].x + c[0].z) / q, y = (c[2].y + c[1].z) / q, z = 0.25 * q;
+  }
+  t.rotation = Normalize(Quat{static_cast<float>(x), static_cast<float>(y), static_cast<float>(z),
+                              static_cast<float>(w)});
+  return t;
+}
+
+// Per frame, each joint's local transform from the skinning matrices: world = skinning *
+// inverse(inverse bind), local = inverse(parent world) * world.
+std::vector<Transform> LocalPoses(const SkeletonData& skeleton,
+                                  const std::vector<std::vector<Mat34>>& skinning) {
+  const uint32_t joints = skeleton.joint_count();
+  std::vector<Mat34> bind_world(joints);
+  for (uint32_t j = 0; j < joints; ++j) InverseAffine(skeleton.inverse_bind[j], &bind_world[j]);
+  std::vector<Transform> local;
+  std::vector<Mat34> world(joints);
+  for (const std::vector<Mat34>& frame : skinning) {
+    for (uint32_t j = 0; j < joints; ++j) {
+      world[j] = Multiply(frame[j], bind_world[j]);
+      Mat34 parent_inverse;
+      const int32_t p = skeleton.parents[j];
+      if (p < 0 || !InverseAffine(world[static_cast<size_t>(p)], &parent_inverse))
+        parent_inverse = Mat34{};
+      local.push_back(Decompose(Multiply(parent_inverse, world[j])));
+    }
+  }
+  return local;
+}
+
+tinygltf::AnimationSampler Sampler(int input, int output, const char* interpolation) {
+  tinygltf::AnimationSampler sampler;
+  sampler.input = input;
+  sampler.output = output;
+  sampler.interpolation = interpolation;
+  return sampler;
+}
+
+// One channel per joint and path over the recorded frames.
+void AddPoseChannels(const std::vector<Transform>& local, uint32_t joints, int input,
+                     tinygltf::Animation* animation, Builder* b) {
+  const size_t frames = local.size() / joints;
+  for (uint32_t j = 0; j < joints; ++j) {
+    std::vector<float> translation, rotation, scale;
+    for (size_t f = 0; f < frames; ++f) {
+      const Transform& k = local[f * joints + j];
+      translation.insert(translation.end(), {k.translation.x, k.translation.y, k.translation.z});
+      rotation.insert(rotation.end(), {k.rotation.x, k.rotation.y, k.rotation.z, k.rotation.w});
+      scale.insert(scale.end(), {k.scale.x, k.scale.y, k.scale.z});
+    }
+    for (const auto& [path, values, type] :
+         {std::tuple{"translation", &translation, TINYGLTF_TYPE_VEC3},
+          std::tuple{"rotation", &rotation, TINYGLTF_TYPE_VEC4},
+          std::tuple{"scale", &scale, TINYGLTF_TYPE_VEC3}}) {
+      const int view = b->View(values->data(), values->size() * sizeof(float), 0);
+      animation->samplers.push_back(
+          Sampler(input, b->Accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, frames, type), "LINEAR"));
+      tinygltf::AnimationChannel channel;
+      channel.sampler = static_cast<int>(animation->samplers.size()) - 1;
+      channel.target_node = static_cast<int>(j);
+      channel.target_path = path;
+      animation->channels.push_back(channel);
+    }
+  }
+}
+
+// A garment: frame 0 as the mesh, frame k as morph target k - 1, and weights that switch to
+// target k - 1 at frame k (STEP). Returns its node.
+int AddGarment(const SimulationRecording::Garment& g, int input, tinygltf::Animation* animation,
+               Builder* b) {
+  const int material = b->Material("garment", 0.85, 0.35, 0.25, 1.0);
+  const int mesh = b->Mesh(g.name, b->Positions(g.positions[0]), b->Indices(g.triangles), material);
+  const size_t frames = g.positions.size();
+  tinygltf::Primitive& primitive = b->model.meshes[static_cast<size_t>(mesh)].primitives[0];
+  for (size_t f = 1; f < frames; ++f) {
+    std::vector<Float3> delta(g.positions[f].size());
+    for (size_t i = 0; i < delta.size(); ++i) delta[i] = g.positions[f][i] - g.positions[0][i];
+    primitive.targets.push_back({{"POSITION", b->Positions(delta)}});
+  }
+  b->model.meshes[static_cast<size_t>(mesh)].weights.assign(frames - 1, 0.0);
+  std::vector<float> weights(frames * (frames - 1), 0.f);
+  for (size_t f = 1; f < frames; ++f) weights[f * (frames - 1) + (f - 1)] = 1.f;
+  const int view = b->View(weights.data(), weights.size() * sizeof(float), 0);
+  animation->samplers.push_back(Sampler(
+      input, b->Accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, weights.size(), TINYGLTF_TYPE_SCALAR),
+      "STEP"));
+  tinygltf::Node node;
+  node.name = g.name;
+  node.mesh = mesh;
+  const int index = b->Node(node, -1);
+  tinygltf::AnimationChannel channel;
+  channel.sampler = static_cast<int>(animation->samplers.size()) - 1;
+  channel.target_node = index;
+  channel.target_path = "weights";
+  animation->channels.push_back(channel);
+  return index;
+}
+
+}  // namespace
+
+Status WriteAssetGltf(const CharacterAsset& asset, const std::string& path) {
+  if (asset.skeleton.joint_count() == 0)
+    return Status(StatusCode::kInvalidArgument, path + ": the asset has no skeleton to export");
+  Builder b;
+  const int body = AddCharacter(asset, &b);
+  AddHulls(asset, &b);
+  AddJointSpheres(asset, &b);
+  const uint32_t joints = asset.skeleton.joint_count();
+  for (const ClipData& clip : asset.clips)
+    if (clip.frame_count > 1 && clip.keys.size() == size_t{clip.frame_count} * joints)
+      AddClip(clip, joints, &b);
+  return Write(asset, {body}, path, &b);
+}
+
+Status WriteSimulationGltf(const CharacterAsset& asset, const SimulationRecording& recording,
+                           const std::string& path) {
+  const auto invalid = [&](const std::string& why) {
+    return Status(StatusCode::kInvalidArgument, path + ": " + why);
+  };
+  const uint32_t joints = asset.skeleton.joint_count();
+  const size_t frames = recording.skinning.size();
+  if (joints == 0) return invalid("the asset has no skeleton to export");
+  if (frames < 2 || !(recording.frame_seconds > 0.f))
+    return invalid("a simulation of at least two recorded frames, frame_seconds > 0, is needed");
+  for (const std::vector<Mat34>& frame : recording.skinning)
+    if (frame.size() < joints) return invalid("a recorded frame has too few skinning matrices");
+  for (const SimulationRecording::Garment& g : recording.garments)
+    if (g.positions.size() != frames) return invalid("garment " + g.name + ": frames missing");
+  Builder b;
+  const int body = AddCharacter(asset, &b);
+  std::vector<float> times(frames);
+  for (size_t f = 0; f < frames; ++f) times[f] = static_cast<float>(f) * recording.frame_seconds;
+  const int input_view = b.View(times.data(), times.size() * sizeof(float), 0);
+  const int input = b.Accessor(input_view, TINYGLTF_COMPONENT_TYPE_FLOAT, frames,
+                               TINYGLTF_TYPE_SCALAR, {times.front()}, {times.back()});
+  tinygltf::Animation animation;
+  animation.name = "simulation";
+  AddPoseChannels(LocalPoses(asset.skeleton, recording.skinning), joints, input, &animation, &b);
+  std::vector<int> roots = {body};
+  for (const SimulationRecording::Garment& g : recording.garments)
+    roots.push_back(AddGarment(g, input, &animation, &b));
+  b.model.animations.push_back(animation);
+  return Write(asset, roots, path, &b);
 }
 
 }  // namespace drape::bake

@@ -49,14 +49,16 @@ held, which collision methods run, the solver's parameters and what to output. `
 one:
 
 ```
-drape-sim samples/scenes/demo.json -o out/demo [--frames N] [--threads T]
+drape-sim samples/scenes/demo.json -o out/demo [--frames N] [--threads T] [--gltf RUN.glb]
 ```
 
 It bakes the character into `out/demo/character.drape` when that file is missing or stale (see
 [Cache](#cache)), keeps only the colliders the garments can reach (see [Reach](#reach)),
 simulates, and writes `frames/frame_NNNN.png` (NNNN: the simulation frame, every `output.every`-th),
 `animation.mp4` (or `.gif`) when `ffmpeg` is on `PATH` and `contact_sheet.png` otherwise,
-`obj/<garment>_NNNN.obj` on request, `stats.json`,
+`obj/<garment>_NNNN.obj` on request, with `--gltf` the whole run as one animated glTF (the body
+skinned by the played poses, each garment's frames as morph targets; up to 300 frames spread
+over the written ones), `stats.json`,
 `reach.json` and, after a bake, `bake_report.json`. Progress goes to stderr (a bar on a terminal,
 else a line per 10 %), log lines to stdout. On any error it prints one line on stderr naming the
 file and the reason, for a scene field its JSON path, and exits with 1:

@@ -5,6 +5,7 @@
 // with the character.
 
 #include <string>
+#include <vector>
 
 #include "drape/formats/character_asset.h"
 #include "drape/formats/status.h"
@@ -14,5 +15,24 @@ namespace drape::bake {
 // Binary glTF (.glb) when `path` ends in .glb, else .gltf with its buffer embedded. Written
 // atomically: nothing on error.
 Status WriteAssetGltf(const CharacterAsset& asset, const std::string& path);
+
+// A simulation as recorded frame by frame: the character's skinning matrices and each garment's
+// particle positions, frame_seconds apart.
+struct SimulationRecording {
+  float frame_seconds = 1.f / 60.f;          // > 0
+  std::vector<std::vector<Mat34>> skinning;  // per frame: one matrix per joint
+  struct Garment {
+    std::string name;
+    std::vector<uint32_t> triangles;             // 3 particle indices each
+    std::vector<std::vector<Float3>> positions;  // per frame: one per particle
+  };
+  std::vector<Garment> garments;
+};
+
+// The simulation as one animated glTF: the skinned body animated by the recorded poses (each
+// joint's local transform per frame) and each garment as a mesh whose per-frame shapes are morph
+// targets switched frame by frame (STEP weights), all in one animation "simulation".
+Status WriteSimulationGltf(const CharacterAsset& asset, const SimulationRecording& recording,
+                           const std::string& path);
 
 }  // namespace drape::bake
