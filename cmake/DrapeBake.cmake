@@ -14,17 +14,22 @@
 # DRAPE_BAKE_EXECUTABLE names the drape-bake to run (set by the package).
 include_guard(GLOBAL)
 
+# In the caller's scope (a macro): no unparsed argument, and every required one given.
+macro(_drape_check_arguments function)
+  if(ARG_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "${function}: unknown arguments ${ARG_UNPARSED_ARGUMENTS}")
+  endif()
+  foreach(_drape_required ${ARGN})
+    if(NOT ARG_${_drape_required})
+      message(FATAL_ERROR "${function}: ${_drape_required} is required")
+    endif()
+  endforeach()
+endmacro()
+
 function(drape_add_bake)
   cmake_parse_arguments(PARSE_ARGV 0 ARG "STRICT" "TARGET;INPUT;OUTPUT;CONFIG;SCENE;REPORT;PREVIEW"
                         "")
-  if(ARG_UNPARSED_ARGUMENTS)
-    message(FATAL_ERROR "drape_add_bake: unknown arguments ${ARG_UNPARSED_ARGUMENTS}")
-  endif()
-  foreach(required TARGET INPUT OUTPUT)
-    if(NOT ARG_${required})
-      message(FATAL_ERROR "drape_add_bake: ${required} is required")
-    endif()
-  endforeach()
+  _drape_check_arguments(drape_add_bake TARGET INPUT OUTPUT)
   if(NOT DRAPE_BAKE_EXECUTABLE OR (NOT TARGET "${DRAPE_BAKE_EXECUTABLE}"
                                    AND NOT EXISTS "${DRAPE_BAKE_EXECUTABLE}"))
     message(FATAL_ERROR "drape_add_bake(${ARG_TARGET}): no drape-bake in this drape package "
@@ -85,14 +90,7 @@ set(_DRAPE_GOLDEN_SCRIPT "${CMAKE_CURRENT_LIST_DIR}/DrapeGoldenTest.cmake")
 
 function(drape_add_golden_test)
   cmake_parse_arguments(PARSE_ARGV 0 ARG "" "NAME;INPUT;GOLDEN;CONFIG;SCENE;TOLERANCE" "")
-  if(ARG_UNPARSED_ARGUMENTS)
-    message(FATAL_ERROR "drape_add_golden_test: unknown arguments ${ARG_UNPARSED_ARGUMENTS}")
-  endif()
-  foreach(required NAME INPUT GOLDEN)
-    if(NOT ARG_${required})
-      message(FATAL_ERROR "drape_add_golden_test: ${required} is required")
-    endif()
-  endforeach()
+  _drape_check_arguments(drape_add_golden_test NAME INPUT GOLDEN)
   foreach(tool BAKE DIFF)
     set(executable "${DRAPE_${tool}_EXECUTABLE}")
     if(NOT executable OR (NOT TARGET "${executable}" AND NOT EXISTS "${executable}"))

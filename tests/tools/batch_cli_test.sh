@@ -4,11 +4,7 @@
 # manifest bakes nothing and names the manifest, the item and the reason.
 set -u
 BAKE=$1 SOURCE=$2
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
-failures=0 passed=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-check() { if "$@"; then passed=$((passed + 1)); else fail "$*"; fi; }
+. "$(dirname "$0")/cli_test_lib.sh"
 MANNEQUIN="$SOURCE/samples/mannequin/mannequin.gltf"
 echo '{"maps": {"resolution": 128}}' >"$WORK/bake.json"
 echo "garbage" >"$WORK/broken.fbx"
@@ -58,5 +54,4 @@ check grep -q "also the output of /items/0" "$WORK/twice.err"
 "$BAKE" --batch "$WORK/good.json" "$MANNEQUIN" >/dev/null 2>"$WORK/mixed.err"
 check grep -q "takes its inputs" "$WORK/mixed.err"
 
-echo "batch_cli_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish batch_cli_test

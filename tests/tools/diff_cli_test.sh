@@ -5,11 +5,7 @@
 # key is one line naming it and exit 2.
 set -u
 BAKE=$1 DIFF=$2 SOURCE=$3
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
-failures=0 passed=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-check() { if "$@"; then passed=$((passed + 1)); else fail "$*"; fi; }
+. "$(dirname "$0")/cli_test_lib.sh"
 GOLDEN="$SOURCE/tests/golden/mannequin_colliders_v2.drape"
 MANNEQUIN="$SOURCE/samples/mannequin/mannequin.gltf"
 echo '{"maps": {"resolution": 256, "epsilon": 0.006}}' >"$WORK/offset.json"
@@ -25,7 +21,7 @@ check grep -q "agree within tolerance" "$WORK/same.txt"
 check [ $? -eq 1 ]
 check grep -q "body map pose 0 (rest).*texel depths moved" "$WORK/offset.txt"
 check grep -q "differences beyond tolerance" "$WORK/offset.txt"
-if grep -q "^hull" "$WORK/offset.txt"; then fail "a map offset moved a hull: $(cat "$WORK/offset.txt")"; else passed=$((passed + 1)); fi
+if grep -q "^hull" "$WORK/offset.txt"; then fail "a map offset moved a hull: $(cat "$WORK/offset.txt")"; else pass; fi
 
 "$DIFF" "$GOLDEN" "$WORK/pieces.drape" >"$WORK/pieces.txt"
 check [ $? -eq 1 ]
@@ -45,5 +41,4 @@ echo '{"plane_mn": 1}' >"$WORK/typo.json"
 check [ $? -eq 2 ]
 check grep -q "plane_mn" "$WORK/typo.err"
 
-echo "diff_cli_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish diff_cli_test

@@ -6,11 +6,7 @@
 # Usage: gltf_export_test.sh BAKE SOURCE SHARED NODE_DIR [SIM]
 set -u
 BAKE=$1 SOURCE=$2 SHARED=$3 NODE_DIR=$4 SIM=${5:-}
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
-failures=0 passed=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-check() { if "$@"; then passed=$((passed + 1)); else fail "$*"; fi; }
+. "$(dirname "$0")/cli_test_lib.sh"
 if [ ! -f "$NODE_DIR/node_modules/gltf-validator/package.json" ]; then
   echo "FAIL: the glTF validator is not installed in $NODE_DIR (scripts/setup.sh installs it)"
   exit 1
@@ -62,5 +58,4 @@ PY
 check [ $? -ne 0 ]
 check grep -q "no/such/dir/x.gltf" "$WORK/x.err"
 check [ ! -e "$WORK/x.drape" ]
-echo "gltf_export_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish gltf_export_test

@@ -5,22 +5,11 @@
 # a failed bake leaves no depfile behind.
 set -u
 BAKE=$1 SOURCE=$2
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
-failures=0 passed=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-pass() { passed=$((passed + 1)); }
+. "$(dirname "$0")/cli_test_lib.sh"
 
 # The mannequin with its buffer in an external .bin, in a directory whose name has a space.
 mkdir -p "$WORK/first dir" "$WORK/second" "$WORK/elsewhere"
-python3 - "$SOURCE/samples/mannequin/mannequin.gltf" "$WORK/first dir" <<'PY'
-import base64, json, sys
-gltf = json.load(open(sys.argv[1]))
-uri = gltf["buffers"][0]["uri"]
-open(sys.argv[2] + "/mannequin.bin", "wb").write(base64.b64decode(uri.split(",", 1)[1]))
-gltf["buffers"][0]["uri"] = "mannequin.bin"
-json.dump(gltf, open(sys.argv[2] + "/mannequin.gltf", "w"))
-PY
+external_buffer_mannequin "$SOURCE" "$WORK/first dir"
 echo '{"maps": {"resolution": 128}}' >"$WORK/first dir/bake.json"
 
 # --- The dependency file, from a relative invocation.
@@ -47,5 +36,4 @@ if (cd "$WORK" && "$BAKE" "first dir/mannequin.gltf" -o bad.drape --config bad.j
   --depfile bad.d 2>/dev/null); then fail "a bad config baked"; fi
 if [ -e "$WORK/bad.d" ] || [ -e "$WORK/bad.drape" ]; then fail "a failed bake left a depfile or asset"; else pass; fi
 
-echo "pipeline_cli_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish pipeline_cli_test

@@ -8,25 +8,14 @@
 # Usage: pipeline_sample_test.sh CMAKE BUILD_DIR SOURCE_DIR SHARED_DIR
 set -u
 CMAKE=$1 BUILD=$2 SOURCE=$3 SHARED=$4
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
-failures=0 passed=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-pass() { passed=$((passed + 1)); }
+. "$(dirname "$0")/cli_test_lib.sh"
 command -v ninja >/dev/null || { echo "FAIL: ninja is not installed (scripts/setup.sh installs ninja-build)"; exit 1; }
 
 "$CMAKE" --install "$BUILD" --prefix "$WORK/prefix" >/dev/null || { echo "FAIL: install"; exit 1; }
 
 # Two characters: the mannequin with its buffer in an external .bin, and the built-in one.
 mkdir -p "$WORK/assets/external"
-python3 - "$SOURCE/samples/mannequin/mannequin.gltf" "$WORK/assets/external" <<'PY'
-import base64, json, sys
-gltf = json.load(open(sys.argv[1]))
-uri = gltf["buffers"][0]["uri"]
-open(sys.argv[2] + "/mannequin.bin", "wb").write(base64.b64decode(uri.split(",", 1)[1]))
-gltf["buffers"][0]["uri"] = "mannequin.bin"
-json.dump(gltf, open(sys.argv[2] + "/mannequin.gltf", "w"))
-PY
+external_buffer_mannequin "$SOURCE" "$WORK/assets/external"
 cat >"$WORK/assets/CMakeLists.txt" <<CM
 cmake_minimum_required(VERSION 3.22)
 project(asset_build NONE)
@@ -67,5 +56,4 @@ if (cd "$WORK/sample" && ctest --output-on-failure >"$WORK/golden.log" 2>&1); th
   fail "samples/pipeline's golden test failed: $(tail -8 "$WORK/golden.log")"
 fi
 
-echo "pipeline_sample_test: $passed passed, $failures failed"
-[ "$failures" -eq 0 ]
+finish pipeline_sample_test

@@ -248,49 +248,6 @@ void AddJointSpheres(const CharacterAsset& asset, Builder* b) {
   }
 }
 
-// One channel's keys of every joint: times (strictly increasing: frames whose time does not
-// advance past the previous one's are left out), translations, rotations and scales.
-void AddClip(const ClipData& clip, uint32_t joint_count, Builder* b) {
-  std::vector<float> times;
-  std::vector<uint32_t> frames;
-  for (uint32_t f = 0; f < clip.frame_count; ++f) {
-    const float t = std::min(static_cast<float>(f) / clip.sample_rate, clip.duration);
-    if (times.empty() || t > times.back()) times.push_back(t), frames.push_back(f);
-  }
-  const int input_view = b->View(times.data(), times.size() * sizeof(float), 0);
-  const int input = b->Accessor(input_view, TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(),
-                                TINYGLTF_TYPE_SCALAR, {times.front()}, {times.back()});
-  tinygltf::Animation animation;
-  animation.name = clip.name;
-  for (uint32_t j = 0; j < joint_count; ++j) {
-    std::vector<float> translation, rotation, scale;
-    for (const uint32_t f : frames) {
-      const Transform& k = clip.keys[static_cast<size_t>(f) * joint_count + j];
-      const Quat q = Normalize(k.rotation);
-      translation.insert(translation.end(), {k.translation.x, k.translation.y, k.translation.z});
-      rotation.insert(rotation.end(), {q.x, q.y, q.z, q.w});
-      scale.insert(scale.end(), {k.scale.x, k.scale.y, k.scale.z});
-    }
-    for (const auto& [path, values, type] :
-         {std::tuple{"translation", &translation, TINYGLTF_TYPE_VEC3},
-          std::tuple{"rotation", &rotation, TINYGLTF_TYPE_VEC4},
-          std::tuple{"scale", &scale, TINYGLTF_TYPE_VEC3}}) {
-      const int view = b->View(values->data(), values->size() * sizeof(float), 0);
-      tinygltf::AnimationSampler sampler;
-      sampler.input = input;
-      sampler.output = b->Accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), type);
-      sampler.interpolation = "LINEAR";
-      animation.samplers.push_back(sampler);
-      tinygltf::AnimationChannel channel;
-      channel.sampler = static_cast<int>(animation.samplers.size()) - 1;
-      channel.target_node = static_cast<int>(j);
-      channel.target_path = path;
-      animation.channels.push_back(channel);
-    }
-  }
-  b->model.animations.push_back(animation);
-}
-
 // The skeleton, skin and skinned body; returns the body's node.
 int AddCharacter(const CharacterAsset& asset, Builder* b) {
   AddSkeleton(asset.skeleton, b);
@@ -372,6 +329,13 @@ std::vector<Transform> LocalPoses(const SkeletonData& skeleton,
   return local;
 }
 
+// Key times (seconds, strictly increasing) with their bounds.
+int TimeAccessor(const std::vector<float>& times, Builder* b) {
+  const int view = b->View(times.data(), times.size() * sizeof(float), 0);
+  return b->Accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_SCALAR,
+                     {times.front()}, {times.back()});
+}
+
 tinygltf::AnimationSampler Sampler(int input, int output, const char* interpolation) {
   tinygltf::AnimationSampler sampler;
   sampler.input = input;
@@ -406,6 +370,27 @@ void AddPoseChannels(const std::vector<Transform>& local, uint32_t joints, int i
       animation->channels.push_back(channel);
     }
   }
+}
+
+// A clip as an animation of the joints' local transforms. Key times strictly increase: frames
+// whose time does not advance past the previous one's are left out.
+void AddClip(const ClipData& clip, uint32_t joint_count, Builder* b) {
+  std::vector<float> times;
+  std::vector<Transform> local;
+  for (uint32_t f = 0; f < clip.frame_count; ++f) {
+    const float t = std::min(static_cast<float>(f) / clip.sample_rate, clip.duration);
+    if (!times.empty() && !(t > times.back())) continue;
+    times.push_back(t);
+    for (uint32_t j = 0; j < joint_count; ++j) {
+      Transform k = clip.keys[static_cast<size_t>(f) * joint_count + j];
+      k.rotation = Normalize(k.rotation);
+      local.push_back(k);
+    }
+  }
+  tinygltf::Animation animation;
+  animation.name = clip.name;
+  AddPoseChannels(local, joint_count, TimeAccessor(times, b), &animation, b);
+  b->model.animations.push_back(animation);
 }
 
 // A garment: frame 0 as the mesh, frame k as morph target k - 1, and weights that switch to
@@ -474,9 +459,7 @@ Status WriteSimulationGltf(const CharacterAsset& asset, const SimulationRecordin
   const int body = AddCharacter(asset, &b);
   std::vector<float> times(frames);
   for (size_t f = 0; f < frames; ++f) times[f] = static_cast<float>(f) * recording.frame_seconds;
-  const int input_view = b.View(times.data(), times.size() * sizeof(float), 0);
-  const int input = b.Accessor(input_view, TINYGLTF_COMPONENT_TYPE_FLOAT, frames,
-                               TINYGLTF_TYPE_SCALAR, {times.front()}, {times.back()});
+  const int input = TimeAccessor(times, &b);
   tinygltf::Animation animation;
   animation.name = "simulation";
   AddPoseChannels(LocalPoses(asset.skeleton, recording.skinning), joints, input, &animation, &b);
