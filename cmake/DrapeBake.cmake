@@ -2,14 +2,17 @@
 # includes it when the install has drape-bake):
 #
 #   drape_add_bake(TARGET hero INPUT hero.fbx OUTPUT hero.drape
-#                  [CONFIG bake.json] [SCENE scene.json] [REPORT hero.json] [PREVIEW dir] [STRICT])
+#                  [CONFIG bake.json] [SCENE scene.json] [REPORT hero.json] [PREVIEW dir]
+#                  [GLTF hero.glb] [STRICT])
 #
 # adds a target `hero` (built by default) whose one command bakes INPUT into OUTPUT. drape-bake
 # writes a dependency file (--depfile) naming every file it read (the model, its external
 # buffers, materials and textures, the config, the scene and its garment meshes), so Ninja and
 # Make re-bake exactly when one of them, or drape-bake itself, changes. Relative INPUT, CONFIG
 # and SCENE resolve against the calling CMakeLists.txt's directory; relative OUTPUT, REPORT and
-# PREVIEW against its build directory. STRICT fails the bake on any warning.
+# PREVIEW and GLTF against its build directory. GLTF also writes the asset as glTF 2.0 (the
+# skinned body with every collider on its joint, to look at). STRICT fails the bake on any
+# warning.
 #
 # DRAPE_BAKE_EXECUTABLE names the drape-bake to run (set by the package).
 include_guard(GLOBAL)
@@ -27,8 +30,8 @@ macro(_drape_check_arguments function)
 endmacro()
 
 function(drape_add_bake)
-  cmake_parse_arguments(PARSE_ARGV 0 ARG "STRICT" "TARGET;INPUT;OUTPUT;CONFIG;SCENE;REPORT;PREVIEW"
-                        "")
+  cmake_parse_arguments(PARSE_ARGV 0 ARG "STRICT"
+                        "TARGET;INPUT;OUTPUT;CONFIG;SCENE;REPORT;PREVIEW;GLTF" "")
   _drape_check_arguments(drape_add_bake TARGET INPUT OUTPUT)
   if(NOT DRAPE_BAKE_EXECUTABLE OR (NOT TARGET "${DRAPE_BAKE_EXECUTABLE}"
                                    AND NOT EXISTS "${DRAPE_BAKE_EXECUTABLE}"))
@@ -59,6 +62,11 @@ function(drape_add_bake)
     get_filename_component(report "${ARG_REPORT}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
     list(APPEND arguments --report "${report}")
     list(APPEND outputs "${report}")
+  endif()
+  if(ARG_GLTF)
+    get_filename_component(gltf "${ARG_GLTF}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_BINARY_DIR}")
+    list(APPEND arguments --gltf "${gltf}")
+    list(APPEND outputs "${gltf}")
   endif()
   if(ARG_PREVIEW)
     get_filename_component(preview "${ARG_PREVIEW}" ABSOLUTE BASE_DIR

@@ -3,11 +3,11 @@
 #  - a project baking two characters builds, then has no work to do;
 #  - touching the external buffer of one (a file only its dependency file names) plans exactly
 #    that character's bake;
-#  - samples/pipeline (the sample a studio copies) configures, builds and passes its golden test
-#    (drape-diff) against the install.
-# Usage: pipeline_sample_test.sh CMAKE BUILD_DIR SOURCE_DIR SHARED_DIR
+#  - samples/pipeline (the sample a studio copies) configures, builds, exports glTF views the
+#    Khronos validator passes, and passes its golden test (drape-diff) against the install.
+# Usage: pipeline_sample_test.sh CMAKE BUILD_DIR SOURCE_DIR SHARED_DIR NODE_DIR
 set -u
-CMAKE=$1 BUILD=$2 SOURCE=$3 SHARED=$4
+CMAKE=$1 BUILD=$2 SOURCE=$3 SHARED=$4 NODE_DIR=$5
 . "$(dirname "$0")/cli_test_lib.sh"
 command -v ninja >/dev/null || { echo "FAIL: ninja is not installed (scripts/setup.sh installs ninja-build)"; exit 1; }
 
@@ -50,6 +50,13 @@ if "$CMAKE" -S "$SOURCE/samples/pipeline" -B "$WORK/sample" -G Ninja -DCMAKE_PRE
   pass
 else
   fail "samples/pipeline did not build: $(tail -5 "$WORK/sample.log" 2>/dev/null)"
+fi
+# Its glTF views pass the Khronos validator (when scripts/setup.sh installed it).
+if [ -f "$NODE_DIR/node_modules/gltf-validator/package.json" ]; then
+  NODE_PATH="$NODE_DIR/node_modules" node "$SOURCE/tests/tools/validate_gltf.js" "$WORK"/sample/views/*.glb \
+    >"$WORK/views.txt" 2>&1 && pass || fail "the sample's glTF views: $(cat "$WORK/views.txt")"
+else
+  fail "the glTF validator is not installed in $NODE_DIR (scripts/setup.sh installs it)"
 fi
 # Its golden test, through the installed drape-diff.
 if (cd "$WORK/sample" && ctest --output-on-failure >"$WORK/golden.log" 2>&1); then pass; else

@@ -2,7 +2,7 @@
 // w), block k in the low 128 bits and block k + 1 in the high ones; only the differences b - a
 // are transposed to x / y / z lanes (in-lane shuffles: one set for eight springs) and each end
 // moves by its row times its lane's scale broadcast in-lane. Per x, y and z lane the operations
-// of cloth_solver.cpp's CorrectBlock, in its order (no FMA: the project builds with
+// of spring_kernels.cpp's CorrectBlock, in its order (no FMA: the project builds with
 // -ffp-contract=off and the target below has none), so the same bits; the w lanes, which nothing
 // reads, become w + (w_b - w_a) s.
 //
