@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -22,6 +23,7 @@
 #include "drape/bake/bake_pipeline.h"
 #include "drape/bake/gltf_export.h"
 #include "drape/formats/asset_file.h"
+#include "tasks/passive_waits.h"
 
 namespace {
 
@@ -59,6 +61,7 @@ std::string DepfileRule(const std::string& output, std::vector<std::string> inpu
 }  // namespace
 
 int main(int argc, char** argv) {
+  drape::detail::PreferPassiveOpenMpWaits(argv);  // tasks/passive_waits.h: why
   CLI::App app{
       "drape-bake: turns a rigged character (glTF, FBX, COLLADA, .X ...) into a .drape asset"};
   std::string input, output, config_path, scene_path, report_path, preview_dir, depfile_path;
@@ -150,6 +153,8 @@ int main(int argc, char** argv) {
   if (drape::Status s = drape::EncodeAsset(result.asset, &bytes); !s.ok())
     return Fail(input + ": " + s.message());
   result.report["output"] = output;
+  const char* wait_policy = std::getenv("OMP_WAIT_POLICY");  // how the bake's threads waited
+  result.report["openmp_wait_policy"] = wait_policy != nullptr ? wait_policy : "";
   result.report["output_bytes"] = bytes.size();
   result.report["timings"]["total_ms"] =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -16,6 +16,7 @@
 #include "body_map/body_map_collider_access.h"
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
+#include "tasks/passive_waits.h"
 
 namespace {
 
@@ -386,6 +387,7 @@ void Print(const Report& r, const std::string& a, const std::string& b, bool as_
 }  // namespace
 
 int main(int argc, char** argv) {
+  drape::detail::PreferPassiveOpenMpWaits(argv);  // tasks/passive_waits.h: why
   CLI::App app{"drape-diff: compares two .drape assets by meaning (golden files)"};
   std::string path_a, path_b, tolerance_path;
   bool as_json = false;

@@ -16,6 +16,7 @@
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
+#include "tasks/passive_waits.h"
 
 namespace {
 
@@ -250,6 +251,7 @@ void PrintText(const drape::CharacterAsset& a, const Placement& place, const std
 }  // namespace
 
 int main(int argc, char** argv) {
+  drape::detail::PreferPassiveOpenMpWaits(argv);  // tasks/passive_waits.h: why
   std::string path;
   bool json = false, dump = false;
   for (int i = 1; i < argc; ++i) {

@@ -32,6 +32,7 @@
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
+#include "tasks/passive_waits.h"
 
 namespace {
 
@@ -202,6 +203,7 @@ drape::ContactQuery Answer(const Segment& s, const Query& query) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  drape::detail::PreferPassiveOpenMpWaits(argv);  // tasks/passive_waits.h: why
   std::string path, clip_name, points_path, segments_path, method = "all", mesh_path;
   std::string matrices_path, write_matrices_path;
   float time = 0.f;

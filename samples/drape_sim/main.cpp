@@ -13,8 +13,10 @@
 
 #include "drape/bake/scene.h"
 #include "run_scene.h"
+#include "tasks/passive_waits.h"
 
 int main(int argc, char** argv) {
+  drape::detail::PreferPassiveOpenMpWaits(argv);  // tasks/passive_waits.h: why
   CLI::App app{
       "drape-sim: bakes a scene's character if needed, simulates its garments and "
       "writes pictures and figures"};

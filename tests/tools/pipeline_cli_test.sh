@@ -30,6 +30,14 @@ if cmp -s "$WORK/out.drape" "$WORK/elsewhere/copy.drape"; then pass; else
   fail "the copied inputs baked from elsewhere gave different bytes"
 fi
 
+# --- OpenMP's threads wait passively unless the caller chose (the bake report says how).
+(cd "$WORK" && env -u OMP_WAIT_POLICY "$BAKE" "first dir/mannequin.gltf" -o w.drape \
+  --config "first dir/bake.json" --report w.json 2>/dev/null)
+check python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['openmp_wait_policy'] == 'passive'" "$WORK/w.json"
+(cd "$WORK" && OMP_WAIT_POLICY=active "$BAKE" "first dir/mannequin.gltf" -o w.drape \
+  --config "first dir/bake.json" --report w.json 2>/dev/null)
+check python3 -c "import json,sys; assert json.load(open(sys.argv[1]))['openmp_wait_policy'] == 'active'" "$WORK/w.json"
+
 # --- A failing bake writes no depfile.
 echo 'not json' >"$WORK/bad.json"
 if (cd "$WORK" && "$BAKE" "first dir/mannequin.gltf" -o bad.drape --config bad.json \
