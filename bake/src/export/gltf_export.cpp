@@ -16,6 +16,7 @@
 
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/math.h"
+#include "import/import_transforms.h"
 
 namespace drape::bake {
 namespace {
@@ -273,57 +274,23 @@ Status Write(const CharacterAsset& asset, const std::vector<int>& extra_roots,
   return WriteFileAtomically(path, out.str());
 }
 
-// A matrix as translation, rotation and scale (columns' lengths; a mirror goes into the x scale).
-Transform Decompose(const Mat34& m) {
-  Transform t;
-  t.translation = {m.m[3], m.m[7], m.m[11]};
-  Float3 c[3];
-  float s[3];
-  for (int k = 0; k < 3; ++k) {
-    c[k] = {m.m[k], m.m[4 + k], m.m[8 + k]};
-    s[k] = Length(c[k]);
-    c[k] = s[k] > 0.f ? c[k] * (1.f / s[k]) : Float3{};
-  }
-  if (Dot(Cross(c[0], c[1]), c[2]) < 0.f) s[0] = -s[0], c[0] = c[0] * -1.f;
-  t.scale = {s[0], s[1], s[2]};
-  // Rotation matrix (columns c) to a quaternion (Shepperd's method).
-  const double r00 = c[0].x, r11 = c[1].y, r22 = c[2].z, trace = r00 + r11 + r22;
-  double x, y, z, w;
-  if (trace > 0.0) {
-    const double q = 2.0 * std::sqrt(1.0 + trace);
-    w = 0.25 * q, x = (c[1].z - c[2].y) / q, y = (c[2].x - c[0].z) / q, z = (c[0].y - c[1].x) / q;
-  } else if (r00 > r11 && r00 > r22) {
-    const double q = 2.0 * std::sqrt(1.0 + r00 - r11 - r22);
-    w = (c[1].z - c[2].y) / q, x = 0.25 * q, y = (c[1].x + c[0].y) / q, z = (c[2].x + c[0].z) / q;
-  } else if (r11 > r22) {
-    const double q = 2.0 * std::sqrt(1.0 + r11 - r00 - r22);
-    w = (c[2].x - c[0].z) / q, x = (c[1].x + c[0].y) / q, y = 0.25 * q, z = (c[2].y + c[1].z) / q;
-  } else {
-    const double q = 2.0 * std::sqrt(1.0 + r22 - r00 - r11);
-    w = (c[0].y - c[1].x) / q, x = (c[2].x + c[0].z) / q, y = (c[2].y + c[1].z) / q, z = 0.25 * q;
-  }
-  t.rotation = Normalize(Quat{static_cast<float>(x), static_cast<float>(y), static_cast<float>(z),
-                              static_cast<float>(w)});
-  return t;
-}
-
-// Per frame, each joint's local transform from the skinning matrices: world = skinning *
-// inverse(inverse bind), local = inverse(parent world) * world.
+// Per frame, each joint's local transform from the skinning matrices, in double: world =
+// skinning * inverse(inverse bind), local = inverse(parent world) * world, decomposed as the
+// import decomposes (import/import_transforms.h).
 std::vector<Transform> LocalPoses(const SkeletonData& skeleton,
                                   const std::vector<std::vector<Mat34>>& skinning) {
   const uint32_t joints = skeleton.joint_count();
-  std::vector<Mat34> bind_world(joints);
-  for (uint32_t j = 0; j < joints; ++j) InverseAffine(skeleton.inverse_bind[j], &bind_world[j]);
-  std::vector<Transform> local;
-  std::vector<Mat34> world(joints);
-  for (const std::vector<Mat34>& frame : skinning) {
+  std::vector<detail::Mat4> bind_world(joints), world(joints);
+  for (uint32_t j = 0; j < joints; ++j)
+    bind_world[j] = detail::ToEigen(skeleton.inverse_bind[j]).inverse();
+  std::vector<Transform> local(skinning.size() * joints);
+  for (size_t f = 0; f < skinning.size(); ++f) {
     for (uint32_t j = 0; j < joints; ++j) {
-      world[j] = Multiply(frame[j], bind_world[j]);
-      Mat34 parent_inverse;
+      world[j] = detail::ToEigen(skinning[f][j]) * bind_world[j];
       const int32_t p = skeleton.parents[j];
-      if (p < 0 || !InverseAffine(world[static_cast<size_t>(p)], &parent_inverse))
-        parent_inverse = Mat34{};
-      local.push_back(Decompose(Multiply(parent_inverse, world[j])));
+      const detail::Mat4 relative =
+          p < 0 ? world[j] : detail::Mat4(world[static_cast<size_t>(p)].inverse() * world[j]);
+      detail::Decompose(relative, &local[f * joints + j]);
     }
   }
   return local;

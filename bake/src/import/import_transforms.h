@@ -19,6 +19,14 @@ inline Mat4 ToEigen(const aiMatrix4x4& m) {
   return r;
 }
 
+// The asset's 3x4 (rows), with (0, 0, 0, 1) below.
+inline Mat4 ToEigen(const Mat34& m) {
+  Mat4 r = Mat4::Identity();
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 4; ++col) r(row, col) = m.m[4 * row + col];
+  return r;
+}
+
 // The top three rows, rounded to float.
 inline Mat34 ToMat34(const Mat4& m) {
   Mat34 r;
