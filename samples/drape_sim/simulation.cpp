@@ -13,7 +13,7 @@
 
 #include "drape/runtime/math.h"
 #include "drape/runtime/skinning.h"
-#include "drape/runtime/task_system.h"
+#include "tasks/parallel_for.h"
 
 namespace drape::sim {
 namespace {
@@ -362,51 +362,42 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
   if (has_hull_set_) (void)hulls_.SelectSubstep(1.f, 1.f);
   const HullColliderSet* hulls = has_hull_set_ ? &hulls_ : nullptr;
   // The queries are const and thread-safe; they run in chunks of 1024 particles on the
-  // runtime's task system, each chunk's figures in its own slot, combined in chunk order.
+  // runtime's task system (tasks/parallel_for.h), each chunk's figures in its own slot, combined
+  // in chunk order.
   struct ChunkFigures {
     uint32_t inside = 0;
     float deepest = 0.f;
     bool finite = true;
   };
-  struct Job {
-    const ClothState* state;
-    const HullColliderSet* hulls;
-    const BodyMapCollider* body_map;
-    std::vector<ChunkFigures> chunks;
-  };
-  constexpr size_t kChunk = 1024;
-  const TaskFunction measure_chunk = [](void* context, uint32_t chunk) {
-    Job& job = *static_cast<Job*>(context);
-    const ClothState& state = *job.state;
-    const size_t end = std::min(state.positions.size(), (size_t{chunk} + 1) * kChunk);
-    ChunkFigures& figures = job.chunks[chunk];
-    for (size_t i = size_t{chunk} * kChunk; i < end; ++i) {
-      const Float3 p = state.positions[i];
-      if (!Finite(p) || !Finite(state.velocities[i])) {
-        figures.finite = false;
-        continue;
-      }
-      float depth = -1.f;  // < 0: outside every collider
-      if (job.hulls != nullptr) {
-        const ContactQuery q = job.hulls->Query(p, p);
-        if (q.inside_end) depth = std::max(depth, q.depth);
-      }
-      if (job.body_map != nullptr) {
-        const ContactQuery q = job.body_map->Query(p, p);
-        if (q.inside_end) depth = std::max(depth, q.depth);
-      }
-      if (depth < 0.f) continue;
-      ++figures.inside;
-      figures.deepest = std::max(figures.deepest, depth);
-    }
-  };
+  constexpr int64_t kChunk = 1024;
+  std::vector<ChunkFigures> chunks;
   for (const auto& g : garments_) {
-    Job job{&g->state, hulls, body_map, {}};
-    job.chunks.resize((g->state.positions.size() + kChunk - 1) / kChunk);
-    const auto count = static_cast<uint32_t>(job.chunks.size());
-    if (count == 1) measure_chunk(&job, 0);
-    if (count > 1) GetTaskSystem().ParallelFor(count, measure_chunk, &job);
-    for (const ChunkFigures& figures : job.chunks) {
+    const ClothState& state = g->state;
+    const auto n = static_cast<int64_t>(state.positions.size());
+    chunks.assign(static_cast<size_t>((n + kChunk - 1) / kChunk), ChunkFigures{});
+    detail::ParallelRanges(n, kChunk, [&](int64_t begin, int64_t end) {
+      ChunkFigures& figures = chunks[static_cast<size_t>(begin / kChunk)];
+      for (int64_t i = begin; i < end; ++i) {
+        const Float3 p = state.positions[static_cast<size_t>(i)];
+        if (!Finite(p) || !Finite(state.velocities[static_cast<size_t>(i)])) {
+          figures.finite = false;
+          continue;
+        }
+        float depth = -1.f;  // < 0: outside every collider
+        if (hulls != nullptr) {
+          const ContactQuery q = hulls->Query(p, p);
+          if (q.inside_end) depth = std::max(depth, q.depth);
+        }
+        if (body_map != nullptr) {
+          const ContactQuery q = body_map->Query(p, p);
+          if (q.inside_end) depth = std::max(depth, q.depth);
+        }
+        if (depth < 0.f) continue;
+        ++figures.inside;
+        figures.deepest = std::max(figures.deepest, depth);
+      }
+    });
+    for (const ChunkFigures& figures : chunks) {
       stats->inside_particles += figures.inside;
       stats->max_penetration = std::max(stats->max_penetration, figures.deepest);
       stats->finite = stats->finite && figures.finite;
