@@ -34,6 +34,11 @@ int main(int argc, char** argv) {
                  "also write the run as one animated glTF 2.0 (.glb: binary): the body skinned by "
                  "the played poses, each garment's frames as morph targets (at most 300 frames, "
                  "evenly spread over the written ones)");
+  app.add_option("--export-garments", options.garments_dir,
+                 "also write each garment as DIR/<garment>.glb: the character and the garment "
+                 "skinned to its skeleton (its skin weights, or its carrier joint's), with max "
+                 "distance (0 where a joint holds it) and backstop as _MAX_DISTANCE / _BACKSTOP, "
+                 "to paint and read back as a `gltf` garment");
   app.add_flag("--dump-scene-reference", dump_reference,
                "print the scenes reference (docs/SCENES.md) as markdown and exit");
   try {

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -14,6 +15,7 @@
 #include "asset_cache.h"
 #include "drape/bake/gltf_export.h"
 #include "drape/bake/scene.h"
+#include "drape/runtime/math.h"
 #include "drape/runtime/task_system.h"
 #include "frame_renderer.h"
 #include "renderer.h"
@@ -100,6 +102,47 @@ Status WriteReach(const std::string& dir, const bake::Scene& scene, const bake::
 }
 
 // The frames before frame 0 (not output), with the body held at the start pose.
+// --export-garments: each garment bound to the skeleton, by its skin or rigidly by the joint
+// that carries each particle (the root joint for particles nothing carries).
+Status ExportGarments(const bake::Scene& scene, const CharacterAsset& asset,
+                      const SceneSimulation& sim, const std::string& dir) {
+  std::error_code error;
+  fs::create_directories(dir, error);
+  if (error) return Status(StatusCode::kIoError, dir + ": cannot create: " + error.message());
+  for (size_t g = 0; g < sim.garment_count(); ++g) {
+    const bake::ResolvedGarment& resolved = sim.resolved_garment(g);
+    const ClothDescription& d = resolved.description;
+    bake::GarmentExport out;
+    out.name = scene.garments[g].name;
+    out.triangles = d.triangles;
+    if (!d.skin.empty()) {
+      out.bind_positions = d.skin_bind_positions;
+      out.skin = d.skin;
+      out.max_distance = d.max_distance;
+      out.backstop = d.backstop;
+      // Held by a joint: the skin holds it in the file (max distance 0 follows the skin).
+      for (const ClothAttachment& a : d.attachments) out.max_distance[a.particle] = 0.f;
+    } else {
+      for (size_t i = 0; i < d.positions.size(); ++i) {
+        const int32_t joint = std::max(resolved.carrier_joint[i], 0);
+        ClothSkinWeights w;
+        w.joints[0] = static_cast<uint32_t>(joint);
+        w.weights[0] = 1.f;
+        out.skin.push_back(w);
+        out.bind_positions.push_back(
+            TransformPoint(resolved.frame_to_bind[static_cast<size_t>(joint)], d.positions[i]));
+      }
+      // Free but for the held particles, which follow their joint (max distance 0).
+      out.max_distance.assign(d.positions.size(), std::numeric_limits<float>::infinity());
+      for (const ClothAttachment& a : d.attachments) out.max_distance[a.particle] = 0.f;
+    }
+    const std::string path = (fs::path(dir) / (out.name + ".glb")).string();
+    if (Status s = bake::WriteGarmentGltf(asset, out, path); !s.ok()) return s;
+    std::printf("drape-sim: wrote %s\n", path.c_str());
+  }
+  return Status::Ok();
+}
+
 Status Settle(SceneSimulation* sim, json* settle) {
   double settle_ms = 0.0;
   FrameStats stats;
@@ -251,6 +294,10 @@ int RunScene(const RunOptions& options) {
 
   SceneSimulation sim;
   if (Status s = sim.Init(scene, asset, clip); !s.ok()) return Fail(s.message());
+  if (!options.garments_dir.empty()) {
+    if (Status s = ExportGarments(scene, asset, sim, options.garments_dir); !s.ok())
+      return Fail(s.message());
+  }
   std::printf(
       "drape-sim: simulating %u frames (+%lld settle) of %u particles, dt %.4f s, %u substeps, "
       "%s\n",

@@ -12,6 +12,8 @@ struct RunOptions {
   int64_t frames = 0;     // > 0: overrides the scene's frame count
   int threads = 0;        // > 0: worker threads (the step's task pool, the bake's OpenMP team)
   std::string gltf_path;  // non-empty: also write the run as an animated glTF (.glb: binary)
+  // Non-empty: also write each garment bound to the skeleton as <dir>/<garment>.glb.
+  std::string garments_dir;
 };
 
 // Returns the process exit code: 0, or 1 after printing one line naming the input and the reason.

@@ -99,6 +99,8 @@ class SceneSimulation {
     return garments_[g]->start_positions;
   }
   uint32_t particle_count() const;
+  // Garment g as the scene resolved it (mesh, holds, skin, max distance and backstop).
+  const bake::ResolvedGarment& resolved_garment(size_t g) const { return garments_[g]->resolved; }
   // The colliders in use, posed for the last frame (null when no hull or sphere is used).
   const HullColliderSet* hulls() const { return has_hull_set_ ? &hulls_ : nullptr; }
   // Indices into asset.hulls / asset.joint_spheres of the hull set's colliders.

@@ -2,7 +2,8 @@
 # drape-bake --gltf: the asset as glTF 2.0 (.gltf and .glb) that the Khronos validator passes with
 # no error, holding the skeleton, the skinned body, a node per hull and joint sphere on its joint
 # and the clips; an export that cannot be written fails the bake and leaves nothing.
-# With drape-sim (SIM): a short run of the demo scene as an animated glTF passes too.
+# With drape-sim (SIM): a short run of the demo scene as an animated glTF passes too, and so does
+# its skirt exported bound to the skeleton (--export-garments), which reads back as a glTF garment.
 # Usage: gltf_export_test.sh BAKE SOURCE SHARED NODE_DIR [SIM]
 set -u
 BAKE=$1 SOURCE=$2 SHARED=$3 NODE_DIR=$4 SIM=${5:-}
@@ -29,9 +30,30 @@ else
 fi
 if [ -n "$SIM" ]; then
   "$SIM" "$SOURCE/samples/scenes/demo.json" -o "$WORK/sim" --frames 24 --threads 1 \
-    --gltf "$WORK/sim/demo.glb" >/dev/null 2>&1
+    --gltf "$WORK/sim/demo.glb" --export-garments "$WORK/garments" >/dev/null 2>&1
   check [ $? -eq 0 ]
-  files+=("$WORK/sim/demo.glb")
+  files+=("$WORK/sim/demo.glb" "$WORK/garments/skirt.glb")
+  # The exported skirt read back as a scene's glTF garment (its waist held by max distance 0),
+  # and the sample that reads a painted one.
+  check python3 - "$SOURCE/samples/scenes/demo.json" "$WORK/garments/skirt.glb" "$WORK/back.json" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+scene["character"] = sys.argv[1].rsplit("/", 2)[0] + "/mannequin/mannequin.gltf"
+scene["garments"] = [{"name": "skirt", "type": "gltf",
+                      "shape": {"file": sys.argv[2], "mesh": "skirt"},
+                      "skin": {"paint": "attribute"}}]
+json.dump(scene, open(sys.argv[3], "w"))
+PY
+  "$SIM" "$WORK/back.json" -o "$WORK/back" --frames 4 --threads 1 >"$WORK/back.txt" 2>&1
+  check [ $? -eq 0 ]
+  check grep -q "0 NaN frames" "$WORK/back.txt"
+  "$SIM" "$SOURCE/samples/scenes/mannequin_gltf_dress.json" -o "$WORK/dress" --frames 4 \
+    --threads 1 >/dev/null 2>&1
+  check [ $? -eq 0 ]
+  sed 's|"file": "[^"]*"|"file": "no_such_garment.glb"|' "$WORK/back.json" >"$WORK/missing.json"
+  "$SIM" "$WORK/missing.json" -o "$WORK/missing" --frames 1 >/dev/null 2>"$WORK/missing.err"
+  check [ $? -ne 0 ]
+  check grep -q "/garments/0/shape/file.*no_such_garment.glb" "$WORK/missing.err"
 fi
 NODE_PATH="$NODE_DIR/node_modules" node "$(dirname "$0")/validate_gltf.js" "${files[@]}" >"$WORK/validator.txt" 2>&1
 check [ $? -eq 0 ]

@@ -146,6 +146,19 @@ int AddSkin(const SkeletonData& skeleton, Builder* b) {
   return static_cast<int>(b->model.skins.size()) - 1;
 }
 
+// JOINTS_0 and WEIGHTS_0 from four (joint, weight) pairs per vertex.
+std::map<std::string, int> SkinAttributes(const std::vector<uint16_t>& joints,
+                                          const std::vector<float>& weights, Builder* b) {
+  const size_t n = joints.size() / 4;
+  const int joints_view = b->View(joints.data(), joints.size() * 2, TINYGLTF_TARGET_ARRAY_BUFFER);
+  const int weights_view =
+      b->View(weights.data(), weights.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
+  return {{"JOINTS_0",
+           b->Accessor(joints_view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, n, TINYGLTF_TYPE_VEC4)},
+          {"WEIGHTS_0",
+           b->Accessor(weights_view, TINYGLTF_COMPONENT_TYPE_FLOAT, n, TINYGLTF_TYPE_VEC4)}};
+}
+
 // The bind mesh skinned by its four strongest influences (renormalised).
 int AddBody(const MeshData& mesh, int skin, Builder* b) {
   const size_t n = mesh.positions.size();
@@ -167,16 +180,9 @@ int AddBody(const MeshData& mesh, int skin, Builder* b) {
       joints[4 * v + k] = influences[k].second;
     }
   }
-  const int joints_view = b->View(joints.data(), joints.size() * 2, TINYGLTF_TARGET_ARRAY_BUFFER);
-  const int weights_view =
-      b->View(weights.data(), weights.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER);
-  const int mesh_index = b->Mesh(
-      "body", b->Positions(mesh.positions), b->Indices(mesh.triangles),
-      b->Material("body", 0.7, 0.7, 0.7, 1.0),
-      {{"JOINTS_0",
-        b->Accessor(joints_view, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, n, TINYGLTF_TYPE_VEC4)},
-       {"WEIGHTS_0",
-        b->Accessor(weights_view, TINYGLTF_COMPONENT_TYPE_FLOAT, n, TINYGLTF_TYPE_VEC4)}});
+  const int mesh_index =
+      b->Mesh("body", b->Positions(mesh.positions), b->Indices(mesh.triangles),
+              b->Material("body", 0.7, 0.7, 0.7, 1.0), SkinAttributes(joints, weights, b));
   tinygltf::Node node;
   node.name = "body";
   node.mesh = mesh_index;
@@ -392,7 +398,64 @@ int AddGarment(const SimulationRecording::Garment& g, int input, tinygltf::Anima
   return index;
 }
 
+// A per-vertex distance as a SCALAR float attribute: metres, -1 for unlimited (+inf is not a
+// value a glTF accessor may hold).
+int DistanceAttribute(const std::vector<float>& metres, Builder* b) {
+  std::vector<float> values(metres.size());
+  for (size_t i = 0; i < metres.size(); ++i)
+    values[i] = std::isfinite(metres[i]) ? metres[i] : -1.f;
+  const int view =
+      b->View(values.data(), values.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+  return b->Accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, values.size(), TINYGLTF_TYPE_SCALAR);
+}
+
+int AddBoundGarment(const GarmentExport& g, int skin, Builder* b) {
+  const size_t n = g.bind_positions.size();
+  std::vector<uint16_t> joints(4 * n, 0);
+  std::vector<float> weights(4 * n, 0.f);
+  for (size_t v = 0; v < n; ++v) {
+    for (int k = 0; k < 4; ++k) {
+      joints[4 * v + k] = static_cast<uint16_t>(g.skin[v].joints[k]);
+      weights[4 * v + k] = g.skin[v].weights[k];
+    }
+  }
+  std::map<std::string, int> attributes = SkinAttributes(joints, weights, b);
+  if (g.max_distance.size() == n)
+    attributes[detail::kGltfMaxDistanceAttribute] = DistanceAttribute(g.max_distance, b);
+  if (g.backstop.size() == n)
+    attributes[detail::kGltfBackstopAttribute] = DistanceAttribute(g.backstop, b);
+  tinygltf::Node node;
+  node.name = g.name;
+  node.mesh = b->Mesh(g.name, b->Positions(g.bind_positions), b->Indices(g.triangles),
+                      b->Material("garment", 0.85, 0.35, 0.25, 1.0), std::move(attributes));
+  node.skin = skin;
+  return b->Node(node, -1);
+}
+
 }  // namespace
+
+Status WriteGarmentGltf(const CharacterAsset& asset, const GarmentExport& garment,
+                        const std::string& path) {
+  const auto invalid = [&](const std::string& why) {
+    return Status(StatusCode::kInvalidArgument, path + ": " + why);
+  };
+  const uint32_t joints = asset.skeleton.joint_count();
+  const size_t n = garment.bind_positions.size();
+  if (joints == 0) return invalid("the asset has no skeleton to bind the garment to");
+  if (joints > 65535) return invalid("more joints than JOINTS_0 can name");
+  if (garment.skin.size() != n || n == 0 || garment.triangles.size() % 3 != 0)
+    return invalid("garment " + garment.name + ": no particles, or skin and positions differ");
+  for (const ClothSkinWeights& w : garment.skin)
+    for (int k = 0; k < 4; ++k)
+      if (w.weights[k] > 0.f && w.joints[k] >= joints)
+        return invalid("garment " + garment.name + ": a skin weight names no joint");
+  for (const uint32_t t : garment.triangles)
+    if (t >= n) return invalid("garment " + garment.name + ": a triangle names no particle");
+  Builder b;
+  const int body = AddCharacter(asset, &b);
+  const int node = AddBoundGarment(garment, b.model.nodes[static_cast<size_t>(body)].skin, &b);
+  return Write(asset, {body, node}, path, &b);
+}
 
 Status WriteAssetGltf(const CharacterAsset& asset, const std::string& path) {
   if (asset.skeleton.joint_count() == 0)

@@ -32,10 +32,15 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
   const SceneGarment& g = scene.garments[index];
   if (!g.skinned) return Status::Ok();
   const std::string at = scene.source + ": " + g.path + "/skin";
-  if (body.triangles.empty() && g.skin_weights_file.empty())
+  const bool file_skin = !garment->file_skin.empty();
+  if (file_skin && !g.skin_weights_file.empty())
+    return Invalid(at + "/weights_file: the glTF garment has its own skin; remove one of them");
+  if (body.triangles.empty() && g.skin_weights_file.empty() && !file_skin)
     return Invalid(at + ": the asset has no body mesh to take weights from");
   ClothDescription& d = garment->description;
-  if (!g.skin_weights_file.empty()) {  // authored weights, as they are
+  if (file_skin) {  // a skinned glTF's own weights, as they are
+    d.skin = garment->file_skin;
+  } else if (!g.skin_weights_file.empty()) {  // authored weights, as they are
     if (Status s =
             detail::ReadSkinWeightsFile(g.skin_weights_file, skeleton, d.positions.size(), &d.skin);
         !s.ok())
@@ -50,7 +55,8 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
   }
   const size_t n = d.positions.size();
   d.skin_bind_positions.assign(n, Float3{});
-  for (size_t i = 0; i < n; ++i) {
+  if (file_skin) d.skin_bind_positions = garment->file_bind_positions;  // exact, from the file
+  for (size_t i = 0; i < n && !file_skin; ++i) {
     const ClothSkinWeights& w = d.skin[i];
     for (int k = 0; k < 4; ++k)
       if (w.weights[k] > 0.f)
@@ -59,11 +65,18 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
   }
   d.max_distance.assign(n, g.max_distance);
   d.backstop.assign(n, g.backstop);
-  if (g.max_distance_channel >= 0) {  // painted: the channel scales max_distance
+  if (g.max_distance_channel == SceneGarment::kPaintAttribute) {  // painted in metres
+    if (garment->painted_max_distance.size() != n)
+      return Invalid(at +
+                     "/paint: the glTF garment has no _MAX_DISTANCE attribute on every "
+                     "primitive");
+    d.max_distance = garment->painted_max_distance;
+    if (garment->painted_backstop.size() == n) d.backstop = garment->painted_backstop;
+  } else if (g.max_distance_channel >= 0) {  // painted: the channel scales max_distance
     if (garment->colors.size() != n)
       return Invalid(at +
                      "/paint: the garment has no vertex colours (an OBJ whose every `v` line has "
-                     "r g b after x y z)");
+                     "r g b after x y z, a glTF whose every primitive has COLOR_0)");
     for (size_t i = 0; i < n; ++i) {
       const Float3 c = garment->colors[i];
       const float channel =

@@ -157,6 +157,29 @@ const JsonSchema<SceneGarment>& ObjSchema() {
   return schema;
 }
 
+const JsonSchema<SceneGarment>& GltfSchema() {
+  static const JsonSchema<SceneGarment> schema =
+      JsonSchema<SceneGarment>(
+          "A glTF 2.0 file's mesh (.gltf or .glb; its triangle primitives merged, vertices split "
+          "at UV or normal seams welded). A mesh with a skin is bound to the character's "
+          "skeleton by joint name: each vertex keeps its JOINTS_0 / WEIGHTS_0 (four joints) and "
+          "is placed by the file's inverse bind matrices, which must agree with the "
+          "character's skeleton at bind; `scale`, `offset` and the garment's `anchor` then do not "
+          "apply. Optional SCALAR float attributes `_MAX_DISTANCE` and `_BACKSTOP` paint the "
+          "skin's distances per vertex (file units; negative: unlimited; see `/skin/paint`).")
+          .FilePath("file", "a glTF file, relative to the scene",
+                    [](SceneGarment& g) -> std::string& { return g.obj_file; })
+          .Required()
+          .String("mesh", StringRule::kNonEmpty, "the mesh node's (or mesh's) name",
+                  [](SceneGarment& g) -> std::string& { return g.gltf_mesh; })
+          .Default("the file's only mesh")
+          .Float("scale", "", OpenBelow(0, 1e6), "metres per file unit (a mesh without a skin)",
+                 [](SceneGarment& g) -> float& { return g.obj_scale; })
+          .Vector("offset", "m", kMaxCoordinate, "added after scaling (a mesh without a skin)",
+                  [](SceneGarment& g) -> Float3& { return g.obj_offset; });
+  return schema;
+}
+
 const JsonSchema<SceneGarment>& ShapeSchema(GarmentType type) {
   switch (type) {
     case GarmentType::kSheet:
@@ -167,6 +190,8 @@ const JsonSchema<SceneGarment>& ShapeSchema(GarmentType type) {
       return CapeSchema();
     case GarmentType::kSleeve:
       return SleeveSchema();
+    case GarmentType::kGltf:
+      return GltfSchema();
     case GarmentType::kObj:
       break;
   }
@@ -222,16 +247,18 @@ Status ReadDistanceOrNone(const JsonAt& at, float* out) {
   return ReadFloat(at, Closed(0, 100), out);
 }
 
-// "r", "g", "b" (a colour channel: 0, 1, 2) or "none" (-1).
+// "r", "g", "b" (a colour channel: 0, 1, 2), "attribute" or "none" (-1).
 Status ReadPaintChannel(const JsonAt& at, SceneGarment& g) {
   const std::string value = at.value().is_string() ? at.value().get<std::string>() : "";
   const size_t channel = std::string("rgb").find(value);
   if (value == "none") {
     g.max_distance_channel = -1;
+  } else if (value == "attribute") {
+    g.max_distance_channel = SceneGarment::kPaintAttribute;
   } else if (value.size() == 1 && channel != std::string::npos) {
     g.max_distance_channel = static_cast<int32_t>(channel);
   } else {
-    return at.Error("must be one of \"r\", \"g\", \"b\", \"none\"");
+    return at.Error("must be one of \"r\", \"g\", \"b\", \"attribute\", \"none\"");
   }
   return Status::Ok();
 }
@@ -240,7 +267,8 @@ const JsonSchema<SceneGarment>& SkinSchema() {
   static const JsonSchema<SceneGarment> schema =
       JsonSchema<SceneGarment>(
           "A skinned garment: each particle takes the skin weights of the closest point of the "
-          "character's body (or the `weights_file`'s) and follows the skinned surface within "
+          "character's body (or the `weights_file`'s, or a skinned glTF garment's own) and follows "
+          "the skinned surface within "
           "`max_distance`, never more "
           "than `backstop` behind it (along the garment's normal: the side its triangles' "
           "counter-clockwise winding faces, which should face away from the body). Attached "
@@ -259,11 +287,17 @@ const JsonSchema<SceneGarment>& SkinSchema() {
                               "how far behind its skinned position a particle may go"),
               [](const JsonAt& at, SceneGarment& g) { return ReadDistanceOrNone(at, &g.backstop); })
           .Default("none")
-          .Custom(CustomFieldInfo("paint", "`\"r\"` \\| `\"g\"` \\| `\"b\"` \\| `\"none\"`",
-                                  "one of \"r\", \"g\", \"b\", \"none\"",
-                                  "an OBJ garment's vertex colour channel (`v x y z r g b`) that "
-                                  "scales `max_distance` per particle (painted black: the particle "
-                                  "follows the skin exactly)"),
+          .Custom(CustomFieldInfo("paint",
+                                  "`\"r\"` \\| `\"g\"` \\| `\"b\"` \\| `\"attribute\"` \\| "
+                                  "`\"none\"`",
+                                  "one of \"r\", \"g\", \"b\", \"attribute\", \"none\"",
+                                  "a vertex colour channel of the garment file (an OBJ's `v x y z "
+                                  "r g b`, a glTF's COLOR_0) that scales `max_distance` per "
+                                  "particle (painted black: the particle follows the skin "
+                                  "exactly); `attribute`: a glTF garment's `_MAX_DISTANCE` "
+                                  "attribute gives it per vertex, and `_BACKSTOP`, when present, "
+                                  "the backstop (file units scaled to metres; negative: "
+                                  "unlimited)"),
                   [](const JsonAt& at, SceneGarment& g) { return ReadPaintChannel(at, g); })
           .Default("none")
           .FilePath("weights_file",
@@ -398,8 +432,10 @@ const JsonSchema<SceneGarment>& GarmentSchema() {
                               {"skirt", GarmentType::kSkirt},
                               {"cape", GarmentType::kCape},
                               {"sleeve", GarmentType::kSleeve},
-                              {"obj", GarmentType::kObj}},
-                             "a procedural generator (drape/runtime/garments.h) or an OBJ file",
+                              {"obj", GarmentType::kObj},
+                              {"gltf", GarmentType::kGltf}},
+                             "a procedural generator (drape/runtime/garments.h), an OBJ file or "
+                             "a glTF file (skinned to the character's skeleton, or not)",
                              [](SceneGarment& g) -> GarmentType& { return g.type; })
           .Required()
           .String("name", StringRule::kNonEmpty, "unique; names the OBJ files",
@@ -424,7 +460,7 @@ const JsonSchema<SceneGarment>& GarmentSchema() {
               [](const SceneGarment& defaults, const std::string& path, std::string* out) {
                 for (GarmentType type :
                      {GarmentType::kSheet, GarmentType::kSkirt, GarmentType::kCape,
-                      GarmentType::kSleeve, GarmentType::kObj}) {
+                      GarmentType::kSleeve, GarmentType::kObj, GarmentType::kGltf}) {
                   ShapeSchema(type).WriteSections(
                       defaults, path, "`" + path + "` of `" + ToString(type) + "`", out);
                 }
@@ -484,6 +520,13 @@ const JsonSchema<SceneGarment>& GarmentSchema() {
           .Rule([](const JsonAt& at, SceneGarment& g) {
             if (g.type == GarmentType::kObj && at.Find("shape") == nullptr)
               return at.Member("shape").Error("missing (an OBJ garment needs {\"file\": ...})");
+            if (g.type == GarmentType::kGltf && at.Find("shape") == nullptr)
+              return at.Member("shape").Error("missing (a glTF garment needs {\"file\": ...})");
+            if (g.max_distance_channel == SceneGarment::kPaintAttribute &&
+                g.type != GarmentType::kGltf)
+              return at.Member("skin").Member("paint").Error(
+                  "\"attribute\" paints from a glTF garment's _MAX_DISTANCE attribute; this "
+                  "garment is not glTF");
             return Status::Ok();
           });
   return schema;

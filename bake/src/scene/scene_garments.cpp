@@ -11,6 +11,7 @@
 #include "drape/bake/scene.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
+#include "scene/gltf_garment.h"
 #include "scene/obj_reader.h"
 #include "scene/scene_messages.h"
 
@@ -55,6 +56,7 @@ std::vector<uint32_t> RingParticles(const SceneGarment& g, const GarmentMesh& me
       if (name == "end") row(g.sleeve.segments, g.sleeve.rings);
       break;
     case GarmentType::kObj:
+    case GarmentType::kGltf:
       break;
   }
   return out;
@@ -66,12 +68,14 @@ Status SelectParticles(const Scene& scene, const SceneGarment& g, const GarmentM
   const std::string prefix = scene.source + ": ";
   if (!sel.ring.empty()) {
     std::vector<std::string> names = GarmentRingNames(g.type);
-    if (g.type != GarmentType::kObj) names.insert(names.begin(), "held");
+    if (!names.empty()) names.insert(names.begin(), "held");
     if (std::find(names.begin(), names.end(), sel.ring) == names.end()) {
       return Invalid(prefix + sel.path + "/ring: " +
-                     (names.empty() ? "an OBJ garment has no rings; use vertices or box"
-                                    : "no ring named " + Quote(sel.ring) + " on a " +
-                                          ToString(g.type) + " (rings: " + JoinNames(names) + ")"));
+                     (names.empty()
+                          ? std::string(g.type == GarmentType::kObj ? "an OBJ" : "a glTF") +
+                                " garment has no rings; use vertices or box"
+                          : "no ring named " + Quote(sel.ring) + " on a " + ToString(g.type) +
+                                " (rings: " + JoinNames(names) + ")"));
     }
     *out = RingParticles(g, mesh, sel.ring);
   } else if (!sel.vertices.empty()) {
@@ -171,8 +175,80 @@ Status MakeGarmentMesh(const std::string& prefix, const SceneGarment& g, Float3 
       for (Float3& p : mesh->positions) p = p * g.obj_scale + g.obj_offset + anchor;
       break;
     }
+    case GarmentType::kGltf:  // MakeGltfGarment
+      return Invalid(prefix + g.path + ": internal: a glTF garment has its own path");
   }
   if (!made.ok()) return Invalid(prefix + g.path + "/shape: " + made.message());
+  if (mesh->positions.size() > kMaxGarmentParticles) {
+    return Invalid(prefix + g.path + "/shape: " + std::to_string(mesh->positions.size()) +
+                   " particles: at most " + std::to_string(kMaxGarmentParticles));
+  }
+  return Status::Ok();
+}
+
+// Metres a skinned glTF garment's joints may disagree on a vertex's bind position: 1 % of the
+// skeleton's extent at bind, at least 5 mm (float rounding of a file written at another origin).
+float GltfBindTolerance(const SkeletonData& skeleton) {
+  Float3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
+  for (const Mat34& inverse_bind : skeleton.inverse_bind) {
+    Mat34 bind_world;
+    if (!InverseAffine(inverse_bind, &bind_world)) continue;
+    const Float3 p = Translation(bind_world);
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  const float extent = lo.x <= hi.x ? Length(hi - lo) : 0.f;
+  return std::max(0.005f, 0.01f * extent);
+}
+
+// Painted distances in metres: file units times `scale`, negative values unlimited.
+std::vector<float> PaintedMetres(const std::vector<float>& painted, float scale) {
+  std::vector<float> out(painted.size());
+  for (size_t i = 0; i < painted.size(); ++i) out[i] = painted[i] < 0.f ? kInf : painted[i] * scale;
+  return out;
+}
+
+// A glTF garment's mesh in the garment's frame. With a skin: bound to the skeleton by joint name
+// (its weights and bind positions kept in `out` for the skin stage), placed at bind or skinned
+// to the rest pose; without: placed like an OBJ (scale, offset, anchor).
+Status MakeGltfGarment(const std::string& prefix, const SceneGarment& g,
+                       const SkeletonData& skeleton, const SkeletonPose& rest, Float3 anchor,
+                       GarmentMesh* mesh, ResolvedGarment* out) {
+  const std::string where = prefix + g.path + "/shape/file";
+  GltfGarmentMesh file;
+  DRAPE_RETURN_IF_ERROR(ReadGltfGarment(g.obj_file, where, g.gltf_mesh, &file));
+  mesh->triangles = file.triangles;
+  out->colors = file.colors;
+  float scale = g.obj_scale;
+  if (file.joint_names.empty()) {
+    mesh->positions = file.positions;
+    for (Float3& p : mesh->positions) p = p * g.obj_scale + g.obj_offset + anchor;
+  } else {
+    if (g.obj_scale != 1.f || Length(g.obj_offset) != 0.f || !g.anchor.empty())
+      return Invalid(prefix + g.path +
+                     ": a skinned glTF garment is placed by its skin; remove `shape/scale`, "
+                     "`shape/offset` and `anchor`");
+    GltfGarmentBinding binding;
+    DRAPE_RETURN_IF_ERROR(
+        BindGltfGarment(file, skeleton, GltfBindTolerance(skeleton), where, &binding));
+    scale = binding.scale;
+    mesh->positions = binding.bind_positions;
+    if (g.frame == GarmentFrame::kRest) {  // linear blend skinning to the rest pose
+      for (size_t i = 0; i < mesh->positions.size(); ++i) {
+        Float3 p;
+        for (int k = 0; k < 4; ++k)
+          if (binding.skin[i].weights[k] > 0.f)
+            p += TransformPoint(rest.skinning()[binding.skin[i].joints[k]],
+                                binding.bind_positions[i]) *
+                 binding.skin[i].weights[k];
+        mesh->positions[i] = p;
+      }
+    }
+    out->file_skin = std::move(binding.skin);
+    out->file_bind_positions = std::move(binding.bind_positions);
+  }
+  out->painted_max_distance = PaintedMetres(file.max_distance, scale);
+  out->painted_backstop = PaintedMetres(file.backstop, scale);
   if (mesh->positions.size() > kMaxGarmentParticles) {
     return Invalid(prefix + g.path + "/shape: " + std::to_string(mesh->positions.size()) +
                    " particles: at most " + std::to_string(kMaxGarmentParticles));
@@ -259,6 +335,8 @@ const char* ToString(GarmentType type) {
       return "sleeve";
     case GarmentType::kObj:
       return "obj";
+    case GarmentType::kGltf:
+      return "gltf";
   }
   return "?";
 }
@@ -274,6 +352,7 @@ std::vector<std::string> GarmentRingNames(GarmentType type) {
     case GarmentType::kSleeve:
       return {"start", "end"};
     case GarmentType::kObj:
+    case GarmentType::kGltf:
       return {};
   }
   return {};
@@ -300,7 +379,11 @@ Status ResolveGarment(const Scene& scene, size_t index, const SkeletonData& skel
     anchor = joint_positions[static_cast<size_t>(j)];
   }
   GarmentMesh mesh;
-  DRAPE_RETURN_IF_ERROR(MakeGarmentMesh(prefix, g, anchor, &mesh, &out->colors));
+  if (g.type == GarmentType::kGltf) {
+    DRAPE_RETURN_IF_ERROR(MakeGltfGarment(prefix, g, skeleton, rest, anchor, &mesh, out));
+  } else {
+    DRAPE_RETURN_IF_ERROR(MakeGarmentMesh(prefix, g, anchor, &mesh, &out->colors));
+  }
 
   ClothDescription& d = out->description;
   d.positions = mesh.positions;

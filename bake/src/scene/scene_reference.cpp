@@ -27,6 +27,10 @@ constexpr SampleScene kSampleScenes[] = {
     {"cesium_man_skinned_dress.json", "`CesiumMan.glb` (shared assets)",
      "a dress skinned to the body (weights from the closest body point, smoothed; max distance "
      "and backstop) whose hem nears a floor the scene adds (`/collision/shapes`)"},
+    {"mannequin_gltf_dress.json", "the built-in mannequin",
+     "a dress read from a skinned glTF bound to the skeleton by joint name "
+     "(`garments/mannequin_dress.glb`, written by `drape-sim --export-garments`), its max distance "
+     "painted per vertex (`_MAX_DISTANCE`: 0 at the waist to 8 cm at the hem), on a floor"},
     {"robot_expressive_cape.json", "`RobotExpressive.glb` (shared assets)",
      "a cape on a rigid-part robot (4.4 m tall as authored), 18 hulls"},
     {"animated_human_skirt.json", "`Animated_Human.fbx` (shared assets)",

@@ -9,6 +9,7 @@
 
 #include "drape/formats/character_asset.h"
 #include "drape/formats/status.h"
+#include "drape/runtime/cloth.h"
 
 namespace drape::bake {
 
@@ -34,5 +35,28 @@ struct SimulationRecording {
 // targets switched frame by frame (STEP weights), all in one animation "simulation".
 Status WriteSimulationGltf(const CharacterAsset& asset, const SimulationRecording& recording,
                            const std::string& path);
+
+// A garment bound to the character's skeleton, to paint or refit in a DCC tool and read back as
+// a scene's `gltf` garment (docs/SCENES.md).
+struct GarmentExport {
+  std::string name;                    // the garment's node and mesh
+  std::vector<Float3> bind_positions;  // metres, the bind-pose asset frame
+  std::vector<uint32_t> triangles;     // 3 particle indices each
+  std::vector<ClothSkinWeights> skin;  // per particle, the skeleton's joints
+  // Per particle, metres (+inf: unlimited), written as _MAX_DISTANCE / _BACKSTOP attributes with
+  // -1 for unlimited; empty: not written.
+  std::vector<float> max_distance, backstop;
+};
+
+// The character (skeleton at rest, its skin, the skinned body, named "body") and the garment as a
+// mesh skinned by the same skin (JOINTS_0 / WEIGHTS_0) at its bind positions. Binary (.glb) when
+// `path` ends in .glb. Written atomically: nothing on error.
+Status WriteGarmentGltf(const CharacterAsset& asset, const GarmentExport& garment,
+                        const std::string& path);
+
+namespace detail {
+inline constexpr const char* kGltfMaxDistanceAttribute = "_MAX_DISTANCE";
+inline constexpr const char* kGltfBackstopAttribute = "_BACKSTOP";
+}  // namespace detail
 
 }  // namespace drape::bake

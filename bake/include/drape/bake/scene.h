@@ -30,7 +30,7 @@
 
 namespace drape::bake {
 
-enum class GarmentType : uint8_t { kSheet, kSkirt, kCape, kSleeve, kObj };
+enum class GarmentType : uint8_t { kSheet, kSkirt, kCape, kSleeve, kObj, kGltf };
 const char* ToString(GarmentType type);
 
 // The frame a garment's positions are written in. kBind: the bind-pose asset frame (attachments
@@ -64,9 +64,10 @@ struct SceneGarment {
   SkirtShape skirt;
   CapeShape cape;
   SleeveShape sleeve;
-  std::string obj_file;   // kObj: resolved against the scene's directory
-  float obj_scale = 1.f;  // kObj: metres per OBJ unit, > 0
-  Float3 obj_offset;      // kObj: metres, added after scaling
+  std::string obj_file;   // kObj, kGltf: resolved against the scene's directory
+  float obj_scale = 1.f;  // kObj, kGltf without a skin: metres per file unit, > 0
+  Float3 obj_offset;      // kObj, kGltf without a skin: metres, added after scaling
+  std::string gltf_mesh;  // kGltf: the mesh node's (or mesh's) name; empty: the file's only one
   // Cloth material (drape/runtime/cloth.h). Masses come from area and density, rescaled to
   // total_mass when it is > 0.
   float density = 0.15f;   // kg/m^2
@@ -84,8 +85,10 @@ struct SceneGarment {
   float backstop = std::numeric_limits<float>::infinity();  // metres, >= 0
   uint32_t skin_smoothing = 20;   // passes averaging the weights with the mesh neighbours
   std::string skin_weights_file;  // authored weights, one line per vertex (empty: from the body)
-  // -1: max_distance everywhere; 0, 1, 2: an OBJ's vertex colour channel (r, g, b) in [0, 1]
-  // scales it per particle (painted 0: the particle follows the skin exactly).
+  // -1: max_distance everywhere; 0, 1, 2: the garment file's vertex colour channel (r, g, b) in
+  // [0, 1] scales it per particle (painted 0: the particle follows the skin exactly);
+  // kPaintAttribute: a glTF garment's _MAX_DISTANCE (and _BACKSTOP) attributes give them.
+  static constexpr int32_t kPaintAttribute = 3;
   int32_t max_distance_channel = -1;
   float tether_stretch = 0.02f;                   // long-range tethers' allowed stretch, >= 0
   std::array<float, 3> color{0.8f, 0.25f, 0.3f};  // linear RGB in [0, 1], for pictures
@@ -251,7 +254,14 @@ struct ResolvedGarment {
   // inverse rest skinning matrix for kRest). A particle p carried by joint j sits at
   // S[j] * frame_to_bind[j] * p at a pose with skinning matrices S.
   std::vector<Mat34> frame_to_bind;
-  std::vector<Float3> colors;  // an OBJ garment's vertex colours (empty: none)
+  std::vector<Float3> colors;  // an OBJ or glTF garment's vertex colours (empty: none)
+  // A glTF garment with a skin: its weights by the skeleton's joints and bind positions (the
+  // skin stage takes them instead of the body's), empty otherwise; and for any glTF garment the
+  // distances painted in its _MAX_DISTANCE / _BACKSTOP attributes in metres (+inf: unlimited),
+  // empty when the file has none.
+  std::vector<ClothSkinWeights> file_skin;
+  std::vector<Float3> file_bind_positions;
+  std::vector<float> painted_max_distance, painted_backstop;
 };
 
 // Builds garment `index` of the scene against the skeleton: generator or OBJ mesh, anchoring,
