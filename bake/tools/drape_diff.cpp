@@ -36,6 +36,7 @@ struct Tolerance {
   double vertex_mm = 0.01;         // hull vertices
   double obb_mm = 0.01;            // OBB centre and half extents
   double sphere_mm = 0.01;         // joint sphere centres and radii
+  double capsule_mm = 0.01;        // capsule end centres and radii
   double map_depth_p99_mm = 0.01;  // body-map texel depths over texels both cover
   double map_depth_max_mm = 0.1;
   double map_coverage_pct = 0.0;  // texels covered by one map and not the other, of either's
@@ -199,6 +200,30 @@ void CompareHull(const std::string& name, const drape::HullColliderData& a,
   r->Measured(name + ": OBB or frame changed", obb, r->tolerance.obb_mm, "mm");
 }
 
+void CompareCapsules(const CharacterAsset& a, const CharacterAsset& b, Report* r) {
+  if (a.capsules.size() != b.capsules.size()) {
+    r->Structural("capsules: " + std::to_string(a.capsules.size()) + " vs " +
+                  std::to_string(b.capsules.size()));
+    return;
+  }
+  double mm = 0.0;
+  int changed = 0;
+  for (size_t c = 0; c < a.capsules.size(); ++c) {
+    const drape::CapsuleColliderData &ca = a.capsules[c], &cb = b.capsules[c];
+    if (ca.joint != cb.joint) {
+      r->Structural("capsule " + std::to_string(c) + ": another joint");
+      continue;
+    }
+    const double d = std::max({Mm(Distance(ca.from, cb.from)), Mm(Distance(ca.to, cb.to)),
+                               Mm(std::abs(double{ca.radius_from} - cb.radius_from)),
+                               Mm(std::abs(double{ca.radius_to} - cb.radius_to))});
+    changed += d > 0.0 ? 1 : 0;
+    mm = std::max(mm, d);
+  }
+  r->Measured("capsules: " + std::to_string(changed) + " moved or resized", mm,
+              r->tolerance.capsule_mm, "mm");
+}
+
 void CompareColliders(const CharacterAsset& a, const CharacterAsset& b, Report* r) {
   if (a.hulls.size() != b.hulls.size()) {
     r->Structural("hulls: " + std::to_string(a.hulls.size()) + " vs " +
@@ -227,6 +252,7 @@ void CompareColliders(const CharacterAsset& a, const CharacterAsset& b, Report* 
   }
   r->Measured("joint spheres: " + std::to_string(changed) + " moved or resized", mm,
               r->tolerance.sphere_mm, "mm");
+  CompareCapsules(a, b, r);
 }
 
 // The slab of the texel of `c` whose square holds (x, y) (asset frame, metres); false outside
@@ -333,6 +359,7 @@ bool ReadTolerance(const std::string& path, Tolerance* t, std::string* error) {
                                                     {"vertex_mm", &t->vertex_mm},
                                                     {"obb_mm", &t->obb_mm},
                                                     {"sphere_mm", &t->sphere_mm},
+                                                    {"capsule_mm", &t->capsule_mm},
                                                     {"map_depth_p99_mm", &t->map_depth_p99_mm},
                                                     {"map_depth_max_mm", &t->map_depth_max_mm},
                                                     {"map_coverage_pct", &t->map_coverage_pct}};
@@ -395,7 +422,8 @@ int main(int argc, char** argv) {
   app.add_option("B", path_b, "the asset to check")->required();
   app.add_option("--tolerance", tolerance_path,
                  "JSON limits: joint_mm joint_deg clip_mm mesh_mm plane_deg plane_mm vertex_mm "
-                 "obb_mm sphere_mm map_depth_p99_mm map_depth_max_mm map_coverage_pct");
+                 "obb_mm sphere_mm capsule_mm map_depth_p99_mm map_depth_max_mm "
+                 "map_coverage_pct");
   app.add_flag("--json", as_json, "print the findings as JSON");
   try {
     app.parse(argc, argv);

@@ -460,6 +460,15 @@ Status ValidateAsset(const CharacterAsset& asset) {
         c.Finite(s.center, at + ".center"))
       c.Require(std::isfinite(s.radius) && s.radius > 0.f, at + ".radius", "is not > 0");
   }
+  for (size_t i = 0; i < asset.capsules.size() && !c.failed(); ++i) {
+    const CapsuleColliderData& k = asset.capsules[i];
+    const std::string at = "capsules[" + std::to_string(i) + "]";
+    if (c.Index(k.joint, static_cast<int64_t>(joints), at + ".joint") &&
+        c.Finite(k.from, at + ".from") && c.Finite(k.to, at + ".to") &&
+        c.Require(std::isfinite(k.radius_from) && k.radius_from > 0.f, at + ".radius_from",
+                  "is not > 0"))
+      c.Require(std::isfinite(k.radius_to) && k.radius_to > 0.f, at + ".radius_to", "is not > 0");
+  }
   if (c.failed()) return Status(StatusCode::kCorrupt, c.message());
   return Status::Ok();
 }

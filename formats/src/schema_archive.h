@@ -364,8 +364,16 @@ void serialize(Archive& ar, JointSphereData& s, const uint32_t version) {
 }
 
 template <class Archive>
+void serialize(Archive& ar, CapsuleColliderData& c, const uint32_t version) {
+  detail::CheckVersion(version, 1, "CapsuleColliderData");
+  ar(cereal::make_nvp("joint", c.joint), cereal::make_nvp("from", c.from),
+     cereal::make_nvp("to", c.to), cereal::make_nvp("radius_from", c.radius_from),
+     cereal::make_nvp("radius_to", c.radius_to));
+}
+
+template <class Archive>
 void serialize(Archive& ar, CharacterAsset& a, const uint32_t version) {
-  detail::CheckVersionRange(version, 1, 2, "CharacterAsset");
+  detail::CheckVersionRange(version, 1, 3, "CharacterAsset");
   ar(cereal::make_nvp("info", a.info), cereal::make_nvp("skeleton", a.skeleton));
   Array(ar, "clips", a.clips);
   ar(cereal::make_nvp("mesh", a.mesh), cereal::make_nvp("body_maps", a.body_maps));
@@ -376,11 +384,22 @@ void serialize(Archive& ar, CharacterAsset& a, const uint32_t version) {
   // so that a file of an older format with a newer field inside names that field.
   if constexpr (Archive::is_loading::value) {
     if (detail::g_format_version != 0 && detail::g_format_version < 5) {
-      throw DecodeError("CharacterAsset version 2 in a format version " +
-                        std::to_string(detail::g_format_version) + " file");
+      throw DecodeError("CharacterAsset version " + std::to_string(version) +
+                        " in a format version " + std::to_string(detail::g_format_version) +
+                        " file");
     }
   }
   ar(cereal::make_nvp("bone_maps", a.bone_maps));
+  if (version < 3) return;
+  // Version 3 (tapered capsules, at the end) from format version 6 on.
+  if constexpr (Archive::is_loading::value) {
+    if (detail::g_format_version != 0 && detail::g_format_version < 6) {
+      throw DecodeError("CharacterAsset version " + std::to_string(version) +
+                        " in a format version " + std::to_string(detail::g_format_version) +
+                        " file");
+    }
+  }
+  Array(ar, "capsules", a.capsules);
 }
 
 }  // namespace drape
@@ -397,4 +416,5 @@ CEREAL_CLASS_VERSION(drape::KirkpatrickHierarchy, 1)
 CEREAL_CLASS_VERSION(drape::MapTableData, 1)
 CEREAL_CLASS_VERSION(drape::HullColliderData, 2)
 CEREAL_CLASS_VERSION(drape::JointSphereData, 1)
-CEREAL_CLASS_VERSION(drape::CharacterAsset, 2)  // 2: bone_maps (format 5)
+CEREAL_CLASS_VERSION(drape::CapsuleColliderData, 1)
+CEREAL_CLASS_VERSION(drape::CharacterAsset, 3)  // 2: bone_maps (format 5); 3: capsules (format 6)

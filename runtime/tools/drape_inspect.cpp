@@ -13,7 +13,9 @@
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/bone_map_collider.h"
+#include "drape/runtime/capsule_colliders.h"
 #include "drape/runtime/hull_collider_set.h"
+#include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
 #include "tasks/passive_waits.h"
@@ -184,6 +186,13 @@ std::string JsonSummary(const drape::CharacterAsset& a, const Placement& place,
     o << (s ? ", " : "") << "{\"joint\": " << Quote(a.skeleton.joint_names[sphere.joint])
       << ", \"radius\": " << sphere.radius << "}";
   }
+  o << "],\n  \"capsules\": [";
+  for (size_t c = 0; c < a.capsules.size(); ++c) {
+    const auto& capsule = a.capsules[c];
+    o << (c ? ", " : "") << "{\"joint\": " << Quote(a.skeleton.joint_names[capsule.joint])
+      << ", \"radius_from\": " << capsule.radius_from << ", \"radius_to\": " << capsule.radius_to
+      << "}";
+  }
   o << "]\n}\n";
   return o.str();
 }
@@ -246,6 +255,12 @@ void PrintText(const drape::CharacterAsset& a, const Placement& place, const std
     std::printf("    %-28s radius %.1f mm\n", a.skeleton.joint_names[sphere.joint].c_str(),
                 sphere.radius * 1000.f);
   }
+  std::printf("  capsules: %zu\n", a.capsules.size());
+  for (const auto& capsule : a.capsules) {
+    std::printf("    %-28s radius %.1f -> %.1f mm, %.1f mm between the centres (bind)\n",
+                a.skeleton.joint_names[capsule.joint].c_str(), capsule.radius_from * 1000.f,
+                capsule.radius_to * 1000.f, drape::Length(capsule.to - capsule.from) * 1000.f);
+  }
 }
 
 }  // namespace
@@ -305,6 +320,13 @@ int main(int argc, char** argv) {
   drape::HullColliderSet hulls;
   if (drape::Status status =
           hulls.Build(asset.hulls, asset.joint_spheres, asset.skeleton.joint_count());
+      !status.ok()) {
+    std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
+    return 1;
+  }
+  drape::ShapeColliderSet capsules;  // the capsules at the bind pose, as the runtime adds them
+  const std::vector<drape::Mat34> bind(asset.skeleton.joint_count());
+  if (drape::Status status = drape::AddCapsuleColliders(asset.capsules, bind, bind, &capsules);
       !status.ok()) {
     std::fprintf(stderr, "drape-inspect: error: %s: %s\n", path.c_str(), status.message().c_str());
     return 1;

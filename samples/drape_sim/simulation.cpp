@@ -11,6 +11,7 @@
 #include <limits>
 #include <string>
 
+#include "drape/runtime/capsule_colliders.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/skinning.h"
 #include "tasks/parallel_for.h"
@@ -169,13 +170,14 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
     has_maps_ = true;
   }
 
-  // The engine shapes, placed from the rest pose.
+  // The engine shapes, placed from the rest pose, and the baked capsules.
   {
     SkeletonPose rest;
     if (Status s = rest.Init(asset.skeleton); !s.ok()) return s;
     rest.SetRest();
     if (Status s = scene_shapes_.Init(scene, asset.skeleton, rest.skinning()); !s.ok()) return s;
-    shapes_.Reserve(scene_shapes_.size(), 0);
+    const size_t capsules = scene.use_capsules ? asset.capsules.size() : 0;
+    shapes_.Reserve(scene_shapes_.size() + static_cast<uint32_t>(capsules), 0);
   }
 
   // Garments, placed at the start pose.
@@ -265,9 +267,14 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
                                       : 0.f;
     colliders.body_map = &maps_.At(map_time, &map_scratch_);
   }
-  if (!scene_shapes_.empty()) {
+  if (!scene_shapes_.empty() || scene_->use_capsules) {
     if (Status s = scene_shapes_.Pose(skin_start_, skin_end_, &shapes_); !s.ok())
       return Status(s.code(), scene_->source + ": " + s.message());
+    if (scene_->use_capsules) {
+      if (Status s = AddCapsuleColliders(asset_->capsules, skin_start_, skin_end_, &shapes_);
+          !s.ok())
+        return Status(s.code(), scene_->source + ": " + s.message());
+    }
     colliders.shapes = &shapes_;
   }
   ClothFrame cloth_frame;

@@ -43,7 +43,7 @@ TEST(BakeConfig, OutOfRangeAndUnknownKeysNameTheirPath) {
   s = ApplyBakeConfig({{"hull", {{"delta", 0.01}}}}, "c.json", &config);
   EXPECT_EQ(s.message(),
             "c.json: /hull: unknown key: hull is not a parameter of the top level (did you mean "
-            "hulls? known here: import | maps | bone_maps | hulls | spheres)");
+            "hulls? known here: import | maps | bone_maps | hulls | spheres | capsules)");
   s = ApplyBakeConfig({{"import", {{"no_such_key", 1}}}}, "c.json", &config);
   EXPECT_EQ(s.message(),
             "c.json: /import/no_such_key: unknown key: no_such_key is not a parameter of /import "
@@ -80,11 +80,12 @@ TEST(BakeConfig, FileBytesAreReadStrictly) {
             0u)
       << s.message();
   s = ParseBakeConfig(
-      R"({"maps": {"enabled": false}, "hulls": {"enabled": false}, "spheres": {"enabled": false}})",
+      R"({"maps": {"enabled": false}, "hulls": {"enabled": false}, "spheres": {"enabled": false},
+          "capsules": {"enabled": false}})",
       "c.json", &config);
   EXPECT_EQ(s.message(),
-            "c.json: /: maps.enabled, bone_maps.enabled, hulls.enabled and spheres.enabled are all "
-            "false: the asset would hold no collider");
+            "c.json: /: maps.enabled, bone_maps.enabled, hulls.enabled, spheres.enabled and "
+            "capsules.enabled are all false: the asset would hold no collider");
   s = ParseBakeConfig("{\"maps\": ", "c.json", &config);
   EXPECT_EQ(s.message().rfind("c.json: not valid JSON: ", 0), 0u) << s.message();
   EXPECT_EQ(config.maps.resolution, BakeConfig{}.maps.resolution);  // untouched by the failures

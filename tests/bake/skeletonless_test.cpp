@@ -63,6 +63,9 @@ TEST_P(SkeletonRemoved, ConvexPiecesFitTheBody) {
   // One region, cut: more than one hull, within the single-region budget (4 x max_pieces).
   EXPECT_GT(result.asset.hulls.size(), 1u);
   EXPECT_LE(result.asset.hulls.size(), 4u * config.hull_max_pieces);
+  // The capsules need bones: the whole body gets one, which the report measures.
+  EXPECT_EQ(result.asset.capsules.size(), 1u);
+  EXPECT_TRUE(result.report.contains("fit_capsules"));
   const nlohmann::json& fit = result.report["fit"];
   EXPECT_GE(fit["coverage"].get<double>(), 0.99);
   // One hull of the whole body bulged 104 mm on CesiumMan at rest. The pieces: 21.2 mm on the

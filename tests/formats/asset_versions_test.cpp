@@ -39,14 +39,56 @@ TEST(AssetFile, NewerAndOlderFormatVersionsAreRefusedByName) {
 TEST(AssetFile, UnknownTypeVersionIsRefusedByTypeName) {
   std::vector<uint8_t> bytes = Encode(SmallAsset());
   // Payload: 1 byte of cereal endianness, then CharacterAsset's uint32 class version.
-  ASSERT_EQ(bytes[kAssetHeaderSize + 1], 2);
-  bytes[kAssetHeaderSize + 1] = 3;
+  ASSERT_EQ(bytes[kAssetHeaderSize + 1], 3);
+  bytes[kAssetHeaderSize + 1] = 4;
   FixChecksums(bytes);
   CharacterAsset out;
   const Status s = DecodeAsset(bytes, "t.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_NE(s.message().find("unsupported version 3 of CharacterAsset"), std::string::npos)
+  EXPECT_NE(s.message().find("unsupported version 4 of CharacterAsset"), std::string::npos)
       << s.message();
+}
+
+// Sets the payload size of the header after bytes were cut off the end, and the checksums.
+void FixPayloadSize(std::vector<uint8_t>& bytes) {
+  const uint64_t payload = bytes.size() - kAssetHeaderSize;
+  for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
+  FixChecksums(bytes);
+}
+
+// Capsules arrived with format version 6 (CharacterAsset class version 3): a version 3 asset
+// under an older header is refused naming both, and the older class version reads without them.
+TEST(AssetFile, CapsulesNeedFormatVersion6) {
+  CharacterAsset small = SmallAsset();
+  small.capsules.push_back({0, {0.f, 0.1f, 0.f}, {0.f, 0.4f, 0.f}, 0.05f, 0.04f});
+  std::vector<uint8_t> bytes = Encode(small);
+  CharacterAsset out;
+  ASSERT_TRUE(DecodeAsset(bytes, "v6.drape", &out).ok());
+  ASSERT_EQ(out.capsules.size(), 1u);
+  EXPECT_EQ(out.capsules[0].radius_to, 0.04f);
+  bytes[8] = 5;
+  FixChecksums(bytes);
+  Status s = DecodeAsset(bytes, "v5.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(), "v5.drape: CharacterAsset version 3 in a format version 5 file");
+  // As format 5 wrote it: class version 2, no capsules at the end (a count and one capsule:
+  // 8 + 4 + 4 * 8 bytes, the class version of its element type included).
+  small.capsules.clear();
+  bytes = Encode(small);
+  bytes[8] = 5;
+  bytes[kAssetHeaderSize + 1] = 2;
+  bytes.resize(bytes.size() - 8);
+  FixPayloadSize(bytes);
+  s = DecodeAsset(bytes, "v5.drape", &out);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(AssetToJson(out), AssetToJson(small));
+  // A capsule the validator refuses: named by its field.
+  small.capsules.push_back({0, {0.f, 0.1f, 0.f}, {0.f, 0.4f, 0.f}, 0.05f, -1.f});
+  EXPECT_FALSE(EncodeAsset(small, &bytes).ok());
+  small.capsules[0].radius_to = 0.04f;
+  small.capsules[0].joint = 99;
+  s = EncodeAsset(small, &bytes);
+  EXPECT_NE(s.message().find("capsules[0].joint"), std::string::npos) << s.message();
 }
 
 // Bone maps arrived with format version 5 (CharacterAsset class version 2): a version 2 asset
@@ -59,11 +101,11 @@ TEST(AssetFile, BoneMapsNeedFormatVersion5) {
   CharacterAsset out;
   Status s = DecodeAsset(bytes, "v4.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_EQ(s.message(), "v4.drape: CharacterAsset version 2 in a format version 4 file");
-  // As format 4 wrote it: class version 1, no bone-map set at the end (epsilon and an empty
-  // array: 4 + 4 + 8 bytes).
+  EXPECT_EQ(s.message(), "v4.drape: CharacterAsset version 3 in a format version 4 file");
+  // As format 4 wrote it: class version 1, no bone-map set and no capsules at the end (epsilon
+  // and an empty array: 4 + 4 + 8 bytes; the capsules' empty array: 8).
   bytes[kAssetHeaderSize + 1] = 1;
-  bytes.resize(bytes.size() - 16);
+  bytes.resize(bytes.size() - 16 - 8);
   const uint64_t payload = bytes.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   FixChecksums(bytes);
@@ -165,9 +207,9 @@ TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
   bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at),
               bytes.begin() + static_cast<std::ptrdiff_t>(gap_count_at + 8));
   // As format 2 wrote it: CharacterAsset class version 1, without the bone-map set at the end
-  // (its class version, epsilon and an empty array: 16 bytes).
+  // (its class version, epsilon and an empty array: 16 bytes) and the capsules' empty array (8).
   bytes[kAssetHeaderSize + 1] = 1;
-  bytes.resize(bytes.size() - 16);
+  bytes.resize(bytes.size() - 16 - 8);
   const uint64_t payload = bytes.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   bytes[8] = 2;

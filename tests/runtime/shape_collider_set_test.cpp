@@ -1,11 +1,13 @@
 // drape::ShapeColliderSet: the engine's spheres, tapered capsules, planes, boxes and convexes.
 // Each kind: resting contact, tunnelling, sweeping by a moving shape, push-out from inside,
 // friction on a slope, the round cone's distance against a brute-force reference, hostile
-// inputs, argument validation, thread-count independence and no allocation on re-adding.
+// inputs, argument validation, thread-count independence and no allocation on re-adding. The
+// bake's capsules posed from a skeleton (AddCapsuleColliders) follow their bone.
 
 #include "rigid_poses.h"
 #include "workers.h"
 
+#include "drape/runtime/capsule_colliders.h"
 #include "drape/runtime/shape_collider_set.h"
 
 #include <gtest/gtest.h>
@@ -611,6 +613,56 @@ TEST(ShapeColliderSetTest, SecondPassResolvesAParticlePushedBackIn) {
   // One pass leaves it 2.1 cm inside the box; the second 0.8 cm (a pinch converges slowly).
   EXPECT_GT(r.x.y, -0.01f);
   EXPECT_LT(r.x.y, -0.005f);
+}
+
+// A baked capsule on joint 1 posed from the skeleton: its end spheres' centres are the bone's
+// skinning of `from` and `to` at both ends of the frame, a segment through its middle at the end
+// pose is caught and the particle ends outside; a capsule whose ends coincide is a sphere; a
+// joint without a matrix is refused naming the capsule.
+TEST(ShapeColliderSetTest, BakedCapsulesFollowTheirBone) {
+  const CapsuleColliderData capsule{1, {0.f, 0.f, 0.f}, {0.f, 0.4f, 0.f}, 0.06f, 0.04f};
+  const std::vector<Mat34> start = {Mat34{}, Pose({1.f, 0.f, 0.f}, {0.f, 0.f, 1.f}, 90.0)};
+  const std::vector<Mat34> end = {Mat34{}, Pose({1.f, 0.1f, 0.f}, {0.3f, 0.f, 1.f}, 110.0)};
+  ShapeColliderSet shapes;
+  ASSERT_TRUE(AddCapsuleColliders(std::span(&capsule, 1), start, end, &shapes).ok());
+  ASSERT_EQ(shapes.size(), 1u);
+  EXPECT_EQ(shapes.kind(0), ShapeKind::kCapsule);
+  const float half = 0.2f;
+  for (const auto& [s, skinning] : {std::pair{0.f, start[1]}, std::pair{1.f, end[1]}}) {
+    const Mat34 frame = shapes.WorldTransform(0, s);
+    EXPECT_LT(
+        Distance3(TransformPoint(frame, {-half, 0.f, 0.f}), TransformPoint(skinning, capsule.from)),
+        1e-5);
+    EXPECT_LT(
+        Distance3(TransformPoint(frame, {half, 0.f, 0.f}), TransformPoint(skinning, capsule.to)),
+        1e-5);
+  }
+  const Float3 middle = TransformPoint(end[1], {0.f, 0.2f, 0.f});
+  const Float3 across = TransformVector(end[1], {0.f, 0.f, 1.f});  // normal to the axis
+  std::vector<Float3> previous = {middle + across * 0.2f}, positions = {middle - across * 0.2f},
+                      velocities = {Float3{}};
+  std::vector<uint8_t> flags(1);
+  ResponseParams params;
+  ShapeColliderSet still;  // held at the end pose, so the particle's exit is exact
+  ASSERT_TRUE(AddCapsuleColliders(std::span(&capsule, 1), end, end, &still).ok());
+  const ContactQuery q = still.Query(middle + across * 0.2f, middle - across * 0.2f, 0.f, 1.f);
+  EXPECT_TRUE(q.contact);
+  EXPECT_NEAR(Distance3(q.point, middle), 0.05, 1e-4);  // the radius halfway: (0.06 + 0.04) / 2
+  ASSERT_TRUE(
+      still.CollideBatch(previous, positions, velocities, flags, params, 0.f, 1.f, kFrame).ok());
+  EXPECT_GE(Distance3(positions[0], middle), 0.05 - 1e-5);
+  EXPECT_LT(Distance3(positions[0], middle), 0.05 + 0.005);
+
+  CapsuleColliderData ball = capsule;
+  ball.to = ball.from;
+  float half_length = 1.f;
+  const Mat34 frame = CapsuleFrame(ball, start[1], &half_length);
+  EXPECT_EQ(half_length, 0.f);
+  EXPECT_LT(Distance3(TransformPoint(frame, {}), TransformPoint(start[1], ball.from)), 1e-6);
+  CapsuleColliderData stray = capsule;
+  stray.joint = 5;
+  const Status s = AddCapsuleColliders(std::span(&stray, 1), start, end, &shapes);
+  EXPECT_EQ(s.message(), "capsule 0: joint 5 has no skinning matrix");
 }
 
 }  // namespace

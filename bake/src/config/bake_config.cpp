@@ -217,6 +217,26 @@ const JsonSchema<BakeConfig>& SpheresSection() {
   return schema;
 }
 
+const JsonSchema<BakeConfig>& CapsulesSection() {
+  static const JsonSchema<BakeConfig> schema =
+      JsonSchema<BakeConfig>()
+          .Bool("enabled",
+                "bake a tapered capsule per bone that carries skin, fitted to the body's "
+                "cross-section (the engines' cloth colliders)",
+                [](BakeConfig& c) -> bool& { return c.capsules_enabled; })
+          .Float("radius_quantile", "", OpenBelow(0, 1),
+                 "of the surface's distances from the capsule's axis, per slab along it: the "
+                 "radius there (1 bounds the surface and bloats where the cross-section is not "
+                 "round; 0.5 is the median)",
+                 [](BakeConfig& c) -> float& { return c.capsules.radius_quantile; })
+          .Unsigned<uint32_t>("slabs", "", 1, 1000,
+                              "slabs along the axis whose radii the taper is fitted to",
+                              [](BakeConfig& c) -> uint32_t& { return c.capsules.slabs; })
+          .Float("min_radius", "m", OpenBelow(0, 1), "the smallest radius of a capsule's end",
+                 [](BakeConfig& c) -> float& { return c.capsules.min_radius; });
+  return schema;
+}
+
 }  // namespace
 
 const JsonSchema<BakeConfig>& BakeConfigSchema() {
@@ -236,12 +256,15 @@ const JsonSchema<BakeConfig>& BakeConfigSchema() {
                   [](BakeConfig& c) -> BakeConfig& { return c; })
           .Object("spheres", SpheresSection(), "paper B's joint spheres",
                   [](BakeConfig& c) -> BakeConfig& { return c; })
+          .Object("capsules", CapsulesSection(), "tapered capsules per bone",
+                  [](BakeConfig& c) -> BakeConfig& { return c; })
           .Rule([](const JsonAt& at, BakeConfig& c) {
-            if (c.maps_enabled || c.bone_maps_enabled || c.hulls_enabled || c.spheres_enabled)
+            if (c.maps_enabled || c.bone_maps_enabled || c.hulls_enabled || c.spheres_enabled ||
+                c.capsules_enabled)
               return Status::Ok();
             return at.Error(
-                "maps.enabled, bone_maps.enabled, hulls.enabled and spheres.enabled are all "
-                "false: the asset would hold no collider");
+                "maps.enabled, bone_maps.enabled, hulls.enabled, spheres.enabled and "
+                "capsules.enabled are all false: the asset would hold no collider");
           });
   return schema;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "capsule/capsule_fit.h"
 #include "drape/bake/mesh_queries.h"
 #include "drape/bake/mesh_reference.h"
 #include "drape/runtime/math.h"
@@ -14,6 +15,7 @@ namespace {
 // Seeds of the sample streams; hull h draws from kHullSeed + h.
 constexpr uint64_t kHullSeed = 0x68756C6C00000000ull;
 constexpr uint64_t kBodySeed = 0x626F647900000000ull;
+constexpr uint64_t kCapsuleSeed = 0x6361707300000000ull;
 
 // A hull at rest in the asset frame, in double. `placed` is false when its joint has no
 // skinning matrix: it then has no geometry and no samples.
@@ -31,6 +33,12 @@ struct PlacedSphere {
   bool placed = false;
   double centre[3] = {0, 0, 0};
   double radius = 0.0;
+};
+
+struct PlacedCapsule {
+  bool placed = false;
+  double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+  double radius_a = 0.0, radius_b = 0.0;
 };
 
 bool HasJoint(int32_t joint, size_t joint_count) {
@@ -92,6 +100,25 @@ PlacedSphere PlaceSphere(const JointSphereData& sphere, std::span<const Mat34> r
   return placed;
 }
 
+PlacedCapsule PlaceCapsule(const CapsuleColliderData& c, std::span<const Mat34> rest_skinning) {
+  PlacedCapsule placed;
+  if (!HasJoint(c.joint, rest_skinning.size())) return placed;
+  const Float3 a = TransformPoint(rest_skinning[c.joint], c.from);
+  const Float3 b = TransformPoint(rest_skinning[c.joint], c.to);
+  placed.placed = true;
+  placed.a[0] = a.x, placed.a[1] = a.y, placed.a[2] = a.z;
+  placed.b[0] = b.x, placed.b[1] = b.y, placed.b[2] = b.z;
+  placed.radius_a = c.radius_from, placed.radius_b = c.radius_to;
+  return placed;
+}
+
+// The placed colliders of one measure.
+struct Placed {
+  std::vector<PlacedHull> hulls;
+  std::vector<PlacedSphere> spheres;
+  std::vector<PlacedCapsule> capsules;
+};
+
 // How far p lies outside the hull, metres: 0 inside (behind every plane), else the distance to
 // its surface. Beyond `limit` the answer may be any value above `limit` (the largest plane
 // distance, a lower bound of the true one), which is all the coverage needs.
@@ -115,16 +142,20 @@ double HullOutsideDistance(const PlacedHull& hull, const double p[3], double lim
 }
 
 // Whether a point on the body is inside some collider or within its delta + tolerance of it.
-bool Covered(const double p[3], std::span<const PlacedHull> hulls,
-             std::span<const PlacedSphere> spheres, const ColliderFitOptions& options) {
+bool Covered(const double p[3], const Placed& placed, const ColliderFitOptions& options) {
+  for (const PlacedCapsule& c : placed.capsules) {
+    if (c.placed &&
+        RoundConeDistance(p, c.a, c.radius_a, c.b, c.radius_b) <= options.coverage_tolerance)
+      return true;
+  }
   const double sphere_limit = options.sphere_delta + options.coverage_tolerance;
-  for (const PlacedSphere& s : spheres) {
+  for (const PlacedSphere& s : placed.spheres) {
     if (!s.placed) continue;
     const double d[3] = {p[0] - s.centre[0], p[1] - s.centre[1], p[2] - s.centre[2]};
     if (std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) - s.radius <= sphere_limit) return true;
   }
   const double hull_limit = options.hull_delta + options.coverage_tolerance;
-  for (const PlacedHull& h : hulls) {
+  for (const PlacedHull& h : placed.hulls) {
     if (!h.placed) continue;
     bool near_box = true;  // within hull_limit of the bounding box on every axis
     for (int k = 0; k < 3; ++k) {
@@ -157,9 +188,8 @@ struct BloatSamples {
   }
 };
 
-BloatSamples CollectBloatSamples(std::span<const PlacedHull> hulls,
-                                 std::span<const PlacedSphere> spheres,
-                                 const ColliderFitOptions& options) {
+BloatSamples CollectBloatSamples(const Placed& placed, const ColliderFitOptions& options) {
+  const std::vector<PlacedHull>& hulls = placed.hulls;
   BloatSamples s;
   for (size_t h = 0; h < hulls.size(); ++h) {
     s.begin.push_back(s.count());
@@ -172,12 +202,25 @@ BloatSamples CollectBloatSamples(std::span<const PlacedHull> hulls,
     s.points.insert(s.points.end(), hulls[h].vertices.begin(), hulls[h].vertices.end());
     s.Close(options.hull_delta);
   }
-  for (const PlacedSphere& sphere : spheres) {
+  for (const PlacedSphere& sphere : placed.spheres) {
     s.begin.push_back(s.count());
     if (sphere.placed)
       SampleSphere(sphere.centre, sphere.radius, options.sphere_samples, &s.points);
     s.area_end.push_back(s.count());
     s.Close(options.sphere_delta);
+  }
+  for (size_t c = 0; c < placed.capsules.size(); ++c) {
+    const PlacedCapsule& capsule = placed.capsules[c];
+    s.begin.push_back(s.count());
+    if (capsule.placed) {
+      std::vector<double> vertices;
+      std::vector<uint32_t> triangles;
+      RoundConeMesh(capsule.a, capsule.radius_a, capsule.b, capsule.radius_b, 32, 8, &vertices,
+                    &triangles);
+      SampleTriangles(vertices, triangles, options.capsule_samples, kCapsuleSeed + c, &s.points);
+    }
+    s.area_end.push_back(s.count());
+    s.Close(0.0);
   }
   return s;
 }
@@ -206,14 +249,14 @@ ColliderBloat Summarise(const std::vector<double>& bloat, size_t begin, size_t a
 }
 
 // The fraction of area-weighted body samples that some collider covers.
-double Coverage(std::span<const double> body_points, std::span<const PlacedHull> hulls,
-                std::span<const PlacedSphere> spheres, const ColliderFitOptions& options) {
+double Coverage(std::span<const double> body_points, const Placed& placed,
+                const ColliderFitOptions& options) {
   const size_t count = body_points.size() / 3;
   if (count == 0) return 0.0;
   std::vector<uint8_t> covered(count);
 #pragma omp parallel for schedule(dynamic, 256)
   for (int64_t i = 0; i < static_cast<int64_t>(count); ++i) {
-    covered[i] = Covered(&body_points[3 * static_cast<size_t>(i)], hulls, spheres, options);
+    covered[i] = Covered(&body_points[3 * static_cast<size_t>(i)], placed, options);
   }
   size_t inside = 0;
   for (uint8_t c : covered) inside += c;
@@ -244,24 +287,29 @@ ColliderFit MeasureColliderFit(std::span<const Float3> rest_positions,
                                std::span<const uint32_t> triangles,
                                std::span<const HullColliderData> hulls,
                                std::span<const JointSphereData> spheres,
+                               std::span<const CapsuleColliderData> capsules,
                                std::span<const Mat34> rest_skinning,
                                const ColliderFitOptions& options) {
-  std::vector<PlacedHull> placed_hulls;
-  for (const HullColliderData& hull : hulls) placed_hulls.push_back(PlaceHull(hull, rest_skinning));
-  std::vector<PlacedSphere> placed_spheres;
-  for (const JointSphereData& s : spheres) placed_spheres.push_back(PlaceSphere(s, rest_skinning));
+  Placed placed;
+  for (const HullColliderData& hull : hulls) placed.hulls.push_back(PlaceHull(hull, rest_skinning));
+  for (const JointSphereData& s : spheres) placed.spheres.push_back(PlaceSphere(s, rest_skinning));
+  for (const CapsuleColliderData& c : capsules)
+    placed.capsules.push_back(PlaceCapsule(c, rest_skinning));
 
   WindingNumberOptions winding;
   winding.beta = options.winding_beta;
   const MeshReference body(rest_positions, triangles, winding);
-  const BloatSamples samples = CollectBloatSamples(placed_hulls, placed_spheres, options);
+  const BloatSamples samples = CollectBloatSamples(placed, options);
   const std::vector<double> bloat = BloatOf(samples, body);
 
   ColliderFit fit;
   std::vector<double> area_bloat;  // every collider's area-weighted samples, for the p99
   for (size_t c = 0; c < samples.begin.size(); ++c) {
     const ColliderBloat b = Summarise(bloat, samples.begin[c], samples.area_end[c], samples.end[c]);
-    (c < hulls.size() ? fit.hulls : fit.spheres).push_back(b);
+    (c < hulls.size()                    ? fit.hulls
+     : c < hulls.size() + spheres.size() ? fit.spheres
+                                         : fit.capsules)
+        .push_back(b);
     area_bloat.insert(area_bloat.end(), bloat.begin() + samples.begin[c],
                       bloat.begin() + samples.area_end[c]);
     fit.bloat_max_mm = std::max(fit.bloat_max_mm, b.max_mm);
@@ -272,7 +320,7 @@ ColliderFit MeasureColliderFit(std::span<const Float3> rest_positions,
   const std::vector<double> body_points =
       BodySamples(rest_positions, triangles, options.body_samples);
   fit.body_samples = static_cast<uint32_t>(body_points.size() / 3);
-  fit.coverage = Coverage(body_points, placed_hulls, placed_spheres, options);
+  fit.coverage = Coverage(body_points, placed, options);
   return fit;
 }
 

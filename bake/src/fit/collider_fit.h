@@ -23,9 +23,10 @@ struct ColliderFitOptions {
   double sphere_delta = 0.005;  // metres: added to the joint spheres' radii (spheres.delta)
   // A body point counts as covered up to delta + this outside a collider, metres.
   double coverage_tolerance = 0.001;
-  uint32_t hull_samples = 400;    // area-weighted points per hull (its vertices are added)
-  uint32_t sphere_samples = 400;  // Fibonacci points per joint sphere
-  uint32_t body_samples = 20000;  // area-weighted points on the body for the coverage
+  uint32_t hull_samples = 400;     // area-weighted points per hull (its vertices are added)
+  uint32_t sphere_samples = 400;   // Fibonacci points per joint sphere
+  uint32_t capsule_samples = 400;  // area-weighted points per capsule (which has no delta)
+  uint32_t body_samples = 20000;   // area-weighted points on the body for the coverage
   // The winding number's accuracy (MeshReference's beta): 2 classifies every point farther than
   // 0.1 from w = 1/2 right, at a third of the cost of the reference's default.
   double winding_beta = 2.0;
@@ -39,23 +40,25 @@ struct ColliderBloat {
 };
 
 struct ColliderFit {
-  std::vector<ColliderBloat> hulls;    // one per hull, in the order given
-  std::vector<ColliderBloat> spheres;  // one per joint sphere, in the order given
-  double coverage = 0.0;               // [0, 1]; 0 when there is no collider
-  double bloat_p99_mm = 0.0;           // over every collider's area-weighted samples
-  double bloat_max_mm = 0.0;           // over every collider's samples
-  uint32_t collider_samples = 0;       // bloat samples in all (hull vertices included)
-  uint32_t body_samples = 0;           // coverage samples
+  std::vector<ColliderBloat> hulls;     // one per hull, in the order given
+  std::vector<ColliderBloat> spheres;   // one per joint sphere, in the order given
+  std::vector<ColliderBloat> capsules;  // one per capsule, in the order given
+  double coverage = 0.0;                // [0, 1]; 0 when there is no collider
+  double bloat_p99_mm = 0.0;            // over every collider's area-weighted samples
+  double bloat_max_mm = 0.0;            // over every collider's samples
+  uint32_t collider_samples = 0;        // bloat samples in all (hull vertices included)
+  uint32_t body_samples = 0;            // coverage samples
 };
 
 // rest_positions / triangles: the body at rest, asset frame, metres. A hull is placed at
 // rest_skinning[joint] * bind_frame, a sphere's centre at rest_skinning[joint] * center (as the
-// runtime places them at the rest pose). A collider whose joint has no skinning matrix is
-// measured as having no samples.
+// runtime places them at the rest pose), a capsule's ends at rest_skinning[joint] * from, to. A
+// collider whose joint has no skinning matrix is measured as having no samples.
 ColliderFit MeasureColliderFit(std::span<const Float3> rest_positions,
                                std::span<const uint32_t> triangles,
                                std::span<const HullColliderData> hulls,
                                std::span<const JointSphereData> spheres,
+                               std::span<const CapsuleColliderData> capsules,
                                std::span<const Mat34> rest_skinning,
                                const ColliderFitOptions& options = {});
 

@@ -13,6 +13,7 @@
 #include "config/clip_lookup.h"
 #include "drape/bake/body_map_baker.h"
 #include "drape/bake/bone_map_baker.h"
+#include "drape/bake/capsule_fitter.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
 #include "drape/bake/kirkpatrick_builder.h"
@@ -577,7 +578,7 @@ ColliderFit ReportFit(const BakeConfig& config, const Regions& regions, const Ch
   options.sphere_delta = config.sphere_delta;
   const ColliderFit fit =
       MeasureColliderFit(regions.rest_positions, asset.mesh.triangles, asset.hulls,
-                         asset.joint_spheres, regions.rest_skinning, options);
+                         asset.joint_spheres, {}, regions.rest_skinning, options);
   std::vector<std::string> hull_names, sphere_names;
   for (const HullColliderData& h : asset.hulls)
     hull_names.push_back(asset.skeleton.joint_names[h.joint]);
@@ -597,6 +598,30 @@ ColliderFit ReportFit(const BakeConfig& config, const Regions& regions, const Ch
   for (std::string& w : FitWarnings(fit, options, hull_names, sphere_names, config.max_bloat))
     warnings->push_back(std::move(w));
   return fit;
+}
+
+// The tapered capsules, and the report's list with each one's fit and the fit of the capsules
+// as a proxy set of their own (report["capsules"], report["fit_capsules"]).
+void BakeCapsules(const BakeConfig& config, const Regions& regions, const MeshData& mesh,
+                  CharacterAsset* asset, json* report) {
+  asset->capsules = FitCapsules(regions, mesh, asset->skeleton.parents, config.capsules);
+  ColliderFitOptions options;
+  const ColliderFit fit = MeasureColliderFit(regions.rest_positions, mesh.triangles, {}, {},
+                                             asset->capsules, regions.rest_skinning, options);
+  json capsules = json::array();
+  for (size_t c = 0; c < asset->capsules.size(); ++c) {
+    const CapsuleColliderData& k = asset->capsules[c];
+    const Float3 a = TransformPoint(regions.rest_skinning[k.joint], k.from);
+    const Float3 b = TransformPoint(regions.rest_skinning[k.joint], k.to);
+    json entry = {{"joint", asset->skeleton.joint_names[k.joint]},
+                  {"length_mm", 1000.f * Length(b - a)},
+                  {"radius_from_mm", 1000.f * k.radius_from},
+                  {"radius_to_mm", 1000.f * k.radius_to}};
+    if (c < fit.capsules.size()) AddBloatToReport(fit.capsules[c], &entry);
+    capsules.push_back(entry);
+  }
+  (*report)["capsules"] = capsules;
+  (*report)["fit_capsules"] = FitToJson(fit, options, config.max_bloat);
 }
 
 // The preview's colours: each collider's bloat max, red at hulls.max_bloat.
@@ -734,6 +759,11 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     start = Clock::now();
     BakeSpheres(config, regions, character, &asset, &report);
     timings["spheres_ms"] = MillisecondsSince(start);
+  }
+  if (config.capsules_enabled) {
+    start = Clock::now();
+    BakeCapsules(config, regions, character.mesh, &asset, &report);
+    timings["capsules_ms"] = MillisecondsSince(start);
   }
   if (config.hulls_enabled || config.spheres_enabled) {
     start = Clock::now();

@@ -73,6 +73,7 @@ Status ApplySceneToBakeConfig(const Scene& scene, BakeConfig* config) {
   result.maps_enabled = scene.use_maps;
   result.hulls_enabled = scene.use_hulls;
   result.spheres_enabled = scene.use_spheres;
+  result.capsules_enabled = scene.use_capsules;
   // Baked maps of the poses the scene plays: its clip (at maps.clip_rate), or the rest pose.
   // Rendered maps need the rest pose's alone (their texel size, epsilon and grid).
   result.maps_clip = scene.use_maps && scene.maps_source == MapSource::kBaked ? scene.animation.clip

@@ -114,33 +114,37 @@ const JsonSchema<Scene>& CollisionSchema() {
           "The response parameters (friction, restitution, separation) are in `/solver`.")
           .Custom(
               CustomFieldInfo(
-                  "methods", "array of `maps` \\| `hulls` \\| `spheres`",
-                  "an array of maps | hulls | spheres",
+                  "methods", "array of `maps` \\| `hulls` \\| `spheres` \\| `capsules`",
+                  "an array of maps | hulls | spheres | capsules",
                   "any combination (empty: no collision). `maps`: paper A's front/back depth and "
                   "normal maps of the pose of every frame (see `maps_source`); "
                   "`hulls`: paper B's per-bone convex hulls; `spheres`: paper B's joint "
-                  "spheres. The bake builds only these"),
+                  "spheres; `capsules`: a tapered capsule per bone fitted to the body (posed "
+                  "with the engine shapes of `shapes`). The bake builds only these"),
               [](const JsonAt& at, Scene& scene) {
                 const json& methods = at.value();
                 if (!methods.is_array()) {
-                  return at.Error(std::string("must be an array of maps | hulls | spheres, not ") +
-                                  JsonTypeName(methods));
+                  return at.Error(
+                      std::string("must be an array of maps | hulls | spheres | capsules, not ") +
+                      JsonTypeName(methods));
                 }
-                scene.use_maps = scene.use_hulls = scene.use_spheres = false;
+                scene.use_maps = scene.use_hulls = scene.use_spheres = scene.use_capsules = false;
                 for (size_t i = 0; i < methods.size(); ++i) {
                   const JsonAt m = at.Element(i);
                   if (!m.value().is_string()) {
-                    return m.Error(std::string("must be maps | hulls | spheres, not ") +
+                    return m.Error(std::string("must be maps | hulls | spheres | capsules, not ") +
                                    JsonTypeName(m.value()));
                   }
                   const std::string name = m.value().get<std::string>();
-                  bool* flag = name == "maps"      ? &scene.use_maps
-                               : name == "hulls"   ? &scene.use_hulls
-                               : name == "spheres" ? &scene.use_spheres
-                                                   : nullptr;
+                  bool* flag = name == "maps"       ? &scene.use_maps
+                               : name == "hulls"    ? &scene.use_hulls
+                               : name == "spheres"  ? &scene.use_spheres
+                               : name == "capsules" ? &scene.use_capsules
+                                                    : nullptr;
                   if (flag == nullptr) {
-                    return m.Error(Quote(name) +
-                                   " is not a collision method (maps | hulls | spheres)");
+                    return m.Error(
+                        Quote(name) +
+                        " is not a collision method (maps | hulls | spheres | capsules)");
                   }
                   if (*flag) return m.Error(Quote(name) + " is listed twice");
                   *flag = true;
@@ -152,6 +156,7 @@ const JsonSchema<Scene>& CollisionSchema() {
                 if (scene.use_maps) methods.push_back("maps");
                 if (scene.use_hulls) methods.push_back("hulls");
                 if (scene.use_spheres) methods.push_back("spheres");
+                if (scene.use_capsules) methods.push_back("capsules");
                 return methods;
               })
           .Enum<DepthSampling>(
@@ -385,7 +390,8 @@ Status ReadBakeOverrides(const JsonAt& at, BakeConfig* config) {
     if (!values.is_object()) continue;  // the schema names it
     for (const auto& [key, value] : values.items()) {
       const std::string name = section + "." + key;
-      if (name == "maps.enabled" || name == "hulls.enabled" || name == "spheres.enabled")
+      if (name == "maps.enabled" || name == "hulls.enabled" || name == "spheres.enabled" ||
+          name == "capsules.enabled")
         return at.Member(section).Member(key).Error(
             "the collider kinds come from /collision/methods");
       if (name == "maps.clip")

@@ -9,6 +9,7 @@
 
 #include "drape/bake/body_map_baker.h"
 #include "drape/bake/bone_map_baker.h"
+#include "drape/bake/capsule_fitter.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
 #include "drape/bake/kirkpatrick_builder.h"
@@ -77,6 +78,11 @@ struct BakeConfig {
   // Metres, >= 0: with kSurface, a joint whose centre is nearer the body surface than this gets
   // no sphere (it would hold nothing a hull does not).
   float sphere_min_radius = 0.01f;
+
+  // Tapered capsules, one per bone that carries skin, fitted to the body's cross-section
+  // (capsule/capsule_fit.h): the engines' cloth colliders, posed into a ShapeColliderSet.
+  bool capsules_enabled = true;
+  CapsuleFitOptions capsules;
 };
 
 // Reads a JSON config file over the defaults in `config`. `path` names the file in messages.

@@ -157,7 +157,7 @@ struct Scene {
   std::vector<SceneGarment> garments;
 
   // Collision: any combination of the three methods.
-  bool use_maps = false, use_hulls = true, use_spheres = true;
+  bool use_maps = false, use_hulls = true, use_spheres = true, use_capsules = false;
   DepthSampling maps_sampling = DepthSampling::kNearest;
   MapSource maps_source = MapSource::kRendered;
   PoseBlend maps_blend = PoseBlend::kBracket;  // kBaked only

@@ -31,6 +31,7 @@ struct CharacterAsset {
   std::vector<HullColliderData> hulls;
   std::vector<JointSphereData> joint_spheres;
   BoneMapSet bone_maps;  // per-bone local maps; empty unless the bake was asked for them
+  std::vector<CapsuleColliderData> capsules;  // one per bone that carries skin (format 6)
 };
 
 }  // namespace drape

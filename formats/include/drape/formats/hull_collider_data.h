@@ -82,4 +82,15 @@ struct JointSphereData {
   float radius = 0.f;         // metres in the rest pose (the animation's scale), > 0
 };
 
+// A tapered capsule (round cone: the convex hull of two spheres) carried by one bone, fitted to
+// the cross-section of the body the bone carries: the proxy shape engines know (NvCloth, Unity,
+// Chaos, Jolt). Posed by the runtime into a ShapeColliderSet (drape/runtime/capsule_colliders.h).
+struct CapsuleColliderData {  // 36 bytes
+  int32_t joint = -1;         // the bone that carries it
+  Float3 from, to;            // the end spheres' centres, bind-pose asset frame; at a pose:
+                              // skinning(joint) * from, skinning(joint) * to
+  float radius_from = 0.f;    // metres in the rest pose (as a joint sphere's), > 0
+  float radius_to = 0.f;      // metres in the rest pose, > 0
+};
+
 }  // namespace drape
