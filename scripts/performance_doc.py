@@ -406,6 +406,8 @@ def key_rows(rs):
     for r in rs:
         if default_maps(r) or default_hulls(r):
             tag(r, "default")
+        if r["family"] == "capsules":
+            tag(r, "capsules")
     tag(cheapest(rs, passes), "cheapest passing")
     return sorted(tags.values(), key=lambda t: t[0]["ns_per_particle_1t"] or 0)
 

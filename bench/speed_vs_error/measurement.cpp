@@ -204,6 +204,9 @@ void Measurement::MeasureDefaultHullVariants(const Context& context, const Chara
                                    "default hulls alone", bytes));
   Measure(context, *MakeHullMethod({}, a.joint_spheres, joints, rest_skinning, runtime, "spheres",
                                    "joint spheres alone", bytes));
+  Measure(context,
+          *MakeCapsuleMethod(a.capsules, rest_skinning,
+                             "default (" + std::to_string(a.capsules.size()) + " capsules)"));
   if (default_maps) {
     const std::string combined = default_maps->setting + " + default hulls";
     Measure(context,
@@ -292,6 +295,11 @@ void Measurement::RunPosedAt(const CharacterSpec& spec, const bake::Character& c
     Measure(context, *MakeHullMethod(a.hulls, a.joint_spheres, a.skeleton.joint_count(), skinning,
                                      HullColliderOptions{}, "hulls+spheres", setting + counts,
                                      HullBakedBytes(a)));
+    if (setting.rfind("default", 0) == 0) {
+      Measure(context,
+              *MakeCapsuleMethod(a.capsules, skinning,
+                                 "default (" + std::to_string(a.capsules.size()) + " capsules)"));
+    }
   }
   MeasurePeer(context, *MakeExactMeshPeer(reference));
 }

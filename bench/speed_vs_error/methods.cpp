@@ -289,6 +289,25 @@ class FclPeer final : public Method {
   std::unique_ptr<peers::FclMeshPeer> fcl_;
 };
 
+// The bake's tapered capsules posed into the engine shapes' set (still over the step).
+class CapsuleMethod final : public Method {
+ public:
+  CapsuleMethod(std::span<const CapsuleColliderData> capsules, std::span<const Mat34> skinning) {
+    set_.Reserve(static_cast<uint32_t>(capsules.size()), 0);
+    DieOnError(AddCapsuleColliders(capsules, skinning, skinning, &set_), "capsules");
+  }
+  void Collide(std::span<const Float3> previous, std::span<Float3> positions,
+               std::span<Float3> velocities, std::span<uint8_t> flags) const override {
+    DieOnError(set_.CollideBatch(previous, positions, velocities, flags, BenchResponse(), 0.f, 1.f,
+                                 kStepSeconds),
+               setting);
+  }
+  ContactQuery Query(Float3 p0, Float3 p1) const override { return set_.Query(p0, p1, 0.f, 1.f); }
+
+ private:
+  ShapeColliderSet set_;
+};
+
 }  // namespace
 
 ResponseParams BenchResponse() {
@@ -328,6 +347,16 @@ std::unique_ptr<Method> MakeBoneMapMethod(const BoneMapSet& maps, uint32_t joint
   method->setting = std::move(setting);
   method->baked_bytes = baked_bytes;
   method->runtime_bytes = method->collider().memory_bytes();
+  return method;
+}
+
+std::unique_ptr<Method> MakeCapsuleMethod(std::span<const CapsuleColliderData> capsules,
+                                          std::span<const Mat34> skinning, std::string setting) {
+  auto method = std::make_unique<CapsuleMethod>(capsules, skinning);
+  method->family = "capsules";
+  method->setting = std::move(setting);
+  method->baked_bytes = capsules.size() * sizeof(CapsuleColliderData);
+  method->runtime_bytes = capsules.size() * 160;  // ShapeColliderSet's 160-byte shapes
   return method;
 }
 

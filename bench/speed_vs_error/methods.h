@@ -13,9 +13,11 @@
 #include "drape/bake/mesh_reference.h"
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/bone_map_collider.h"
+#include "drape/runtime/capsule_colliders.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
+#include "drape/runtime/shape_collider_set.h"
 
 namespace drape::peers {
 class FclMeshPeer;
@@ -82,6 +84,10 @@ std::unique_ptr<Method> MakeHullMethod(std::span<const HullColliderData> hulls,
                                        uint32_t joint_count, std::span<const Mat34> skinning,
                                        const HullColliderOptions& options, std::string family,
                                        std::string setting, size_t baked_bytes);
+
+// The bake's tapered capsules at one pose (AddCapsuleColliders into a ShapeColliderSet).
+std::unique_ptr<Method> MakeCapsuleMethod(std::span<const CapsuleColliderData> capsules,
+                                          std::span<const Mat34> skinning, std::string setting);
 
 // The body maps first, then the hulls and spheres (what a scene with both methods does).
 std::unique_ptr<Method> MakeCombinedMethod(std::unique_ptr<Method> maps,

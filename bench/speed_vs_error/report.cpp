@@ -238,8 +238,9 @@ bool WriteMarkdown(const std::string& path, const std::vector<Row>& rows,
 std::vector<std::string> WriteCharts(const std::string& dir, const std::vector<Row>& rows) {
   std::vector<std::string> written;
   const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
-  static const std::map<std::string, int> kFamilyStyle = {
-      {"maps", 1}, {"hulls+spheres", 2}, {"hulls", 3}, {"spheres", 4}, {"maps+hulls", 5}};
+  static const std::map<std::string, int> kFamilyStyle = {{"maps", 1},       {"hulls+spheres", 2},
+                                                          {"hulls", 3},      {"spheres", 4},
+                                                          {"maps+hulls", 5}, {"capsules", 6}};
   bool first = true;
   for (const std::string& character : Characters(rows)) {
     const std::vector<const Row*> all = AllRows(rows, character);
@@ -303,7 +304,8 @@ std::vector<std::string> WriteCharts(const std::string& dir, const std::vector<R
           "'' u 1:(column(4)==3?column(Y):1/0) w p pt 4 ps 1.2 lc rgb '#ff7f0e' t 'hulls alone', "
           "'' u 1:(column(4)==4?column(Y):1/0) w p pt 6 ps 1.2 lc rgb '#2ca02c' t 'joint spheres "
           "alone', "
-          "'' u 1:(column(4)==5?column(Y):1/0) w p pt 9 ps 1.4 lc rgb '#9467bd' t 'maps + hulls'";
+          "'' u 1:(column(4)==5?column(Y):1/0) w p pt 9 ps 1.4 lc rgb '#9467bd' t 'maps + hulls', "
+          "'' u 1:(column(4)==7?column(Y):1/0) w p pt 13 ps 1.3 lc rgb '#8c564b' t 'capsules'";
       gp << "Y=2\nset logscale y\nset ylabel 'p99 penetration after response, mm (log)'\n"
          << "plot '" << base << "_front_p99.dat' u 1:2 w steps lw 2 lc rgb 'black' t 'Pareto "
          << "front', '" << base << ".dat' " << families << "\n"

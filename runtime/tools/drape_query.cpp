@@ -1,5 +1,6 @@
 // drape-query FILE.drape [--clip NAME --time T | --joint-matrices F] (--points F | --segments F)
-//             [--method maps|bone_maps|hulls|spheres|all] [--mesh F.obj] [--write-joint-matrices F]
+//             [--method maps|bone_maps|hulls|spheres|capsules|all] [--mesh F.obj]
+//             [--write-joint-matrices F]
 // The runtime's collision answers from the command line, for pipeline checks and debugging.
 // Input rows: "x y z" (points) or "x0 y0 z0 x1 y1 z1" (previous and current position), asset
 // frame, metres; '#' starts a comment; "nan" and "inf" are read as such. Output: CSV on stdout,
@@ -27,6 +28,7 @@
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/bone_map_collider.h"
+#include "drape/runtime/capsule_colliders.h"
 #include "drape/runtime/collision_types.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
@@ -40,7 +42,8 @@ int Usage() {
   std::fprintf(stderr,
                "usage: drape-query FILE.drape [--clip NAME --time T | --joint-matrices F]\n"
                "                   (--points F | --segments F)\n"
-               "                   [--method maps|bone_maps|hulls|spheres|all] [--mesh F.obj]\n"
+               "                   [--method maps|bone_maps|hulls|spheres|capsules|all] [--mesh "
+               "F.obj]\n"
                "                   [--write-joint-matrices F]\n");
   return 2;
 }
@@ -250,8 +253,9 @@ int main(int argc, char** argv) {
     return Usage();
   }
   if (method != "maps" && method != "bone_maps" && method != "hulls" && method != "spheres" &&
-      method != "all") {
-    return Fail("--method '" + method + "' is not maps, bone_maps, hulls, spheres or all");
+      method != "capsules" && method != "all") {
+    return Fail("--method '" + method +
+                "' is not maps, bone_maps, hulls, spheres, capsules or all");
   }
   if (time_given && clip_name.empty()) return Fail("--time needs --clip");
   if (!matrices_path.empty() && !clip_name.empty()) {
@@ -367,6 +371,17 @@ int main(int argc, char** argv) {
       return Fail(path + ": " + s.message());
   }
 
+  drape::ShapeColliderSet capsules;  // the baked capsules at the pose, as an engine adds them
+  const bool want_capsules = method == "capsules" || (method == "all" && !asset.capsules.empty());
+  if (want_capsules) {
+    if (asset.capsules.empty())
+      return Fail(path + ": no capsules baked (format 6, capsules.enabled)");
+    if (drape::Status s =
+            drape::AddCapsuleColliders(asset.capsules, pose.skinning(), pose.skinning(), &capsules);
+        !s.ok())
+      return Fail(path + ": " + s.message());
+  }
+
   std::printf(
       "row,method,inside,contact,t,px,py,pz,nx,ny,nz,depth,x_after,y_after,z_after,flags\n");
   for (size_t r = 0; r < rows.size(); ++r) {
@@ -382,6 +397,8 @@ int main(int argc, char** argv) {
       PrintRow(r, "spheres",
                Answer(s, [&] { return hulls.Query(s.p0, s.p1, drape::kColliderSpheres); }), s);
     }
+    if (want_capsules)
+      PrintRow(r, "capsules", Answer(s, [&] { return capsules.Query(s.p0, s.p1, 0.f, 1.f); }), s);
   }
   return 0;
 }

@@ -172,7 +172,7 @@ if [ -e "$WORK/mannequin.drape" ]; then
   printf '0.095 0.3 0.3 0.095 0.3 -0.3\n' >"$WORK/segments.txt"
   "$QUERY" "$WORK/mannequin.drape" --points "$WORK/points.txt" >"$WORK/points.csv" 2>"$WORK/query.stderr"
   rows=$(grep -c '^[0-9]' "$WORK/points.csv")
-  if [ "$rows" -eq 9 ]; then passed=$((passed + 1)); else fail "query: expected 9 rows (3 points x 3 methods), got $rows: $(cat "$WORK/query.stderr")"; fi
+  if [ "$rows" -eq 12 ]; then passed=$((passed + 1)); else fail "query: expected 12 rows (3 points x 4 methods), got $rows: $(cat "$WORK/query.stderr")"; fi
   # inside flags: column 3. Chest: maps and hulls say inside; the far point: nobody.
   check_flag() {  # row method expected
     local got
@@ -184,9 +184,11 @@ if [ -e "$WORK/mannequin.drape" ]; then
   check_flag 1 maps "$WORK/points.csv" 0
   check_flag 1 hulls "$WORK/points.csv" 0
   check_flag 1 spheres "$WORK/points.csv" 0
+  check_flag 0 capsules "$WORK/points.csv" 1
+  check_flag 1 capsules "$WORK/points.csv" 0
   check_flag 2 maps "$WORK/points.csv" 1
   "$QUERY" "$WORK/mannequin.drape" --segments "$WORK/segments.txt" --method all >"$WORK/segments.csv"
-  for method in maps hulls; do
+  for method in maps hulls capsules; do
     contact=$(awk -F, -v m=$method '$1 == 0 && $2 == m {print $4}' "$WORK/segments.csv")
     if [ "$contact" = 1 ]; then passed=$((passed + 1)); else fail "query: $method missed a segment through the shin"; fi
   done
@@ -203,7 +205,7 @@ if [ -e "$WORK/mannequin.drape" ]; then
     "$QUERY" "$WORK/mannequin.drape" --segments "$WORK/huge_segments.txt" >>"$WORK/huge.csv" 2>>"$WORK/q.err"; then
     invalid=$(awk -F, '$1 ~ /^[0-9]+$/ && $4 == 0 && $16 == 128' "$WORK/huge.csv" | wc -l)
     chest=$(awk -F, '$1 == 4 && $2 == "hulls" {print $3 "," $16}' "$WORK/huge.csv")
-    if [ "$invalid" -eq 15 ] && [ "$chest" = "1,2" ]; then passed=$((passed + 1)); else fail "query on huge and non-finite rows: $invalid invalid rows of 15, chest '$chest': $(cat "$WORK/huge.csv")"; fi
+    if [ "$invalid" -eq 20 ] && [ "$chest" = "1,2" ]; then passed=$((passed + 1)); else fail "query on huge and non-finite rows: $invalid invalid rows of 20, chest '$chest': $(cat "$WORK/huge.csv")"; fi
   else
     fail "query refused huge or non-finite rows: $(cat "$WORK/q.err")"
   fi
