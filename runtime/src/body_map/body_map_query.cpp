@@ -117,7 +117,7 @@ bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& 
   result->inside_end = inside_end;
   if (inside_end) result->depth = std::min(slab.top - z1, z1 - slab.bottom);
   if (inside_start) {
-    if (!inside_end) return true;                        // left through a surface, no entry
+    if (!inside_end) return false;  // left: whether it crossed the body is the walk's (§7.4)
     const bool back = z1 - slab.bottom < slab.top - z1;  // never left: pushed out along z
     result->contact = true;
     result->t = 0.f;
@@ -364,6 +364,32 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
     result.point = Float3{p1.x, p1.y, back ? p1_interval.bottom : p1_interval.top};
     result.normal =
         normal_at(p1_ci, p1_cj, p1_u, p1_v, back ? p1_interval.bottom_slot : p1_interval.top_slot);
+  } else if (start_inside) {
+    // Started inside and left with no entry. Leaving the body, it left through the surface it
+    // started nearer to, or was inside for about the depth it started at; crossing it from inside
+    // the shell (a particle the solver left within epsilon of a limb, pushed through it) it left
+    // elsewhere after more than half the body's thickness there: then it goes back out along z
+    // to the nearer surface of its start (docs §7.4). The reversed segment's first entry is where
+    // this one left (it never re-entered).
+    ContactQuery reverse;
+    WalkInto(p1, p0, &reverse);
+    const float cells = sampling_ == DepthSampling::kNearest ? 1.f : 2.f;
+    const float p0_u = (p0.x - origin_x_) * inv_texel_size_;
+    const float p0_v = (p0.y - origin_y_) * inv_texel_size_;
+    const int p0_ci = static_cast<int>(p0_u * cells), p0_cj = static_cast<int>(p0_v * cells);
+    const Interval start = interval_at(p0_ci, p0_cj, p0_u, p0_v, p0.z);
+    const double dx = double{p1.x} - p0.x, dy = double{p1.y} - p0.y, dz = double{p1.z} - p0.z;
+    const double inside = (1.0 - reverse.t) * std::sqrt(dx * dx + dy * dy + dz * dz);
+    const bool back = p0.z - start.bottom < start.top - p0.z;
+    const bool through_near = back ? reverse.point.z <= start.bottom : reverse.point.z >= start.top;
+    if (reverse.contact && !through_near && inside > 0.5 * (double{start.top} - start.bottom)) {
+      result.contact = true;
+      result.t = 0.f;
+      result.flags = kCollisionStartedInside;
+      result.point = Float3{p0.x, p0.y, back ? start.bottom : start.top};
+      result.normal =
+          normal_at(p0_ci, p0_cj, p0_u, p0_v, back ? start.bottom_slot : start.top_slot);
+    }
   }
 }
 

@@ -185,6 +185,9 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   const F push_out = AndNot(Or(hit_a, hit_b), inside_end);
   const F contact = Or(Or(hit_a, hit_b), push_out);
   const uint32_t contact_lanes = LaneBits(contact) & lanes;
+  // Started inside and left with no entry: Query decides whether it crossed the body (§7.4).
+  const uint32_t left_lanes = LaneBits(AndNot(contact, start_inside)) & lanes;
+  lanes &= ~left_lanes;
   if (contact_lanes == 0) return lanes | free_lanes;  // points and motions in air
 
   // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3
