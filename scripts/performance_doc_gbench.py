@@ -163,34 +163,40 @@ def cloth(doc, gb, sections):
                 "skirt against the same shapes, one thread; depth: the mean over frames of the "
                 "deepest particle inside a collider; worst spring: the largest L / R − 1 over the "
                 "timed frames (tethers + strain limit: the engine defaults of "
-                "`ClothSolverSettings{}`, off in paper B's).", "",
-                "| setup | 1 worker | 2 workers | speed-up | OpenMP, 2 threads | 1 worker, no "
-                "stretch measure | depth mm | worst spring |",
-                "|---|---|---|---|---|---|---|---|")
+                "`ClothSolverSettings{}`, off in paper B's). Lean: without the optional per-step "
+                "safety work (`measure_stretch` and `guard_blowups` off: the worst-spring pass, the "
+                "per-substep backup and finite check), 1 worker / 2 workers.", "",
+                "| setup | 1 worker | 2 workers | speed-up | OpenMP, 2 threads | no stretch "
+                "measure | lean 1 / 2 workers | depth mm | worst spring |",
+                "|---|---|---|---|---|---|---|---|---|")
         for label, substeps, colliders, engine in (
                 ("1 substep, with colliders", 1, 1, 0), ("1 substep, solver alone", 1, 0, 0),
                 ("1 substep, with colliders, tethers + strain limit", 1, 1, 1),
                 ("1 substep, solver alone, tethers + strain limit", 1, 0, 1)):
             args = (substeps, colliders, engine)
-            one = value(gb, p, "BM_ClothStep", (1,) + args + (0, 1), "real_time")
-            two = value(gb, p, "BM_ClothStep", (2,) + args + (0, 1), "real_time")
-            omp = value(gb, p, "BM_ClothStep", (2,) + args + (1, 1), "real_time")
-            lean = value(gb, p, "BM_ClothStep", (1,) + args + (0, 0), "real_time")
-            depth = value(gb, p, "BM_ClothStep", (1,) + args + (0, 1), "frame_max_depth_mm")
-            stretch = value(gb, p, "BM_ClothStep", (1,) + args + (0, 1), "max_stretch_pct")
+            one = value(gb, p, "BM_ClothStep", (1,) + args + (0, 1, 1), "real_time")
+            two = value(gb, p, "BM_ClothStep", (2,) + args + (0, 1, 1), "real_time")
+            omp = value(gb, p, "BM_ClothStep", (2,) + args + (1, 1, 1), "real_time")
+            no_stretch = value(gb, p, "BM_ClothStep", (1,) + args + (0, 0, 1), "real_time")
+            lean = [value(gb, p, "BM_ClothStep", (w,) + args + (0, 0, 0), "real_time")
+                    for w in (1, 2)]
+            depth = value(gb, p, "BM_ClothStep", (1,) + args + (0, 1, 1), "frame_max_depth_mm")
+            stretch = value(gb, p, "BM_ClothStep", (1,) + args + (0, 1, 1), "max_stretch_pct")
             up = f"{one / two:.2f}x" if one and two else "-"
+            lean_pair = (f"{mm(lean[0], 2)} / {mm(lean[1], 2)} ({lean[0] / lean[1]:.2f}x)"
+                         if lean[0] and lean[1] else "-")
             doc.add(f"| drape, {label} | {mm(one, 2)} | {mm(two, 2)} | {up} | {mm(omp, 2)} | "
-                    f"{mm(lean, 2)} | {mm(depth, 2) if colliders else '-'} | "
+                    f"{mm(no_stretch, 2)} | {lean_pair} | {mm(depth, 2) if colliders else '-'} | "
                     f"{f'{stretch:.0f} %' if stretch is not None else '-'} |")
         for substeps in (1,):
             t = value(gb, p, "BM_BulletSkirt", (substeps,), "real_time")
             depth = value(gb, p, "BM_BulletSkirt", (substeps,), "frame_max_depth_mm")
             doc.add(f"| Bullet btSoftBody, {substeps} substep{'s' if substeps > 1 else ''} | "
-                    f"{mm(t, 2)} | - | - | - | - | {mm(depth, 2)} | - |")
+                    f"{mm(t, 2)} | - | - | - | - | - | {mm(depth, 2)} | - |")
         stages = ("integrate", "springs", "constraints", "collide", "bookkeeping")
         per_workers = []
         for workers in (1, 2):
-            args = (workers, 1, 1, 0, 0, 1)
+            args = (workers, 1, 1, 0, 0, 1, 1)
             per_workers.append(", ".join(
                 f"{k} {mm(value(gb, p, 'BM_ClothStep', args, f'{k}_ms'), 3)}" for k in stages))
         doc.add("", "By stage (`ClothSolverSettings::measure_stages`; integrate: backup, root "

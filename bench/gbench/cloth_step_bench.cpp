@@ -5,7 +5,8 @@
 // team of 2 with openmp = 1), substeps, colliders on (1) or off (0: the solver alone, the skirt
 // then falls freely below its waistband), engine defaults (1: long-range tethers and the 10 %
 // strain limit; 0: paper B's solver), openmp, stretch (1: ClothSolverSettings::measure_stretch,
-// the worst-spring measure after each frame; 0: off, max_stretch_pct then reads 0); 5
+// the worst-spring measure after each frame; 0: off, max_stretch_pct then reads 0), guard (1:
+// ClothSolverSettings::guard_blowups, the per-substep backup and finite check; 0: off); 5
 // spring-correction iterations per substep (Verlet). max_stretch_pct: the worst stretch spring over
 // the timed frames. BM_BulletSkirt is the peer: Bullet's soft body (bench/peers) on the same skirt
 // mesh, masses and waistband, against the same 4 boxes (btConvexHullShape of their 8 corners)
@@ -115,6 +116,7 @@ void BM_ClothStep(benchmark::State& state) {
   settings.damping = 0.2f;
   settings.measure_stages = true;
   settings.measure_stretch = state.range(5) != 0;
+  settings.guard_blowups = state.range(6) != 0;
   if (state.range(3) != 0) {
     const ClothSolverSettings engine;
     settings.tethers = engine.tethers;
@@ -185,21 +187,25 @@ void BM_ClothStep(benchmark::State& state) {
   SetTaskSystem(nullptr);
 }
 BENCHMARK(BM_ClothStep)
-    ->ArgNames({"workers", "substeps", "colliders", "engine", "openmp", "stretch"})
-    ->Args({1, 1, 1, 0, 0, 1})
-    ->Args({2, 1, 1, 0, 0, 1})
-    ->Args({2, 1, 1, 0, 1, 1})
-    ->Args({1, 2, 1, 0, 0, 1})
-    ->Args({2, 2, 1, 0, 0, 1})
-    ->Args({1, 1, 0, 0, 0, 1})
-    ->Args({1, 1, 0, 0, 0, 0})
-    ->Args({1, 1, 1, 0, 0, 0})
-    ->Args({2, 1, 0, 0, 0, 1})
-    ->Args({2, 1, 0, 0, 1, 1})
-    ->Args({1, 1, 1, 1, 0, 1})
-    ->Args({2, 1, 1, 1, 0, 1})
-    ->Args({1, 1, 0, 1, 0, 1})
-    ->Args({2, 1, 0, 1, 0, 1})
+    ->ArgNames({"workers", "substeps", "colliders", "engine", "openmp", "stretch", "guard"})
+    ->Args({1, 1, 1, 0, 0, 1, 1})
+    ->Args({2, 1, 1, 0, 0, 1, 1})
+    ->Args({2, 1, 1, 0, 1, 1, 1})
+    ->Args({1, 2, 1, 0, 0, 1, 1})
+    ->Args({2, 2, 1, 0, 0, 1, 1})
+    ->Args({1, 1, 0, 0, 0, 1, 1})
+    ->Args({1, 1, 0, 0, 0, 0, 1})
+    ->Args({1, 1, 1, 0, 0, 0, 1})
+    ->Args({1, 1, 1, 0, 0, 0, 0})
+    ->Args({1, 1, 0, 0, 0, 0, 0})
+    ->Args({2, 1, 1, 0, 0, 0, 0})
+    ->Args({2, 1, 0, 0, 0, 0, 0})
+    ->Args({2, 1, 0, 0, 0, 1, 1})
+    ->Args({2, 1, 0, 0, 1, 1, 1})
+    ->Args({1, 1, 1, 1, 0, 1, 1})
+    ->Args({2, 1, 1, 1, 0, 1, 1})
+    ->Args({1, 1, 0, 1, 0, 1, 1})
+    ->Args({2, 1, 0, 1, 0, 1, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

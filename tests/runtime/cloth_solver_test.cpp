@@ -691,8 +691,9 @@ TEST(ClothSolver, SimdAndScalarKernelsAgree) {
   }
 }
 
-// The stretch measure and the stage timing are reports only: off or on, the same bits.
-TEST(ClothSolver, MeasuresAreOptionalAndChangeNothing) {
+// The stretch measure, the stage timing and the blow-up guard (backup and finite check) change
+// no result: off or on, the same bits.
+TEST(ClothSolver, MeasuresAndGuardsAreOptionalAndChangeNothing) {
   ClothDescription hung = SheetDescription(71, 1.2f, {0.f, 0.45f, 0.f});
   hung.pinned = {0};  // held by a corner: the sheet stretches as it falls
   Cloth cloth;
@@ -701,6 +702,7 @@ TEST(ClothSolver, MeasuresAreOptionalAndChangeNothing) {
   measured.measure_stages = true;
   ClothSolverSettings unmeasured;
   unmeasured.measure_stretch = false;
+  unmeasured.guard_blowups = false;
   const test::TaskSystemCase serial = test::AllTaskSystems().front();
   ExpectBitwiseEqual(RunSheetScene(cloth, measured, serial, 5),
                      RunSheetScene(cloth, unmeasured, serial, 5));

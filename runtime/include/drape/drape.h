@@ -150,6 +150,7 @@ typedef struct drape_solver_settings {
   float restitution;     /* [0, 1] */
   float separation;      /* metres kept off the surfaces, >= 0 */
   int measure_stretch;   /* report drape_step_stats.max_stretch (a pass over the springs) */
+  int guard_blowups;     /* back up and check each substep: a blow-up stops the step */
 } drape_solver_settings;
 void drape_solver_settings_default(drape_solver_settings* settings);
 

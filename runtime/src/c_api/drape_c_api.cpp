@@ -142,6 +142,7 @@ drape::ClothSolverSettings SolverSettings(const drape_solver_settings& s) {
   c.angular_inertia = s.angular_inertia;
   c.centrifugal_inertia = s.centrifugal_inertia;
   c.measure_stretch = s.measure_stretch != 0;
+  c.guard_blowups = s.guard_blowups != 0;
   return c;
 }
 
@@ -379,6 +380,7 @@ void drape_solver_settings_default(drape_solver_settings* settings) {
   settings->restitution = r.restitution;
   settings->separation = r.separation;
   settings->measure_stretch = s.measure_stretch ? 1 : 0;
+  settings->guard_blowups = s.guard_blowups ? 1 : 0;
 }
 
 drape_status drape_cloth_create(const drape_cloth_desc* desc, const drape_solver_settings* settings,

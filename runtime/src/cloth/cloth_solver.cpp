@@ -379,12 +379,13 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
     UpdateVelocities(state, sub);
     clock.Lap(&ClothStageSeconds::integrate);
     if (Status s = Collide(state, colliders, sub, &st); !s.ok()) {
-      RestoreBackup(state);
+      if (settings_.guard_blowups) RestoreBackup(state);
       return s;
     }
     RestoreKinematic(state);
     clock.Lap(&ClothStageSeconds::collide);
-    if (const uint32_t bad = FirstNonFinite(*state); bad != kNoParticle) {
+    if (const uint32_t bad = settings_.guard_blowups ? FirstNonFinite(*state) : kNoParticle;
+        bad != kNoParticle) {
       RestoreBackup(state);
       st.contacts = 0;
       st.max_stretch = MaxStretch(*state);
@@ -448,10 +449,12 @@ void ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const 
   Float3* backup_x = backup_positions_.data();
   Float3* backup_v = backup_velocities_.data();
   const bool carry = root.carry;
+  const bool backup = settings_.guard_blowups;
+  if (!carry && !backup) return;
   const Mat34 carried = carry ? CarriedMotion(root, sub) : Mat34{};
   ParallelRanges(static_cast<int64_t>(state->positions.size()), kParticleGrain,
                  [&](int64_t begin, int64_t end) {
-                   for (int64_t i = begin; i < end; ++i) {
+                   for (int64_t i = begin; backup && i < end; ++i) {
                      backup_x[i] = x[i];
                      backup_v[i] = v[i];
                    }
