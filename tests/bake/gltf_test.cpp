@@ -144,16 +144,19 @@ TEST(GltfExport, AssetHoldsItsSkinAndCollidersOnTheirJoints) {
   const tinygltf::Model m = Load(path);
   const uint32_t joints = asset.skeleton.joint_count();
   ASSERT_EQ(m.skins[0].joints.size(), joints);
-  size_t hulls = 0, spheres = 0;
+  size_t hulls = 0, spheres = 0, capsules = 0;
   for (uint32_t j = 0; j < joints; ++j) {
     for (const int child : m.nodes[j].children) {
       const tinygltf::Node& n = m.nodes[static_cast<size_t>(child)];
       hulls += n.name.rfind("hull ", 0) == 0 ? 1 : 0;
       spheres += n.name.rfind("joint sphere ", 0) == 0 ? 1 : 0;
+      capsules += n.name.rfind("capsule ", 0) == 0 ? 1 : 0;
     }
   }
   EXPECT_EQ(hulls, asset.hulls.size());
   EXPECT_EQ(spheres, asset.joint_spheres.size());
+  ASSERT_FALSE(asset.capsules.empty());
+  EXPECT_EQ(capsules, asset.capsules.size());
   EXPECT_EQ(m.animations.size(), asset.clips.size());
   // Nothing is written where the path cannot be.
   EXPECT_FALSE(WriteAssetGltf(asset, testing::TempDir() + "/no/such/dir/x.glb").ok());

@@ -68,9 +68,10 @@ hulls = sum(1 for n in names if n.startswith("hull "))
 spheres = sum(1 for n in names if n.startswith("joint sphere "))
 assert joints == 17, joints                      # the mannequin's skeleton
 assert "body" in names and g["nodes"][names.index("body")]["skin"] == 0
-assert hulls >= 17 and spheres >= 10, (hulls, spheres)
+capsules = sum(1 for n in names if n.startswith("capsule "))
+assert hulls >= 17 and spheres >= 10 and capsules == 17, (hulls, spheres, capsules)
 for k, n in enumerate(g["nodes"]):              # every collider hangs from a joint
-    if n.get("name", "").startswith(("hull ", "joint sphere ")):
+    if n.get("name", "").startswith(("hull ", "joint sphere ", "capsule ")):
         assert any(k in p.get("children", []) for p in g["nodes"][:joints]), n["name"]
 assert [a["name"] for a in g["animations"]] == ["walk"], g["animations"]
 PY

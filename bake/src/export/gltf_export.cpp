@@ -14,6 +14,7 @@
 #include <tuple>
 #include <vector>
 
+#include "capsule/capsule_fit.h"
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/math.h"
 #include "import/import_transforms.h"
@@ -255,6 +256,33 @@ void AddJointSpheres(const CharacterAsset& asset, Builder* b) {
   }
 }
 
+// Every capsule as a translucent round cone on its joint, in the joint's frame (its radii scaled
+// as the joint spheres' are).
+void AddCapsules(const CharacterAsset& asset, Builder* b) {
+  if (asset.capsules.empty()) return;
+  const int material = b->Material("capsule", 0.9, 0.6, 0.1, 0.35);
+  for (size_t c = 0; c < asset.capsules.size(); ++c) {
+    const CapsuleColliderData& k = asset.capsules[c];
+    const Mat34& local = JointFromAsset(asset.skeleton, k.joint);
+    const double scale = UniformScale(local);
+    const Float3 from = TransformPoint(local, k.from), to = TransformPoint(local, k.to);
+    const double a[3] = {from.x, from.y, from.z}, e[3] = {to.x, to.y, to.z};
+    std::vector<double> vertices;
+    std::vector<uint32_t> triangles;
+    RoundConeMesh(a, k.radius_from * scale, e, k.radius_to * scale, 16, 4, &vertices, &triangles);
+    std::vector<Float3> positions(vertices.size() / 3);
+    for (size_t v = 0; v < positions.size(); ++v)
+      positions[v] = {static_cast<float>(vertices[3 * v]), static_cast<float>(vertices[3 * v + 1]),
+                      static_cast<float>(vertices[3 * v + 2])};
+    const std::string name = "capsule " + asset.skeleton.joint_names[static_cast<size_t>(k.joint)] +
+                             " " + std::to_string(c);
+    tinygltf::Node node;
+    node.name = name;
+    node.mesh = b->Mesh(name, b->Positions(positions), b->Indices(triangles), material);
+    b->Node(node, k.joint);
+  }
+}
+
 // The skeleton, skin and skinned body; returns the body's node.
 int AddCharacter(const CharacterAsset& asset, Builder* b) {
   AddSkeleton(asset.skeleton, b);
@@ -464,6 +492,7 @@ Status WriteAssetGltf(const CharacterAsset& asset, const std::string& path) {
   const int body = AddCharacter(asset, &b);
   AddHulls(asset, &b);
   AddJointSpheres(asset, &b);
+  AddCapsules(asset, &b);
   const uint32_t joints = asset.skeleton.joint_count();
   for (const ClipData& clip : asset.clips)
     if (clip.frame_count > 1 && clip.keys.size() == size_t{clip.frame_count} * joints)

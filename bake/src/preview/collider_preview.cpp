@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "body_map/cpu_rasterizer.h"
+#include "capsule/capsule_fit.h"
 #include "drape/runtime/math.h"
 #include "preview/map_preview.h"
 
@@ -191,8 +192,38 @@ Status WriteColliderPreview(const CharacterAsset& asset, std::span<const Float3>
       !s.ok()) {
     return s;
   }
-  return RenderView(body, hulls, spheres, hull_count, bloat, 0, height,
-                    directory + "/colliders_side.png");
+  if (Status s = RenderView(body, hulls, spheres, hull_count, bloat, 0, height,
+                            directory + "/colliders_side.png");
+      !s.ok()) {
+    return s;
+  }
+  if (asset.capsules.empty()) return Status::Ok();
+  // The capsules over the body, one colour each (their fit is in the report's fit_capsules).
+  Soup capsules;
+  for (size_t c = 0; c < asset.capsules.size(); ++c) {
+    const CapsuleColliderData& k = asset.capsules[c];
+    const Float3 from = TransformPoint(rest_skinning[k.joint], k.from);
+    const Float3 to = TransformPoint(rest_skinning[k.joint], k.to);
+    const double a[3] = {from.x, from.y, from.z}, e[3] = {to.x, to.y, to.z};
+    std::vector<double> v;
+    std::vector<uint32_t> t;
+    RoundConeMesh(a, k.radius_from, e, k.radius_to, 24, 6, &v, &t);
+    const auto corner = [&](uint32_t i) {
+      return Float3{static_cast<float>(v[3 * i]), static_cast<float>(v[3 * i + 1]),
+                    static_cast<float>(v[3 * i + 2])};
+    };
+    for (size_t i = 0; i + 2 < t.size(); i += 3)
+      capsules.Add(corner(t[i]), corner(t[i + 1]), corner(t[i + 2]), static_cast<int32_t>(c));
+  }
+  const Soup none;
+  const int32_t capsule_count = static_cast<int32_t>(asset.capsules.size());
+  if (Status s = RenderView(body, capsules, none, capsule_count, nullptr, 2, height,
+                            directory + "/capsules_front.png");
+      !s.ok()) {
+    return s;
+  }
+  return RenderView(body, capsules, none, capsule_count, nullptr, 0, height,
+                    directory + "/capsules_side.png");
 }
 
 }  // namespace drape::bake

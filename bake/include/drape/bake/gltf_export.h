@@ -1,8 +1,8 @@
 #pragma once
 // A baked asset as glTF 2.0, to look at in Blender or any glTF viewer: the skeleton as nodes
 // (rest pose) with the skinned bind mesh, every hull as a translucent mesh on a node attached to
-// its joint, every joint sphere likewise, and the clips as animations, so the colliders move
-// with the character.
+// its joint, every joint sphere and capsule likewise, and the clips as animations, so the
+// colliders move with the character.
 
 #include <string>
 #include <vector>
