@@ -13,6 +13,7 @@
 
 #include "drape/drape.h"
 #include "drape/formats/asset_file.h"
+#include "drape/runtime/capsule_colliders.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/math.h"
 #include "drape/runtime/shape_collider_set.h"
@@ -55,7 +56,7 @@ std::vector<Float3> RunCpp(uint32_t* contacts) {
   ClothState state;
   state.Reset(cloth);
   ShapeColliderSet shapes;
-  shapes.Reserve(2, 0);
+  shapes.Reserve(2 + static_cast<uint32_t>(asset.capsules.size()), 0);
   ClothColliders hit;
   hit.hulls = &colliders;
   hit.shapes = &shapes;
@@ -76,6 +77,7 @@ std::vector<Float3> RunCpp(uint32_t* contacts) {
     shapes.Clear();
     EXPECT_TRUE(shapes.AddPlane(Mat34{}, Mat34{}).ok());
     EXPECT_TRUE(shapes.AddCapsule(staff_start, staff_end, 0.3f, 0.03f, 0.03f).ok());
+    EXPECT_TRUE(AddCapsuleColliders(asset.capsules, start, end, &shapes).ok());
     ClothStepStats stats;
     EXPECT_TRUE(solver.Step(&state, hit, {dt, start, end}, &stats).ok());
     *contacts = stats.contacts;
@@ -172,6 +174,9 @@ TEST(CApi, BadInputGetsAStatusAndAMessage) {
   ASSERT_EQ(drape_shapes_create(1, &shapes), DRAPE_OK);
   EXPECT_EQ(drape_shapes_add_sphere(shapes, shear, shear, 0.1f), DRAPE_INVALID_ARGUMENT);
   EXPECT_EQ(drape_shapes_add_sphere(shapes, nullptr, shear, 0.1f), DRAPE_INVALID_ARGUMENT);
+  EXPECT_EQ(drape_shapes_add_asset_capsules(shapes, asset, nullptr, shear),
+            DRAPE_INVALID_ARGUMENT);
+  EXPECT_EQ(drape_asset_capsule_count(nullptr), 0u);
   drape_shapes_destroy(shapes);
   drape_cloth_destroy(cloth);
   drape_pose_destroy(pose);

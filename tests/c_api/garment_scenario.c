@@ -94,7 +94,8 @@ int scenario_run(const char* asset_path, int frames, float* out_positions, uint3
   drape_status status = drape_asset_load(asset_path, &s.asset);
   if (status == DRAPE_OK) status = drape_pose_create(s.asset, &s.pose);
   if (status == DRAPE_OK) status = drape_colliders_create(s.asset, &s.colliders);
-  if (status == DRAPE_OK) status = drape_shapes_create(2, &s.shapes);
+  if (status == DRAPE_OK)
+    status = drape_shapes_create(2 + drape_asset_capsule_count(s.asset), &s.shapes);
   float root[12];
   if (status == DRAPE_OK) status = drape_asset_bind_matrix(s.asset, 0, root);
   if (status == DRAPE_OK) status = create_cloth(&s, root);
@@ -129,6 +130,7 @@ int scenario_run(const char* asset_path, int frames, float* out_positions, uint3
     status = drape_shapes_add_plane(s.shapes, floor, floor);
     if (status == DRAPE_OK)
       status = drape_shapes_add_capsule(s.shapes, staff_start, staff_end, 0.3f, 0.03f, 0.03f);
+    if (status == DRAPE_OK) status = drape_shapes_add_asset_capsules(s.shapes, s.asset, start, end);
     if (status == DRAPE_OK)
       status = drape_cloth_step(s.cloth, dt, start, end, joints, s.colliders, s.shapes, &stats);
     memcpy(start, end, sizeof(float) * 12 * joints);

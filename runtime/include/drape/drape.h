@@ -111,6 +111,13 @@ drape_status drape_shapes_add_plane(drape_shapes* shapes, const float start[12],
                                     const float end[12]);
 drape_status drape_shapes_add_box(drape_shapes* shapes, const float start[12], const float end[12],
                                   const float half_extents[3]);
+/* The asset's baked tapered capsules (one per bone that carries skin), posed by the skinning
+ * matrices at the frame's start and end (joint_count * 12 floats each, e.g. drape_pose_skinning):
+ * drape_asset_capsule_count() shapes more. */
+uint32_t drape_asset_capsule_count(const drape_asset* asset);
+drape_status drape_shapes_add_asset_capsules(drape_shapes* shapes, const drape_asset* asset,
+                                             const float* skinning_start,
+                                             const float* skinning_end);
 
 /* ---- Cloth: a garment, its solver and its state ------------------------------------------------
  */

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "drape/formats/asset_file.h"
+#include "drape/runtime/capsule_colliders.h"
 #include "drape/runtime/cloth.h"
 #include "drape/runtime/cloth_solver.h"
 #include "drape/runtime/hull_collider_set.h"
@@ -321,6 +322,23 @@ drape_status drape_shapes_add_capsule(drape_shapes* shapes, const float start[12
   return Guarded("drape_shapes_add_capsule", [&] {
     return FromStatus(
         shapes->shapes.AddCapsule(AsMatrix(start), AsMatrix(end), half_length, radius0, radius1));
+  });
+}
+
+uint32_t drape_asset_capsule_count(const drape_asset* asset) {
+  return asset == nullptr ? 0 : static_cast<uint32_t>(asset->asset.capsules.size());
+}
+
+drape_status drape_shapes_add_asset_capsules(drape_shapes* shapes, const drape_asset* asset,
+                                             const float* skinning_start,
+                                             const float* skinning_end) {
+  if (shapes == nullptr || asset == nullptr || skinning_start == nullptr || skinning_end == nullptr)
+    return Null("drape_shapes_add_asset_capsules", "shapes, asset, skinning_start or skinning_end");
+  const uint32_t joints = asset->asset.skeleton.joint_count();
+  return Guarded("drape_shapes_add_asset_capsules", [&] {
+    return FromStatus(
+        drape::AddCapsuleColliders(asset->asset.capsules, AsMatrices(skinning_start, joints),
+                                   AsMatrices(skinning_end, joints), &shapes->shapes));
   });
 }
 
