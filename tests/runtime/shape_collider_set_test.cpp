@@ -653,6 +653,20 @@ TEST(ShapeColliderSetTest, BakedCapsulesFollowTheirBone) {
   EXPECT_GE(Distance3(positions[0], middle), 0.05 - 1e-5);
   EXPECT_LT(Distance3(positions[0], middle), 0.05 + 0.005);
 
+  // A capsule a hair off its bone's y axis (the bone's y column nearly along the capsule): its
+  // frame stays rigid (the cancellation once left it 1e-3 off orthogonal on a posed mannequin).
+  CapsuleColliderData skewed = capsule;
+  for (float off : {2e-5f, 4e-6f, 1.5e-6f, 8e-7f}) {
+    skewed.to = {off, 0.4f, off};
+    for (double degrees : {0.0, 33.0, 90.0, 147.0}) {
+      const std::vector<Mat34> posed = {Mat34{},
+                                        Pose({0.3f, 1.f, 0.f}, {0.2f, 0.5f, 1.f}, degrees)};
+      ShapeColliderSet one;
+      const Status s = AddCapsuleColliders(std::span(&skewed, 1), posed, posed, &one);
+      EXPECT_TRUE(s.ok()) << off << " " << degrees << ": " << s.message();
+    }
+  }
+
   CapsuleColliderData ball = capsule;
   ball.to = ball.from;
   float half_length = 1.f;

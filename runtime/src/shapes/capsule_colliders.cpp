@@ -10,11 +10,16 @@ namespace {
 
 Float3 Column(const Mat34& m, int c) { return {m.m[c], m.m[4 + c], m.m[8 + c]}; }
 
-// The part of v normal to the unit x, normalised; zero when v is (nearly) along x.
+// The part of v normal to the unit x, normalised (Gram-Schmidt twice, so that it is orthogonal
+// to x to float precision); zero when v lies within 30 degrees of x, where the cancellation would
+// leave it visibly off (one of two orthonormal columns is always 45 degrees or more from x).
 Float3 NormalPart(Float3 v, Float3 x) {
-  const Float3 n = v - x * Dot(v, x);
+  Float3 n = v - x * Dot(v, x);
   const float length = Length(n);
-  return length > 1e-6f * std::max(Length(v), 1e-30f) ? n * (1.f / length) : Float3{};
+  if (!(length > 0.5f * Length(v))) return Float3{};
+  n = n * (1.f / length);
+  n = n - x * Dot(n, x);
+  return n * (1.f / Length(n));
 }
 
 }  // namespace
