@@ -174,8 +174,7 @@ TEST(CApi, BadInputGetsAStatusAndAMessage) {
   ASSERT_EQ(drape_shapes_create(1, &shapes), DRAPE_OK);
   EXPECT_EQ(drape_shapes_add_sphere(shapes, shear, shear, 0.1f), DRAPE_INVALID_ARGUMENT);
   EXPECT_EQ(drape_shapes_add_sphere(shapes, nullptr, shear, 0.1f), DRAPE_INVALID_ARGUMENT);
-  EXPECT_EQ(drape_shapes_add_asset_capsules(shapes, asset, nullptr, shear),
-            DRAPE_INVALID_ARGUMENT);
+  EXPECT_EQ(drape_shapes_add_asset_capsules(shapes, asset, nullptr, shear), DRAPE_INVALID_ARGUMENT);
   EXPECT_EQ(drape_asset_capsule_count(nullptr), 0u);
   drape_shapes_destroy(shapes);
   drape_cloth_destroy(cloth);
