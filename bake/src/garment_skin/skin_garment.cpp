@@ -54,14 +54,17 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
     detail::SmoothSkinWeights(d.triangles, g.skin_smoothing, &d.skin);
   }
   const size_t n = d.positions.size();
-  d.skin_bind_positions.assign(n, Float3{});
-  if (file_skin) d.skin_bind_positions = garment->file_bind_positions;  // exact, from the file
-  for (size_t i = 0; i < n && !file_skin; ++i) {
-    const ClothSkinWeights& w = d.skin[i];
-    for (int k = 0; k < 4; ++k)
-      if (w.weights[k] > 0.f)
-        d.skin_bind_positions[i] +=
-            TransformPoint(garment->frame_to_bind[w.joints[k]], d.positions[i]) * w.weights[k];
+  if (file_skin) {
+    d.skin_bind_positions = garment->file_bind_positions;  // exact, from the file's binding
+  } else {  // each joint's frame -> bind, blended as the runtime skins
+    d.skin_bind_positions.assign(n, Float3{});
+    for (size_t i = 0; i < n; ++i) {
+      const ClothSkinWeights& w = d.skin[i];
+      for (int k = 0; k < 4; ++k)
+        if (w.weights[k] > 0.f)
+          d.skin_bind_positions[i] +=
+              TransformPoint(garment->frame_to_bind[w.joints[k]], d.positions[i]) * w.weights[k];
+    }
   }
   d.max_distance.assign(n, g.max_distance);
   d.backstop.assign(n, g.backstop);
