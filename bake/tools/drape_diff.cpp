@@ -255,7 +255,7 @@ void CompareColliders(const CharacterAsset& a, const CharacterAsset& b, Report* 
   CompareCapsules(a, b, r);
 }
 
-// The slab of the texel of `c` whose square holds (x, y) (asset frame, metres); false outside
+// The slab of the texel of `c` whose square holds (x', y') (view frame, metres); false outside
 // the grid or on background.
 bool SlabAt(const drape::BodyMapCollider& c, double x, double y, float* top, float* bottom) {
   const double u = (x - c.origin_x()) / c.texel_size(), v = (y - c.origin_y()) / c.texel_size();
@@ -290,6 +290,11 @@ void SampleMaps(const drape::BodyMapCollider& from, const drape::BodyMapCollider
 // One pose: the front and back depths where both maps cover, and the coverage either has alone.
 void CompareMapPose(const std::string& name, const drape::BodyMapPose& pa,
                     const drape::BodyMapPose& pb, Report* r) {
+  if (pa.view_axis != pb.view_axis) {  // texels of different frames: nothing to sample
+    r->Structural(name + ": seen along " + drape::BodyMapViewAxisName(pa.view_axis) + " vs " +
+                  drape::BodyMapViewAxisName(pb.view_axis));
+    return;
+  }
   drape::BodyMapCollider a, b;
   if (!a.Build(pa).ok() || !b.Build(pb).ok()) {
     r->Structural(name + ": does not decode");

@@ -52,7 +52,7 @@ void Measurement::MeasureFollowingMaps(const Context& context, const bake::Chara
   const std::vector<Mat34> rest_skinning(pose.skinning().begin(), pose.skinning().end());
 
   // The rest pose's maps, as a default bake holds them.
-  const bake::BodyMapOptions o = BodyMapOptionsFor(MapSetting{});
+  const bake::BodyMapOptions o = BodyMapOptionsFor(MapSetting{}, view_axis_);
   BodyMapPose rest_maps;
   bake::BodyMapPoseStats stats;
   if (!bake::BakeBodyMapPose(rest, triangles, o, &rest_maps, &stats).ok())
@@ -67,6 +67,7 @@ void Measurement::MeasureFollowingMaps(const Context& context, const bake::Chara
   render.epsilon = o.epsilon;
   render.grid_x = rest_maps.origin_x;
   render.grid_y = rest_maps.origin_y;
+  render.view_axis = rest_maps.view_axis;
   BodyMapRenderer renderer;
   BodyMapCollider rendered;
   if (!renderer.Init(character.mesh, render).ok()) Fail(label + ": cannot set up the renderer");

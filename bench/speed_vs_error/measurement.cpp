@@ -96,6 +96,17 @@ void Measurement::RunCharacter(const CharacterSpec& spec) {
 
   if (options_.dump_maps) DumpMotions(options_.out_dir, spec, context.sets.back());
 
+  // The maps' view axis a default bake picks, for this character's rest and posed runs.
+  bake::ViewAxisChoice choice;
+  if (!bake::ChooseBodyMapViewAxis(positions, triangles, BodyMapOptionsFor(MapSetting{}, {}),
+                                   &choice)
+           .ok()) {
+    Fail(spec.label + ": cannot choose the maps' view axis");
+  }
+  view_axis_ = choice.axis;
+  std::printf("%s: maps seen along %s (inside %.2f / %.2f / %.2f litres along x / y / z)\n",
+              spec.label.c_str(), BodyMapViewAxisName(view_axis_), choice.inside_volume[1] * 1e3,
+              choice.inside_volume[2] * 1e3, choice.inside_volume[0] * 1e3);
   std::unique_ptr<Method> default_maps = MeasureRestMaps(context, positions, triangles);
   const HullAssets for_posed =
       MeasureRestHulls(context, import, regions.rest_skinning, std::move(default_maps));
@@ -115,8 +126,15 @@ std::unique_ptr<Method> Measurement::MeasureRestMaps(const Context& context,
                                                      const std::vector<uint32_t>& triangles) {
   const CharacterSpec& spec = context.spec;
   std::unique_ptr<Method> default_maps;
-  for (const MapSetting& m : MapSweep(options_.quick)) {
-    const bake::BodyMapOptions o = BodyMapOptionsFor(m);
+  std::vector<MapSetting> sweep = MapSweep(options_.quick);
+  if (view_axis_ != BodyMapViewAxis::kZ) {  // the default setting along paper A's axis
+    MapSetting z;
+    z.resolution = options_.quick ? 512u : 1024u;
+    z.z_view = true;
+    sweep.push_back(z);
+  }
+  for (const MapSetting& m : sweep) {
+    const bake::BodyMapOptions o = BodyMapOptionsFor(m, view_axis_);
     BodyMapPose pose;
     bake::BodyMapPoseStats stats;
     const Status baked = bake::BakeBodyMapPose(positions, triangles, o, &pose, &stats);
@@ -125,7 +143,7 @@ std::unique_ptr<Method> Measurement::MeasureRestMaps(const Context& context,
     Measure(context, *MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes, m.lanes));
     const bool combo = m.sampling == DepthSampling::kBilinear && !m.fitted && m.epsilon == 0.005f &&
                        m.depth == DepthEncoding::kUnorm16 && m.normals == NormalEncoding::kOct16 &&
-                       m.resolution == (options_.quick ? 512u : 1024u);
+                       m.resolution == (options_.quick ? 512u : 1024u) && !m.z_view;
     if (combo) default_maps = MakeBodyMapMethod(pose, m.sampling, Describe(m), stats.bytes);
   }
   return default_maps;
@@ -280,7 +298,7 @@ void Measurement::RunPosedAt(const CharacterSpec& spec, const bake::Character& c
         m.lanes != InstructionSet::kAvx2) {
       continue;
     }
-    const bake::BodyMapOptions o = BodyMapOptionsFor(m);
+    const bake::BodyMapOptions o = BodyMapOptionsFor(m, view_axis_);
     BodyMapPose map;
     bake::BodyMapPoseStats stats;
     if (!bake::BakeBodyMapPose(positions, triangles, o, &map, &stats).ok()) {

@@ -83,6 +83,7 @@ class Measurement {
   void ClothSolvers(const CharacterSpec& spec, const bake::ImportOptions& import);
 
   const Options& options_;
+  BodyMapViewAxis view_axis_ = BodyMapViewAxis::kZ;  // the character's least-air axis
   std::vector<Row> rows_;
   // Query-set contracts the mesh does not confirm, and humans measured taller than kTallestHuman.
   std::vector<std::string> set_violations_;

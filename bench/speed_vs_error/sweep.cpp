@@ -13,6 +13,7 @@ std::string Describe(const MapSetting& m) {
   s << "N=" << m.resolution << (m.sampling == DepthSampling::kBilinear ? " bilinear" : " nearest");
   if (m.fitted) s << " fitted";
   if (m.layers != 1) s << " layers=" << int(m.layers);
+  if (m.z_view) s << " z-view";
   if (m.lanes == InstructionSet::kSse2) s << " SSE2 lanes";
   if (m.lanes == InstructionSet::kScalar) s << " scalar lanes";
   if (m.epsilon != 0.005f) s << " eps=" << m.epsilon * 1000.f << "mm";
@@ -25,8 +26,9 @@ std::string Describe(const MapSetting& m) {
   return s.str();
 }
 
-bake::BodyMapOptions BodyMapOptionsFor(const MapSetting& m) {
+bake::BodyMapOptions BodyMapOptionsFor(const MapSetting& m, BodyMapViewAxis least_air_axis) {
   bake::BodyMapOptions o;
+  o.view_axis = m.z_view ? BodyMapViewAxis::kZ : least_air_axis;
   o.resolution = m.resolution;
   o.fitted_window = m.fitted;
   o.epsilon = m.epsilon;

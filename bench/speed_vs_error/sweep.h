@@ -25,14 +25,18 @@ struct MapSetting {
   NormalEncoding normals = NormalEncoding::kOct16;
   uint8_t layers = 1;                            // the slab plus layers - 1 air gaps per texel
   InstructionSet lanes = InstructionSet::kAvx2;  // the widest CollideBatch may use (kNearest)
+  // Seen along z whatever the character's least-air axis (the one a default bake picks, which
+  // every other setting uses): paper A's view, for comparison.
+  bool z_view = false;
 };
 
 // The setting as the report names it: N and the sampling, then what differs from paper A's
 // window, epsilon 5 mm, one layer, the widest lanes, unorm16 depth and oct16 normals.
 std::string Describe(const MapSetting& m);
 
-// The bake options of a setting (everything else at the bake's defaults).
-bake::BodyMapOptions BodyMapOptionsFor(const MapSetting& m);
+// The bake options of a setting (everything else at the bake's defaults), seen along
+// `least_air_axis` unless the setting says z.
+bake::BodyMapOptions BodyMapOptionsFor(const MapSetting& m, BodyMapViewAxis least_air_axis);
 
 // The rest pose's body-map settings, in the order they are measured.
 std::vector<MapSetting> MapSweep(bool quick);

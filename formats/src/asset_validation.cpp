@@ -256,7 +256,10 @@ bool CheckBodyMapPose(const BodyMapPose& pose, const std::string& at, size_t cli
                    "is unknown") ||
         !c.Require(pose.layers >= 1 && pose.layers <= kMaxBodyMapLayers, at + ".layers",
                    "= " + std::to_string(pose.layers) + " is not in [1, " +
-                       std::to_string(kMaxBodyMapLayers) + "]"))
+                       std::to_string(kMaxBodyMapLayers) + "]") ||
+        !c.Require(static_cast<uint8_t>(pose.view_axis) <= 2, at + ".view_axis",
+                   "= " + std::to_string(static_cast<int>(pose.view_axis)) +
+                       " is not 0 (z), 1 (x) or 2 (y)"))
       return false;
     // The span table before any array size that depends on it (row spans: the spans' total).
     if (const std::string problem = CheckBodyMapLayout(pose); !problem.empty()) {
@@ -317,7 +320,12 @@ void CheckBodyMaps(const BodyMapSet& set, size_t clips, Checker& c) {
                  "is negative or not finite"))
     return;
   for (size_t p = 0; p < set.poses.size(); ++p) {
-    if (!CheckBodyMapPose(set.poses[p], "body_maps.poses[" + std::to_string(p) + "]", clips, c))
+    const std::string at = "body_maps.poses[" + std::to_string(p) + "]";
+    if (!CheckBodyMapPose(set.poses[p], at, clips, c)) return;
+    // One view frame for the set: a clip's poses blend texel by texel.
+    if (!c.Require(set.poses[p].view_axis == set.poses[0].view_axis, at + ".view_axis",
+                   std::string("is ") + BodyMapViewAxisName(set.poses[p].view_axis) +
+                       ", pose 0's is " + BodyMapViewAxisName(set.poses[0].view_axis)))
       return;
   }
 }
@@ -532,6 +540,7 @@ BodyMapPose CopyHeader(const BodyMapPose& in, BodyMapLayout layout) {
   out.normal_encoding = in.normal_encoding;
   out.layout = layout;
   out.layers = in.layers;
+  out.view_axis = in.view_axis;
   return out;
 }
 
@@ -660,6 +669,18 @@ BodyMapPose PackRowSpans(const BodyMapPose& dense) {
 }
 
 }  // namespace
+
+const char* BodyMapViewAxisName(BodyMapViewAxis axis) {
+  switch (axis) {
+    case BodyMapViewAxis::kZ:
+      return "z";
+    case BodyMapViewAxis::kX:
+      return "x";
+    case BodyMapViewAxis::kY:
+      return "y";
+  }
+  return "unknown";
+}
 
 size_t BodyMapStoredTexels(const BodyMapPose& pose) {
   if (pose.layout == BodyMapLayout::kDense) return static_cast<size_t>(pose.width) * pose.height;

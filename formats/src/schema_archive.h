@@ -233,17 +233,22 @@ void serialize(Archive& ar, MeshData& m, const uint32_t version) {
 // Version 1 (format version 1): always dense, no layout field and no span table. Version 2
 // (format version 2): `layout` and the span table follow normal_encoding. Version 3 (format
 // version 3): `layers` (uint8) follows `layout`, before the span table, and `gap_texels`
-// follows the span table. Writing is always
-// version 3; a version-1 pose loads as dense with an empty span table, and versions 1 and 2
-// load with one layer. Format version N holds exactly class version min(N, 3) (what its writer
-// wrote; format version 4 changed HullColliderData only): a newer class in an older format is
-// impossible, an older one in a newer format is a forgery that would not re-encode to the same
-// bytes.
+// follows the span table. Version 4 (format version 7): `view_axis` (uint8) follows `layers`.
+// Writing is always version 4; a version-1 pose loads as dense with an empty span table,
+// versions 1 and 2 load with one layer, versions 1 to 3 with view axis z. Format version N holds
+// exactly class version min(N, 3) up to 6 and 4 from 7 on (what its writer wrote; format
+// versions 4 to 6 changed other classes): a newer class in an older format is impossible, an
+// older one in a newer format is a forgery that would not re-encode to the same bytes.
+inline uint32_t BodyMapPoseVersionOfFormat(uint32_t format_version) {
+  return format_version >= 7 ? 4u : std::min(format_version, 3u);
+}
+
 template <class Archive>
 void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
-  detail::CheckVersionRange(version, 1, 3, "BodyMapPose");
+  detail::CheckVersionRange(version, 1, 4, "BodyMapPose");
   if constexpr (Archive::is_loading::value) {
-    if (detail::g_format_version != 0 && version != std::min(detail::g_format_version, 3u)) {
+    if (detail::g_format_version != 0 &&
+        version != BodyMapPoseVersionOfFormat(detail::g_format_version)) {
       throw DecodeError("BodyMapPose version " + std::to_string(version) + " in a format version " +
                         std::to_string(detail::g_format_version) + " file");
     }
@@ -262,6 +267,11 @@ void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
     } else {
       p.layers = 1;
     }
+    if (version >= 4) {
+      ar(cereal::make_nvp("view_axis", p.view_axis));
+    } else {
+      p.view_axis = BodyMapViewAxis::kZ;
+    }
     Array(ar, "row_span_offsets", p.row_span_offsets);
     Array(ar, "span_begin", p.span_begin);
     Array(ar, "span_texel_offsets", p.span_texel_offsets);
@@ -273,6 +283,7 @@ void serialize(Archive& ar, BodyMapPose& p, const uint32_t version) {
   } else {
     p.layout = BodyMapLayout::kDense;
     p.layers = 1;
+    p.view_axis = BodyMapViewAxis::kZ;
     p.gap_texels.clear();
     p.row_span_offsets.clear();
     p.span_begin.clear();
@@ -408,7 +419,8 @@ CEREAL_CLASS_VERSION(drape::AssetInfo, 1)
 CEREAL_CLASS_VERSION(drape::SkeletonData, 1)
 CEREAL_CLASS_VERSION(drape::ClipData, 1)
 CEREAL_CLASS_VERSION(drape::MeshData, 1)
-CEREAL_CLASS_VERSION(drape::BodyMapPose, 3)  // 2: layout, spans (format 2); 3: layers (format 3)
+// 2: layout, spans (format 2); 3: layers (format 3); 4: view axis (format 7)
+CEREAL_CLASS_VERSION(drape::BodyMapPose, 4)
 CEREAL_CLASS_VERSION(drape::BodyMapSet, 1)
 CEREAL_CLASS_VERSION(drape::BoneMapData, 1)
 CEREAL_CLASS_VERSION(drape::BoneMapSet, 1)

@@ -162,7 +162,8 @@ std::string JsonSummary(const drape::CharacterAsset& a, const Placement& place,
       << ", \"width\": " << pose.width << ", \"height\": " << pose.height
       << ", \"texel_size_mm\": " << pose.texel_size * 1000.f << ", \"depth\": \""
       << DepthName(pose.depth_encoding) << "\", \"normal\": \"" << NormalName(pose.normal_encoding)
-      << "\", \"layers\": " << int(pose.layers) << ", \"bytes\": " << PoseBytes(pose) << "}";
+      << "\", \"layers\": " << int(pose.layers) << ", \"view_axis\": \""
+      << BodyMapViewAxisName(pose.view_axis) << "\", \"bytes\": " << PoseBytes(pose) << "}";
   }
   o << "]},\n  \"hulls\": [";
   for (size_t h = 0; h < a.hulls.size(); ++h) {
@@ -229,11 +230,11 @@ void PrintText(const drape::CharacterAsset& a, const Placement& place, const std
               a.body_maps.epsilon * 1000.f);
   for (const auto& pose : a.body_maps.poses) {
     std::printf(
-        "    clip %d t=%.3f s: %ux%u texels of %.2f mm, depth %s, normals %s, %d layer(s), %zu "
-        "bytes\n",
+        "    clip %d t=%.3f s: %ux%u texels of %.2f mm along %s, depth %s, normals %s, %d "
+        "layer(s), %zu bytes\n",
         pose.clip, pose.time, pose.width, pose.height, pose.texel_size * 1000.f,
-        DepthName(pose.depth_encoding), NormalName(pose.normal_encoding), int(pose.layers),
-        PoseBytes(pose));
+        BodyMapViewAxisName(pose.view_axis), DepthName(pose.depth_encoding),
+        NormalName(pose.normal_encoding), int(pose.layers), PoseBytes(pose));
   }
   std::printf("  bone maps: %zu (epsilon %.1f mm)\n", a.bone_maps.maps.size(),
               a.bone_maps.epsilon * 1000.f);

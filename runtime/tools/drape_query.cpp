@@ -176,6 +176,7 @@ drape::Status PoseMaps(const drape::CharacterAsset& asset, const drape::Skeleton
     options.epsilon = asset.body_maps.epsilon;
     options.grid_x = baked.origin_x;
     options.grid_y = baked.origin_y;
+    options.view_axis = baked.view_axis;
   }
   drape::BodyMapRenderer renderer;
   if (drape::Status s = renderer.Init(asset.mesh, options); !s.ok()) return s;

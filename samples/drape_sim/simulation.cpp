@@ -324,6 +324,7 @@ Status SceneSimulation::InitRenderedMaps(const CharacterAsset& asset) {
   options.epsilon = asset.body_maps.epsilon;
   options.grid_x = rest.origin_x;
   options.grid_y = rest.origin_y;
+  options.view_axis = rest.view_axis;
   options.sampling = scene_->maps_sampling;
   if (Status s = renderer_.Init(asset.mesh, options); !s.ok())
     return Status(s.code(), where + "rendered maps: " + s.message());

@@ -1,6 +1,7 @@
 // The body-map camera: the near and far planes enclose the offset surface a margin away (nothing
 // clipped), the back map is seen from behind without mirroring, the fitted window spends the same
-// texel budget on smaller texels, and triangles sharing edges leave no crack in the coverage.
+// texel budget on smaller texels, triangles sharing edges leave no crack in the coverage, and the
+// view axis is the one whose slab holds the least air.
 
 #include <gtest/gtest.h>
 
@@ -179,6 +180,60 @@ TEST(BodyMapBaker, SharedEdgesLeaveNoCracks) {
   }
   EXPECT_GT(inside, size_t(0.9 * side * side / (t * t)));
   EXPECT_EQ(stats.silhouette_conflicts, 0u);
+}
+
+// A four-legged table, 0.8 m long along `length`, legs 0.3 m down along -`up` (the other axis
+// is its width): a quadruped's air under the belly, in any orientation.
+Mesh Table(int length, int up) {
+  const int width = 3 - length - up;
+  const auto box = [&](double l0, double l1, double u0, double u1, double w0, double w1) {
+    double lo[3], hi[3];
+    lo[length] = l0, hi[length] = l1, lo[up] = u0, hi[up] = u1, lo[width] = w0, hi[width] = w1;
+    return std::pair<Vec3d, Vec3d>{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+  };
+  Mesh m;
+  const auto add = [&](std::pair<Vec3d, Vec3d> b) { AddSplitBox(&m, b.first, b.second); };
+  add(box(-0.4, 0.4, 0.0, 0.1, -0.15, 0.15));  // the top
+  for (double l : {-0.38, 0.32})
+    for (double w : {-0.13, 0.07}) add(box(l, l + 0.06, -0.3, 0.0, w, w + 0.06));
+  return m;
+}
+
+TEST(BodyMapBaker, TheViewAxisIsTheOneWithTheLeastAirInItsSlab) {
+  BodyMapOptions options;
+  options.resolution = 256;
+  const BodyMapViewAxis axes[3] = {BodyMapViewAxis::kX, BodyMapViewAxis::kY, BodyMapViewAxis::kZ};
+  for (int length = 0; length < 3; ++length) {
+    for (int up = 0; up < 3; ++up) {
+      if (up == length) continue;
+      SCOPED_TRACE("length along " + std::to_string(length) + ", up along " + std::to_string(up));
+      const Mesh table = Table(length, up);
+      ViewAxisChoice choice;
+      ASSERT_TRUE(ChooseBodyMapViewAxis(table.positions, table.triangles, options, &choice).ok());
+      // Seen along `up` the slab holds the table and nothing else; along its length, the air
+      // between the legs; across it, the air between near and far legs.
+      EXPECT_EQ(choice.axis, axes[up]);
+      const double body = 0.8 * 0.1 * 0.3 + 4 * 0.06 * 0.3 * 0.06;  // m^3
+      const double along_up = choice.inside_volume[static_cast<int>(axes[up])];
+      EXPECT_GT(along_up, body);
+      EXPECT_LT(along_up, 1.25 * body);  // the 5 mm offset skin, no air
+      const double along_length = choice.inside_volume[static_cast<int>(axes[length])];
+      EXPECT_GT(along_length, along_up + 0.5 * 0.3 * 0.06 * 0.64);  // the air under the top
+      // The maps baked along the chosen axis see no body under the top between the legs.
+      BodyMapOptions chosen = options;
+      chosen.view_axis = choice.axis;
+      BodyMapPose pose;
+      ASSERT_TRUE(BakeBodyMapPose(table.positions, table.triangles, chosen, &pose).ok());
+      EXPECT_EQ(pose.view_axis, choice.axis);
+      BodyMapCollider maps;
+      ASSERT_TRUE(maps.Build(pose).ok());
+      double under[3] = {0.0, 0.0, 0.0}, in_top[3] = {0.0, 0.0, 0.0};
+      under[up] = -0.15;
+      in_top[up] = 0.05;
+      EXPECT_FALSE(maps.IsInside({float(under[0]), float(under[1]), float(under[2])}));
+      EXPECT_TRUE(maps.IsInside({float(in_top[0]), float(in_top[1]), float(in_top[2])}));
+    }
+  }
 }
 
 }  // namespace

@@ -60,6 +60,7 @@ void FixPayloadSize(std::vector<uint8_t>& bytes) {
 // under an older header is refused naming both, and the older class version reads without them.
 TEST(AssetFile, CapsulesNeedFormatVersion6) {
   CharacterAsset small = SmallAsset();
+  small.body_maps.poses.clear();  // a format 7 pose would be refused first under format 5
   small.capsules.push_back({0, {0.f, 0.1f, 0.f}, {0.f, 0.4f, 0.f}, 0.05f, 0.04f});
   std::vector<uint8_t> bytes = Encode(small);
   CharacterAsset out;
@@ -95,6 +96,7 @@ TEST(AssetFile, CapsulesNeedFormatVersion6) {
 // under an older header is refused naming both, and the older class version reads without them.
 TEST(AssetFile, BoneMapsNeedFormatVersion5) {
   CharacterAsset small = SmallAsset();
+  small.body_maps.poses.clear();  // a format 7 pose would be refused first under format 4
   std::vector<uint8_t> bytes = Encode(small);
   bytes[8] = 4;
   FixChecksums(bytes);
@@ -118,13 +120,13 @@ TEST(AssetFile, BoneMapsNeedFormatVersion5) {
 // header is refused, and an older class version of BodyMapPose is read as dense with one layer
 // (the golden files).
 TEST(BodyMapLayout, FormatVersion1HoldsOnlyDensePoses) {
-  std::vector<uint8_t> bytes = Encode(SmallAsset());  // BodyMapPose version 3
+  std::vector<uint8_t> bytes = Encode(SmallAsset());  // BodyMapPose version 4
   bytes[8] = 1;
   FixChecksums(bytes);
   CharacterAsset out;
   Status s = DecodeAsset(bytes, "v1.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_NE(s.message().find("BodyMapPose version 3 in a format version 1 file"), std::string::npos)
+  EXPECT_NE(s.message().find("BodyMapPose version 4 in a format version 1 file"), std::string::npos)
       << s.message();
   // mannequin_v2.drape holds a BodyMapPose version 2: under a version 1 header it is refused too.
   bytes = ReadBytes(test::GoldenDir() + "/mannequin_v2.drape");
@@ -164,6 +166,60 @@ void ExpectPoseVersionRefused(std::vector<uint8_t> bytes, uint32_t format_versio
   EXPECT_TRUE(out.body_maps.poses.empty());
 }
 
+// Where SmallAsset's pose starts in its encoding: class version 4, clip -1, time 0, width 2,
+// height 2 (the pose's first fields).
+size_t PoseStart(const std::vector<uint8_t>& bytes) {
+  // clang-format off
+  const std::vector<uint8_t> start = {4, 0, 0, 0,  0xFF, 0xFF, 0xFF, 0xFF,  0, 0, 0, 0,
+                                      2, 0, 0, 0,  2, 0, 0, 0};
+  // clang-format on
+  const auto found = std::search(bytes.begin(), bytes.end(), start.begin(), start.end());
+  EXPECT_NE(found, bytes.end());
+  return static_cast<size_t>(found - bytes.begin());
+}
+
+// The view axis arrived with format version 7 (BodyMapPose class version 4, one byte after
+// `layers`): a format 6 file reads with view axis z, a class version 3 pose under a format 7
+// header is refused, and an unknown axis or a set of mixed axes is refused naming the field.
+TEST(BodyMapViewAxis, ArrivedWithFormatVersion7) {
+  CharacterAsset small = SmallAsset();
+  small.hulls.clear();
+  small.body_maps.poses[0].view_axis = BodyMapViewAxis::kY;
+  std::vector<uint8_t> bytes = Encode(small);
+  CharacterAsset out;
+  ASSERT_TRUE(DecodeAsset(bytes, "v7.drape", &out).ok());
+  EXPECT_EQ(out.body_maps.poses[0].view_axis, BodyMapViewAxis::kY);
+  const size_t axis_at = PoseStart(bytes) + 4 + 36 + 2 + 1 + 1;
+  ASSERT_EQ(bytes[axis_at], 2);
+  // An unknown axis: corrupt, naming the field.
+  std::vector<uint8_t> bad = bytes;
+  bad[axis_at] = 3;
+  FixChecksums(bad);
+  Status s = DecodeAsset(bad, "axis.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(),
+            "axis.drape: body_maps.poses[0].view_axis = 3 is not 0 (z), 1 (x) or 2 (y)");
+  // As format 6 wrote it: class version 3, no axis byte; it reads as z.
+  std::vector<uint8_t> v6 = bytes;
+  v6[PoseStart(v6)] = 3;
+  v6.erase(v6.begin() + static_cast<std::ptrdiff_t>(axis_at));
+  const uint64_t payload = v6.size() - kAssetHeaderSize;
+  for (int i = 0; i < 8; ++i) v6[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
+  v6[8] = 6;
+  FixChecksums(v6);
+  s = DecodeAsset(v6, "v6.drape", &out);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(out.body_maps.poses[0].view_axis, BodyMapViewAxis::kZ);
+  small.body_maps.poses[0].view_axis = BodyMapViewAxis::kZ;
+  EXPECT_EQ(AssetToJson(out), AssetToJson(small));
+  ExpectPoseVersionRefused(v6, 7, 3);
+  // Poses of one set share the axis.
+  CharacterAsset mixed = SmallAsset();
+  mixed.body_maps.poses.push_back(mixed.body_maps.poses[0]);
+  mixed.body_maps.poses[1].view_axis = BodyMapViewAxis::kX;
+  EXPECT_EQ(ValidateAsset(mixed).message(), "body_maps.poses[1].view_axis is x, pose 0's is z");
+}
+
 // Files of format versions 1 and 2 load with one layer; a BodyMapPose version 3 cannot be in
 // them.
 TEST(BodyMapLayers, OlderFormatsLoadWithOneLayerAndCannotHoldLayers) {
@@ -176,7 +232,7 @@ TEST(BodyMapLayers, OlderFormatsLoadWithOneLayerAndCannotHoldLayers) {
   ASSERT_TRUE(DecodeAsset(Encode(v2), "v3.drape", &again).ok());
   EXPECT_EQ(AssetToJson(again), AssetToJson(v2));
   // A version 3 pose under a format version 2 header.
-  ExpectPoseVersionRefused(Encode(LayeredAsset()), 2, 3);
+  ExpectPoseVersionRefused(Encode(LayeredAsset()), 2, 4);
 }
 
 // A format version holds exactly its own BodyMapPose version. SmallAsset's pose rewritten as
@@ -188,19 +244,15 @@ TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
   CharacterAsset small = SmallAsset();
   small.hulls.clear();
   std::vector<uint8_t> bytes = Encode(small);
-  // Class version 3, clip -1, time 0, width 2, height 2 (the pose's first fields).
-  // clang-format off
-  const std::vector<uint8_t> start = {3, 0, 0, 0,  0xFF, 0xFF, 0xFF, 0xFF,  0, 0, 0, 0,
-                                      2, 0, 0, 0,  2, 0, 0, 0};
-  // clang-format on
-  const auto found = std::search(bytes.begin(), bytes.end(), start.begin(), start.end());
-  ASSERT_NE(found, bytes.end());
-  const size_t pose = static_cast<size_t>(found - bytes.begin());
-  // 4 class version, 36 of clip .. depth_range, 2 encodings, 1 layout: then layers.
+  const size_t pose = PoseStart(bytes);
+  // 4 class version, 36 of clip .. depth_range, 2 encodings, 1 layout: then layers and the view
+  // axis.
   const size_t layers_at = pose + 4 + 36 + 2 + 1;
   ASSERT_EQ(bytes[layers_at], 1);
+  ASSERT_EQ(bytes[layers_at + 1], 0);
   bytes[pose] = 2;
-  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(layers_at));
+  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(layers_at),
+              bytes.begin() + static_cast<std::ptrdiff_t>(layers_at + 2));
   // The dense pose's empty span table (three uint64 counts), then gap_texels' count: remove it.
   const size_t gap_count_at = layers_at + 3 * 8;
   for (size_t i = 0; i < 8; ++i) ASSERT_EQ(bytes[gap_count_at + i], 0) << i;

@@ -74,11 +74,11 @@ TEST(BodyMapLayers, ThreeLayersRoundTripInEveryEncodingAndBothLayouts) {
 // docs/FORMAT.md: `layers` is one byte right after `layout`, before the span table.
 TEST(BodyMapLayers, LayersFollowLayoutBeforeTheSpanTable) {
   const std::vector<uint8_t> bytes = Encode(LayeredAsset());
-  // texel_size, front_z, depth_range (float32), the encodings, layout (row spans), layers, then
-  // row_span_offsets' uint64 count (height + 1 = 4).
+  // texel_size, front_z, depth_range (float32), the encodings, layout (row spans), layers, the
+  // view axis (z), then row_span_offsets' uint64 count (height + 1 = 4).
   const std::vector<uint8_t> pattern = {
       0, 0, 0, 0x3E, 0, 0, 0, 0x3F, 0, 0, 0x80, 0x3F,  // 0.125f, 0.5f, 1.f, little-endian
-      0, 1, 1, 3,    4, 0, 0, 0,    0, 0, 0,    0};
+      0, 1, 1, 3,    0, 4, 0, 0,    0, 0, 0,    0,    0};
   const auto found = std::search(bytes.begin(), bytes.end(), pattern.begin(), pattern.end());
   ASSERT_NE(found, bytes.end());
   // The byte is the field: 3 -> 2 with the arrays left at three layers is refused by size.
@@ -113,7 +113,7 @@ TEST(BodyMapLayers, LayerCountOutsideOneToFourIsRefusedNamingTheField) {
   }
   // The same in a file with valid checksums: a corrupt error naming the field.
   const std::vector<uint8_t> bytes = Encode(good);
-  const std::vector<uint8_t> pattern = {0, 1, 1, 3, 4, 0, 0, 0, 0, 0, 0, 0};  // encodings..count
+  const std::vector<uint8_t> pattern = {0, 1, 1, 3, 0, 4, 0, 0, 0, 0, 0, 0, 0};  // encodings..count
   const auto found = std::search(bytes.begin(), bytes.end(), pattern.begin(), pattern.end());
   ASSERT_NE(found, bytes.end());
   for (uint8_t layers : {uint8_t{0}, uint8_t{5}}) {

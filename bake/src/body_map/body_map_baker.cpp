@@ -49,6 +49,9 @@ Status ValidateOptions(const BodyMapOptions& o) {
   if (o.depth_encoding != DepthEncoding::kFloat32 && o.depth_encoding != DepthEncoding::kUnorm16) {
     return Invalid("unknown depth encoding " + std::to_string(static_cast<int>(o.depth_encoding)));
   }
+  if (static_cast<uint8_t>(o.view_axis) > 2) {
+    return Invalid("unknown view axis " + std::to_string(static_cast<int>(o.view_axis)));
+  }
   if (o.normal_encoding != NormalEncoding::kFloat32 &&
       o.normal_encoding != NormalEncoding::kOct16 && o.normal_encoding != NormalEncoding::kRgb8) {
     return Invalid("unknown normal encoding " +
@@ -605,6 +608,13 @@ Status BakeBodyMapPose(std::span<const Float3> positions, std::span<const uint32
                        const BodyMapOptions& options, BodyMapPose* pose, BodyMapPoseStats* stats) {
   Status status = ValidateRequest(positions, triangles, options, pose);
   if (!status.ok()) return status;
+  // Everything below works in the view frame, whose z' is the view axis (an exact permutation).
+  std::vector<Float3> view_positions;
+  if (options.view_axis != BodyMapViewAxis::kZ) {
+    view_positions.reserve(positions.size());
+    for (const Float3& p : positions) view_positions.push_back(ToBodyMapView(options.view_axis, p));
+    positions = view_positions;
+  }
 
   // Steps 1-7: the offset surface, its camera box and window, both views rendered, reconciled
   // and encoded as layer 0 (docs/ALGORITHMS.md §6.1-6.4, 6.6).
@@ -624,6 +634,7 @@ Status BakeBodyMapPose(std::span<const Float3> positions, std::span<const uint32
   status = ReconcileViews(options, window, views.images, &cover);
   if (!status.ok()) return status;
   BodyMapPose result = EncodeViews(*pose, options, box, window, cover, views.images);
+  result.view_axis = options.view_axis;
 
   // 8. Gap layers, from the CPU fragment pass whichever renderer drew layer 0.
   GapCounts gap_counts;

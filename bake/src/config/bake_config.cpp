@@ -82,6 +82,16 @@ const JsonSchema<BakeConfig>& MapsSection() {
               "CPU fragment pass (also with renderer osmesa); only the texels with a gap store "
               "the extra layers",
               [](BakeConfig& c) -> uint8_t& { return c.maps.layers; })
+          .Enum<BakeConfig::MapViewAxis>(
+              "view_axis",
+              {{"auto", BakeConfig::MapViewAxis::kAuto},
+               {"x", BakeConfig::MapViewAxis::kX},
+               {"y", BakeConfig::MapViewAxis::kY},
+               {"z", BakeConfig::MapViewAxis::kZ}},
+              "the asset axis the maps are seen along; auto: the one whose slab holds the least "
+              "air at the rest pose (a quadruped is seen from above: from the front, the air "
+              "under its belly would be inside)",
+              [](BakeConfig& c) -> BakeConfig::MapViewAxis& { return c.maps_view_axis; })
           .Enum<MapRenderer>(
               "renderer", {{"cpu", MapRenderer::kCpu}, {"osmesa", MapRenderer::kOsMesa}},
               "cpu: in-house deterministic rasterizer; osmesa: the paper's GL path (llvmpipe)",

@@ -84,9 +84,44 @@ Status MapPoseRequests(const std::string& input, const BakeConfig& config,
   return Status::Ok();
 }
 
+// The maps' view axis: the configured one, or the rest pose's least-air axis (reported with the
+// inside volume along each axis).
+Status ChooseViewAxis(const BakeConfig& config, const Regions& regions, const Character& character,
+                      BodyMapViewAxis* axis, json* report) {
+  switch (config.maps_view_axis) {
+    case BakeConfig::MapViewAxis::kX:
+      *axis = BodyMapViewAxis::kX;
+      break;
+    case BakeConfig::MapViewAxis::kY:
+      *axis = BodyMapViewAxis::kY;
+      break;
+    case BakeConfig::MapViewAxis::kZ:
+      *axis = BodyMapViewAxis::kZ;
+      break;
+    case BakeConfig::MapViewAxis::kAuto: {
+      ViewAxisChoice choice;
+      if (Status s = ChooseBodyMapViewAxis(regions.rest_positions, character.mesh.triangles,
+                                           config.maps, &choice);
+          !s.ok()) {
+        return Status(s.code(), "body maps: view axis: " + s.message());
+      }
+      *axis = choice.axis;
+      (*report)["inside_litres_by_axis"] = {{"x", choice.inside_volume[1] * 1e3},
+                                            {"y", choice.inside_volume[2] * 1e3},
+                                            {"z", choice.inside_volume[0] * 1e3}};
+      break;
+    }
+  }
+  (*report)["view_axis"] = BodyMapViewAxisName(*axis);
+  return Status::Ok();
+}
+
 Status BakeMaps(const BakeConfig& config, std::span<const MapPoseRequest> requests,
                 const Regions& regions, const Character& character, const std::string& preview_dir,
                 CharacterAsset* asset, json* report) {
+  BodyMapOptions options = config.maps;
+  if (Status s = ChooseViewAxis(config, regions, character, &options.view_axis, report); !s.ok())
+    return s;
   SkeletonPose skeleton_pose;
   if (Status s = skeleton_pose.Init(character.skeleton); !s.ok()) return s;
   std::vector<Float3> posed(character.mesh.vertex_count());
@@ -107,7 +142,7 @@ Status BakeMaps(const BakeConfig& config, std::span<const MapPoseRequest> reques
     pose.clip = request.clip;
     pose.time = request.time;
     BodyMapPoseStats stats;
-    if (Status s = BakeBodyMapPose(positions, character.mesh.triangles, config.maps, &pose, &stats);
+    if (Status s = BakeBodyMapPose(positions, character.mesh.triangles, options, &pose, &stats);
         !s.ok()) {
       return Status(s.code(), "body maps: " + s.message());
     }

@@ -28,7 +28,7 @@ uint8_t BodyMapCollider::CollideOne(Float3 from, Float3* position, Float3* veloc
   if (!IsFinite(from) || !IsFinite(*position) || !IsFinite(*velocity)) {
     return kCollisionInvalidInput;
   }
-  const ContactQuery q = Query(from, *position);
+  const ContactQuery q = QueryView(from, *position);
   if (!q.contact) return kCollisionNone;
   ApplyResponse(q, params, position, velocity);
   return static_cast<uint8_t>(kCollisionContact | q.flags);
@@ -103,6 +103,33 @@ uint32_t BodyMapCollider::CollideRange(const Float3* previous, Float3* positions
   return contacts;
 }
 
+// A view axis other than z: the particles go through CollideRange in the view frame, in pieces
+// that fit on the stack (no allocation), and come back. The permutation is exact, so this is the
+// z-view answer of the permuted inputs.
+uint32_t BodyMapCollider::CollideRangeInViewFrame(const Float3* previous, Float3* positions,
+                                                  Float3* velocities, uint8_t* flags, size_t count,
+                                                  const ResponseParams& params) const {
+  constexpr size_t kPiece = 256;  // 3 x 3 KiB of stack
+  Float3 view_previous[kPiece], view_positions[kPiece], view_velocities[kPiece];
+  const BodyMapViewAxis axis = view_axis_;
+  uint32_t contacts = 0;
+  for (size_t begin = 0; begin < count; begin += kPiece) {
+    const size_t n = std::min(kPiece, count - begin);
+    for (size_t k = 0; k < n; ++k) {
+      view_previous[k] = ToBodyMapView(axis, previous[begin + k]);
+      view_positions[k] = ToBodyMapView(axis, positions[begin + k]);
+      view_velocities[k] = ToBodyMapView(axis, velocities[begin + k]);
+    }
+    contacts +=
+        CollideRange(view_previous, view_positions, view_velocities, flags + begin, n, params);
+    for (size_t k = 0; k < n; ++k) {
+      positions[begin + k] = FromBodyMapView(axis, view_positions[k]);
+      velocities[begin + k] = FromBodyMapView(axis, view_velocities[k]);
+    }
+  }
+  return contacts;
+}
+
 Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span<Float3> positions,
                                      std::span<Float3> velocities, std::span<uint8_t> flags,
                                      const ResponseParams& params, uint32_t* contact_count) const {
@@ -132,9 +159,13 @@ Status BodyMapCollider::CollideBatch(std::span<const Float3> previous, std::span
   constexpr int64_t kChunk = 1024;
   detail::ChunkSum contacts;  // an integer sum: the same at any thread count
   detail::ParallelRanges(count, kChunk, [&](int64_t begin, int64_t end) {
-    contacts.Add(CollideRange(previous.data() + begin, positions.data() + begin,
-                              velocities.data() + begin, flags.data() + begin,
-                              static_cast<size_t>(end - begin), params));
+    contacts.Add(view_axis_ == BodyMapViewAxis::kZ
+                     ? CollideRange(previous.data() + begin, positions.data() + begin,
+                                    velocities.data() + begin, flags.data() + begin,
+                                    static_cast<size_t>(end - begin), params)
+                     : CollideRangeInViewFrame(previous.data() + begin, positions.data() + begin,
+                                               velocities.data() + begin, flags.data() + begin,
+                                               static_cast<size_t>(end - begin), params));
   });
   if (contact_count != nullptr) *contact_count = contacts.total();
   return Status::Ok();
@@ -145,8 +176,9 @@ void BodyMapCollider::InsideRange(const Float3* points, uint8_t* inside, size_t 
   const float width_f = width_f_, height_f = height_f_;
   const size_t width = width_;
   const Slab* const slabs = slabs_.data();
+  const BodyMapViewAxis axis = view_axis_;
   for (size_t k = 0; k < count; ++k) {
-    const Float3 p = points[k];
+    const Float3 p = ToBodyMapView(axis, points[k]);
     const float u = (p.x - origin_x) * inv_texel;
     const float v = (p.y - origin_y) * inv_texel;
     uint8_t result = 0;

@@ -42,6 +42,7 @@ void BodyMapCollider::Clear() {
   texel_size_ = inv_texel_size_ = 0.f;
   clip_ = -1;
   time_ = 0.f;
+  view_axis_ = BodyMapViewAxis::kZ;
   bounds_min_ = {1.f, 1.f, 1.f};
   bounds_max_ = {-1.f, -1.f, -1.f};
   for (int k = 0; k < 3; ++k) {

@@ -45,6 +45,10 @@ std::string CheckPoseHeader(const BodyMapPose& pose, DepthSampling sampling) {
     return "layers = " + std::to_string(pose.layers) + " is outside [1, " +
            std::to_string(kMaxBodyMapLayers) + "]";
   }
+  if (static_cast<uint8_t>(pose.view_axis) > 2) {
+    return "view_axis = " + std::to_string(static_cast<int>(pose.view_axis)) +
+           " is not 0 (z), 1 (x) or 2 (y)";
+  }
   return CheckBodyMapLayout(pose);
 }
 
@@ -319,6 +323,7 @@ Status BodyMapCollider::Build(const BodyMapPose& pose, DepthSampling sampling) {
   texel_size_ = pose.texel_size;
   inv_texel_size_ = 1.f / pose.texel_size;
   sampling_ = sampling;
+  view_axis_ = pose.view_axis;
   clip_ = pose.clip;
   time_ = pose.time;
   PackGaps(&gap_texels);

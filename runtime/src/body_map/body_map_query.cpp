@@ -192,6 +192,14 @@ ContactQuery NoContact(Float3 p0, Float3 p1) {
 }  // namespace
 
 ContactQuery BodyMapCollider::Query(Float3 p0, Float3 p1) const {
+  if (view_axis_ == BodyMapViewAxis::kZ) return QueryView(p0, p1);
+  ContactQuery result = QueryView(ToBodyMapView(view_axis_, p0), ToBodyMapView(view_axis_, p1));
+  result.point = FromBodyMapView(view_axis_, result.point);
+  result.normal = FromBodyMapView(view_axis_, result.normal);
+  return result;
+}
+
+ContactQuery BodyMapCollider::QueryView(Float3 p0, Float3 p1) const {
   ContactQuery result = NoContact(p0, p1);
   if (result.flags == kCollisionInvalidInput || stats_.valid_texels == 0) return result;
   const TexelCoords texels = ToTexels(p0, p1);
@@ -271,12 +279,12 @@ bool BodyMapCollider::ClipMotion(Float3 p0, Float3 p1, ClippedMotion* out) const
 
 void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
   ContactQuery& result = *out;
-  result.inside_end = IsInside(p1);
+  result.inside_end = IsInsideView(p1);
   ClippedMotion clip;
   if (!ClipMotion(p0, p1, &clip)) return;
   const Float3 q0 = clip.q0, q1 = clip.q1;
   const double t_start = clip.t_start, t_end = clip.t_end;
-  const bool start_inside = t_start == 0.0 && IsInside(p0);
+  const bool start_inside = t_start == 0.0 && IsInsideView(p0);
 
   BodyMapWalk walk(*this, (q0.x - origin_x_) * inv_texel_size_,
                    (q0.y - origin_y_) * inv_texel_size_, (q1.x - origin_x_) * inv_texel_size_,

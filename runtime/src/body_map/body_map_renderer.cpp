@@ -179,6 +179,10 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   if (o.sampling != DepthSampling::kNearest && o.sampling != DepthSampling::kBilinear) {
     return Invalid("unknown depth sampling");
   }
+  if (static_cast<uint8_t>(o.view_axis) > 2) {
+    return Invalid("view_axis " + std::to_string(static_cast<int>(o.view_axis)) +
+                   " is not 0 (z), 1 (x) or 2 (y)");
+  }
   const uint32_t vertices = mesh.vertex_count();
   if (mesh.triangles.empty() || mesh.triangles.size() % 3 != 0) {
     return Invalid("the mesh has " + std::to_string(mesh.triangles.size()) +
@@ -228,7 +232,8 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
 
   // The bind pose's window, grown: most poses then render without allocating.
   Float3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
-  for (const Float3& p : mesh.positions) {
+  for (const Float3& bind : mesh.positions) {
+    const Float3 p = ToBodyMapView(o.view_axis, bind);
     lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
@@ -250,9 +255,12 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   maps->Clear();
   stats_.width = stats_.height = stats_.triangles_drawn = stats_.valid_texels = 0;
   if (mesh_ == nullptr) return Invalid("not initialised (Init failed or was not called)");
-  const RenderRegion everywhere;
-  const RenderRegion& box = region != nullptr ? *region : everywhere;
-  if (Status s = CheckRegion(box); !s.ok()) return s;
+  RenderRegion box;  // everywhere, or the region in the view frame
+  if (region != nullptr) {
+    if (Status s = CheckRegion(*region); !s.ok()) return s;
+    box.min = ToBodyMapView(options_.view_axis, region->min);
+    box.max = ToBodyMapView(options_.view_axis, region->max);
+  }
   if (Status s = SkinAndOffset(skinning); !s.ok()) return s;
   CullTriangles(box);
   Window window;
@@ -301,8 +309,19 @@ Status BodyMapRenderer::SkinAndOffset(std::span<const Mat34> skinning) {
   }
   ComputeNormals();
   const float epsilon = options_.epsilon;
-  detail::ParallelFor(vertices, kVertexGrain,
-                      [&](int64_t v) { offset_[v] = posed_[v] + normals_[v] * epsilon; });
+  const BodyMapViewAxis axis = options_.view_axis;
+  // The rest of the render is in the view frame: the offset surface and the normals the texels
+  // take (an exact permutation; posed_ stays in the asset frame).
+  detail::ParallelFor(vertices, kVertexGrain, [&](int64_t v) {
+    offset_[v] = ToBodyMapView(axis, posed_[v] + normals_[v] * epsilon);
+    normals_[v] = ToBodyMapView(axis, normals_[v]);
+  });
+  if (axis != BodyMapViewAxis::kZ) {
+    const int64_t triangles = static_cast<int64_t>(face_normals_.size());
+    detail::ParallelFor(triangles, kVertexGrain, [&](int64_t t) {
+      face_normals_[t] = ToBodyMapView(axis, face_normals_[t]);
+    });
+  }
   return Status::Ok();
 }
 
@@ -404,6 +423,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   maps->texel_size_ = options_.texel_size;
   maps->inv_texel_size_ = 1.f / options_.texel_size;
   maps->sampling_ = options_.sampling;
+  maps->view_axis_ = options_.view_axis;
   stats_.width = window.width;
   stats_.height = window.height;
 }
@@ -532,6 +552,11 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
   if (sampling != DepthSampling::kNearest && sampling != DepthSampling::kBilinear) {
     return Invalid("Load: unknown depth sampling");
   }
+  if (static_cast<uint8_t>(view.view_axis) > 2) {
+    return Invalid("Load: view_axis " + std::to_string(static_cast<int>(view.view_axis)) +
+                   " is not 0 (z), 1 (x) or 2 (y)");
+  }
+  const BodyMapViewAxis axis = view.view_axis;
   maps->slabs_.resize(texels);  // capacity kept from earlier grids
   maps->normals_.resize(texels);
   const int64_t count = static_cast<int64_t>(texels);
@@ -540,9 +565,10 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
     const bool body = std::isfinite(top) && std::isfinite(bottom) && top >= bottom;
     maps->slabs_[k] =
         body ? BodyMapCollider::Slab{top, bottom} : BodyMapCollider::Slab{-kInf, kInf};
-    const std::array<uint16_t, 2> front = EncodeOct16(view.front_normals[k]);
+    const std::array<uint16_t, 2> front = EncodeOct16(ToBodyMapView(axis, view.front_normals[k]));
     const std::array<uint16_t, 2> back =
-        EncodeOct16(IsFinite(view.back_normals[k]) ? view.back_normals[k] : Float3{0.f, 0.f, -1.f});
+        EncodeOct16(IsFinite(view.back_normals[k]) ? ToBodyMapView(axis, view.back_normals[k])
+                                                   : Float3{0.f, 0.f, -1.f});
     maps->normals_[k] = {{front[0], front[1]}, {back[0], back[1]}};
   });
   maps->width_ = view.width;
@@ -554,6 +580,7 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
   maps->texel_size_ = view.texel_size;
   maps->inv_texel_size_ = 1.f / view.texel_size;
   maps->sampling_ = sampling;
+  maps->view_axis_ = view.view_axis;
   maps->Finish();
   return Status::Ok();
 }

@@ -17,7 +17,7 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 bool SameGrid(const BodyMapCollider& a, const BodyMapCollider& b) {
   return a.width() == b.width() && a.height() == b.height() && a.origin_x() == b.origin_x() &&
          a.origin_y() == b.origin_y() && a.texel_size() == b.texel_size() &&
-         a.sampling() == b.sampling() && a.layers() == b.layers();
+         a.sampling() == b.sampling() && a.layers() == b.layers() && a.view_axis() == b.view_axis();
 }
 
 }  // namespace
@@ -88,6 +88,7 @@ const BodyMapCollider& BodyMapSequence::At(float time, BodyMapCollider* scratch)
   out.texel_size_ = a.texel_size_;
   out.inv_texel_size_ = a.inv_texel_size_;
   out.sampling_ = a.sampling_;
+  out.view_axis_ = a.view_axis_;
   out.clip_ = a.clip_;
   out.time_ = time;
   out.stats_ = nearer.stats_;

@@ -36,6 +36,10 @@ struct BakeConfig {
     o.depth_encoding = DepthEncoding::kUnorm16;
     return o;
   }();
+  // The axis the maps are seen along: kAuto picks the one whose slab holds the least air at the
+  // rest pose (ChooseBodyMapViewAxis), for every pose of the set; else that axis.
+  enum class MapViewAxis : uint8_t { kAuto, kX, kY, kZ };
+  MapViewAxis maps_view_axis = MapViewAxis::kAuto;
   std::string maps_clip;  // empty: the rest pose; else every time of this clip at maps_clip_rate
   float maps_clip_rate = 0.f;  // Hz, >= 0; 0 = each of the clip's resampled frames
   // Where maps_clip was named ("config.json: /maps/clip", a scene's "/animation/clip"; empty:

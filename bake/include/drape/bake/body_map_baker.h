@@ -38,6 +38,8 @@ struct BodyMapOptions {
   // air gaps inside it (step 8), at the cost of a CPU fragment pass and (k - 1) entries more
   // per texel that has a gap (a few percent of a character's texels).
   uint8_t layers = 1;
+  // The asset axis the body is seen along (body_map_data.h); ChooseBodyMapViewAxis picks it.
+  BodyMapViewAxis view_axis = BodyMapViewAxis::kZ;
 };
 
 // Gaps thinner than this (metres) are not stored: the body counts as inside there. 0.1 mm is far
@@ -78,6 +80,26 @@ struct BodyMapPoseStats {
 Status BakeBodyMapPose(std::span<const Float3> positions, std::span<const uint32_t> triangles,
                        const BodyMapOptions& options, BodyMapPose* pose,
                        BodyMapPoseStats* stats = nullptr);
+
+// The view axis whose slab holds the least air: the body baked along x, y and z at
+// min(options.resolution, kViewAxisProbeResolution) with options' epsilon and layers, and the
+// inside volume of each (slab less its gaps) compared. The air under a quadruped's belly, or
+// between a human's legs seen from the front, is inside the slab; seen from above or from the
+// side it is not. z is kept unless another axis holds at least kViewAxisMinGain less volume, so
+// near-ties keep the paper's view. docs/ALGORITHMS.md §6.9.
+inline constexpr uint32_t kViewAxisProbeResolution = 256;
+inline constexpr double kViewAxisMinGain = 0.03;  // fraction of z's inside volume
+struct ViewAxisChoice {
+  BodyMapViewAxis axis = BodyMapViewAxis::kZ;
+  double inside_volume[3] = {0.0, 0.0, 0.0};  // m^3, indexed by BodyMapViewAxis (z, x, y)
+};
+// Errors as BakeBodyMapPose's (options.view_axis is ignored).
+Status ChooseBodyMapViewAxis(std::span<const Float3> positions, std::span<const uint32_t> triangles,
+                             const BodyMapOptions& options, ViewAxisChoice* choice);
+
+// The volume inside the pose's maps (m^3): per valid texel, the slab's thickness less its gaps',
+// times the texel's area.
+double BodyMapInsideVolume(const BodyMapPose& pose);
 
 // Writes 4 PNGs into `directory` (which must exist): <prefix>_front_depth.png,
 // <prefix>_back_depth.png (grey, nearer is brighter, background black) and

@@ -1,6 +1,7 @@
 #pragma once
 // Paper A's image-space body collider: front and back orthographic depth and normal maps of the
-// posed body, offset by epsilon. The view axis is the asset frame's z (the body faces +z).
+// posed body, offset by epsilon, seen along one of the asset frame's axes (z unless the pose
+// says otherwise: a quadruped is seen from above).
 
 #include <cstddef>
 #include <cstdint>
@@ -31,8 +32,28 @@ enum class BodyMapLayout : uint8_t {
   kRowSpans = 1,  // only the texels inside the row spans, row by row, span by span
 };
 
-// One pose's maps. Texel (i, j) covers asset-frame x in [origin_x + i*texel_size, +texel_size)
-// and y in [origin_y + j*texel_size, +texel_size). Only the rectangle around the covered texels
+// The asset-frame axis a pose is seen along (BodyMapPose class version 4; older poses are z).
+// Every other field of the pose lives in its view frame (x', y', z'), a cyclic permutation of the
+// asset frame whose z' is the view axis: kZ (x, y, z), kX (y, z, x), kY (z, x, y). A rotation,
+// so the front view looks along -z' as before, and exact in floating point. The bake picks the
+// axis whose slab holds the least air (docs/ALGORITHMS.md §6.9).
+enum class BodyMapViewAxis : uint8_t { kZ = 0, kX = 1, kY = 2 };
+
+// asset frame -> the view frame of `axis`, and back.
+constexpr Float3 ToBodyMapView(BodyMapViewAxis axis, Float3 p) {
+  return axis == BodyMapViewAxis::kX   ? Float3{p.y, p.z, p.x}
+         : axis == BodyMapViewAxis::kY ? Float3{p.z, p.x, p.y}
+                                       : p;
+}
+constexpr Float3 FromBodyMapView(BodyMapViewAxis axis, Float3 v) {
+  return axis == BodyMapViewAxis::kX   ? Float3{v.z, v.x, v.y}
+         : axis == BodyMapViewAxis::kY ? Float3{v.y, v.z, v.x}
+                                       : v;
+}
+const char* BodyMapViewAxisName(BodyMapViewAxis axis);  // "x", "y", "z" or "unknown"
+
+// One pose's maps. Texel (i, j) covers view-frame x' in [origin_x + i*texel_size, +texel_size)
+// and y' in [origin_y + j*texel_size, +texel_size). Only the rectangle around the covered texels
 // exists; everything outside it is background. Inside it, `layout` says which texels the
 // per-texel arrays hold: all of them row-major (j * width + i), or only those in the row spans
 // (everything outside the spans is background).
@@ -43,9 +64,9 @@ struct BodyMapPose {
   float time = 0.f;    // seconds into the clip
   uint32_t width = 0;  // texels
   uint32_t height = 0;
-  float origin_x = 0.f, origin_y = 0.f;  // metres, asset frame
+  float origin_x = 0.f, origin_y = 0.f;  // metres, view frame
   float texel_size = 0.f;                // metres, > 0
-  float front_z = 0.f;                   // asset-frame z of the front camera plane
+  float front_z = 0.f;                   // view-frame z' of the front camera plane
   float depth_range = 0.f;  // metres between the front and back planes (paper's W'), > 0
   DepthEncoding depth_encoding = DepthEncoding::kFloat32;
   NormalEncoding normal_encoding = NormalEncoding::kFloat32;
@@ -61,6 +82,7 @@ struct BodyMapPose {
   // texel the gaps are filled in order and nested strictly inside the slab without touching:
   // top > upper_1 > lower_1 > upper_2 > lower_2 > ... > bottom (asset-frame z).
   uint8_t layers = 1;
+  BodyMapViewAxis view_axis = BodyMapViewAxis::kZ;  // class version 4; the same in a whole set
   // The stored texels that hold at least one gap (positions n within layer 0, strictly
   // increasing, each with gap 1 present; empty when layers = 1; class version 3). Layer k >= 1
   // of the t-th of them is entry stored_texels + (k - 1) * gap_texels.size() + t of every

@@ -8,10 +8,13 @@
 //   maps.Build(asset.body_maps[0]);                                   // once: allocates
 //   maps.CollideBatch(previous, positions, velocities, flags, params); // per step
 //
-// The view axis is z: texel (i, j) covers x in [origin_x + i s, + s), y in [origin_y + j s, + s)
-// (s = texel size). A point is inside when both maps are valid at its texel and its z lies
-// between the back and front surfaces (boundaries included) and in none of the texel's air gaps
-// (poses with layers > 1). Points outside the stored rectangle are outside.
+// Points, motions, contacts and velocities are in the asset frame. The maps live in the pose's
+// view frame (x', y', z'), the cyclic permutation of the asset axes that puts the view axis in z'
+// (BodyMapViewAxis; z' = z unless the bake chose x or y): texel (i, j) covers x' in
+// [origin_x + i s, + s), y' in [origin_y + j s, + s) (s = texel size). A point is inside when
+// both maps are valid at its texel and its z' lies between the back and front surfaces
+// (boundaries included) and in none of the texel's air gaps (poses with layers > 1). Points
+// outside the stored rectangle are outside.
 
 #include <bit>
 #include <cmath>
@@ -61,30 +64,22 @@ class BodyMapCollider {
   Status Build(const BodyMapPose& pose, DepthSampling sampling = DepthSampling::kNearest);
 
   // Discrete test at one point.
-  bool IsInside(Float3 p) const {
-    if (sampling_ != DepthSampling::kNearest) return IsInsideBilinear(p);
-    const float u = (p.x - origin_x_) * inv_texel_size_;
-    const float v = (p.y - origin_y_) * inv_texel_size_;
-    if (!(u >= 0.f && v >= 0.f && u < width_f_ && v < height_f_)) return false;  // also NaN
-    const uint32_t i = static_cast<uint32_t>(u), j = static_cast<uint32_t>(v);
-    const Slab& s = slabs_[static_cast<size_t>(j) * width_ + i];
-    const bool in_slab =
-        (p.z <= s.top) & (p.z >= s.bottom);  // no branch: a coin toss near a surface
-    return gap_layers_ == 0 ? in_slab : in_slab && !InGap(GapBase(i, j), p.z);
-  }
+  bool IsInside(Float3 p) const { return IsInsideView(ToBodyMapView(view_axis_, p)); }
 
   // Continuous test of the motion p0 -> p1 (a point query is p0 == p1), no response. The first
   // entry wins: through the front or back surface, or a texel's side wall
   // (kCollisionSideWall); t is its parameter, point is on the surface or wall. A motion that
-  // starts inside and never leaves is pushed out along z to the nearer surface (t = 0,
-  // kCollisionStartedInside). depth: p1's penetration along z. Non-finite input: no contact,
-  // kCollisionInvalidInput.
+  // starts inside and never leaves is pushed out along the view axis to the nearer surface
+  // (t = 0, kCollisionStartedInside). depth: p1's penetration along the view axis. Non-finite
+  // input: no contact, kCollisionInvalidInput.
   ContactQuery Query(Float3 p0, Float3 p1) const;
 
   // Query and the response (collision_types.h) for every particle moving previous[i] ->
   // positions[i], in place on positions[i] and velocities[i]; flags[i] is always written. A
   // non-finite input is flagged kCollisionInvalidInput and left untouched. Spans of one size,
-  // params finite. Bitwise identical at any thread count and to Query + ApplyResponse per particle.
+  // params finite. Bitwise identical at any thread count. With view axis z also bitwise Query +
+  // ApplyResponse per particle; with x or y the response's sums run in view-frame order, which
+  // may differ from that in the last bit.
   Status CollideBatch(std::span<const Float3> previous, std::span<Float3> positions,
                       std::span<Float3> velocities, std::span<uint8_t> flags,
                       const ResponseParams& params, uint32_t* contact_count = nullptr) const;
@@ -101,15 +96,16 @@ class BodyMapCollider {
   uint32_t width() const { return width_; }         // texels
   uint32_t height() const { return height_; }       // texels
   float texel_size() const { return texel_size_; }  // metres
-  float origin_x() const { return origin_x_; }
-  float origin_y() const { return origin_y_; }
+  float origin_x() const { return origin_x_; }      // metres, view frame (x')
+  float origin_y() const { return origin_y_; }      // metres, view frame (y')
+  BodyMapViewAxis view_axis() const { return view_axis_; }
   DepthSampling sampling() const { return sampling_; }
   uint32_t layers() const { return gap_layers_ + 1; }  // the slab and its gap layers
   int32_t clip() const { return clip_; }
   float time() const { return time_; }
   // Asset-frame box of the valid texels; every inside point lies in it. Empty map: min > max.
-  Float3 bounds_min() const { return bounds_min_; }
-  Float3 bounds_max() const { return bounds_max_; }
+  Float3 bounds_min() const { return FromBodyMapView(view_axis_, bounds_min_); }
+  Float3 bounds_max() const { return FromBodyMapView(view_axis_, bounds_max_); }
   const BodyMapStats& stats() const { return stats_; }
   size_t memory_bytes() const;
 
@@ -119,6 +115,20 @@ class BodyMapCollider {
   friend struct detail::BodyMapWalk;
   friend struct BodyMapColliderAccess;  // tests and tools: body_map/body_map_collider_access.h
   struct Decoder;                       // body_map/body_map_decode.cpp
+
+  // IsInside and Query in the view frame.
+  bool IsInsideView(Float3 p) const {
+    if (sampling_ != DepthSampling::kNearest) return IsInsideBilinear(p);
+    const float u = (p.x - origin_x_) * inv_texel_size_;
+    const float v = (p.y - origin_y_) * inv_texel_size_;
+    if (!(u >= 0.f && v >= 0.f && u < width_f_ && v < height_f_)) return false;  // also NaN
+    const uint32_t i = static_cast<uint32_t>(u), j = static_cast<uint32_t>(v);
+    const Slab& s = slabs_[static_cast<size_t>(j) * width_ + i];
+    const bool in_slab =
+        (p.z <= s.top) & (p.z >= s.bottom);  // no branch: a coin toss near a surface
+    return gap_layers_ == 0 ? in_slab : in_slab && !InGap(GapBase(i, j), p.z);
+  }
+  ContactQuery QueryView(Float3 p0, Float3 p1) const;
 
   struct Slab {    // 8 bytes
     float top;     // z of the front surface; -inf on background
@@ -207,6 +217,9 @@ class BodyMapCollider {
                      const ResponseParams& params) const;
   uint32_t CollideRange(const Float3* previous, Float3* positions, Float3* velocities,
                         uint8_t* flags, size_t count, const ResponseParams& params) const;
+  uint32_t CollideRangeInViewFrame(const Float3* previous, Float3* positions, Float3* velocities,
+                                   uint8_t* flags, size_t count,
+                                   const ResponseParams& params) const;
 
   // The lanes (body_map/lanes/), written once over a lane pack and instantiated per instruction
   // set. CollideShortLanes answers the motions within a texel or across one edge, CollideWalkLanes
@@ -261,6 +274,7 @@ class BodyMapCollider {
   float origin_x_ = 0.f, origin_y_ = 0.f;
   float texel_size_ = 0.f, inv_texel_size_ = 0.f;  // metres, 1/metres
   DepthSampling sampling_ = DepthSampling::kNearest;
+  BodyMapViewAxis view_axis_ = BodyMapViewAxis::kZ;
   InstructionSet instruction_set_limit_ = InstructionSet::kAvx2;  // kept by Clear
   int32_t clip_ = -1;
   float time_ = 0.f;

@@ -1,8 +1,9 @@
 #pragma once
 // Paper A's body maps for any pose the engine drives: skins the stored bind mesh with the frame's
 // skinning matrices, offsets it by epsilon along its vertex normals and rasterizes the front and
-// back surfaces (z-view, slab only) straight into a BodyMapCollider, over the window a region
-// box allows. How it works and what it costs: docs/ALGORITHMS.md §7.9, docs/PERFORMANCE.md.
+// back surfaces (slab only, along the view axis the options name) straight into a
+// BodyMapCollider, over the window a region box allows. How it works and what it costs:
+// docs/ALGORITHMS.md §7.9, docs/PERFORMANCE.md.
 //
 //   BodyMapRenderer renderer;
 //   renderer.Init(asset.mesh, {.texel_size = 0.002f, .epsilon = asset.body_maps.epsilon});
@@ -33,7 +34,10 @@ struct BodyMapRenderOptions {
   uint32_t max_side = 8192;  // texels, [16, 16384]: a pose whose window needs more is an error
   // Texel corners lie at grid_x + k * texel_size (and y alike), every frame, so the grid does not
   // slide under the body as it moves; a baked pose's origin puts both on one grid. Finite.
-  float grid_x = 0.f, grid_y = 0.f;  // metres
+  float grid_x = 0.f, grid_y = 0.f;  // metres, view frame (x', y')
+  // The asset axis the maps are seen along (body_map_data.h); a baked pose's view_axis keeps
+  // rendered and baked maps in one frame.
+  BodyMapViewAxis view_axis = BodyMapViewAxis::kZ;
 };
 
 // An asset-frame box: only triangles that reach it are drawn and the window is cut to it. The
@@ -46,19 +50,21 @@ struct RenderRegion {
 };
 
 // Maps the engine rendered itself (on its GPU, say): both views over one texel grid, in the
-// caller's row-major arrays; texel (i, j) is entry j * width + i and covers x in
-// [origin_x + i * texel_size, + texel_size), y alike (asset frame). z values are asset-frame z
-// of the surfaces offset by epsilon: the front surface is the one nearest +z (a GPU depth buffer
-// read back and mapped through the camera's near/far planes). A texel is body where both z are
-// finite and front_z >= back_z; NaN or an infinity marks background.
+// caller's row-major arrays; texel (i, j) is entry j * width + i and covers x' in
+// [origin_x + i * texel_size, + texel_size), y' alike, in the view frame of view_axis
+// (body_map_data.h; x' = x, y' = y for z). z' values are the view-frame depth coordinate of the
+// surfaces offset by epsilon: the front surface is the one nearest +z' (a GPU depth buffer read
+// back and mapped through the camera's near/far planes). A texel is body where both are finite
+// and front_z >= back_z; NaN or an infinity marks background. Normals are in the asset frame.
 struct RenderedMapsView {
   uint32_t width = 0, height = 0;         // texels, [1, 16384] each
-  float origin_x = 0.f, origin_y = 0.f;   // metres, finite
+  float origin_x = 0.f, origin_y = 0.f;   // metres, finite, view frame
   float texel_size = 0.f;                 // metres, [1e-6, 1e3]
   std::span<const float> front_z;         // width * height
   std::span<const float> back_z;          // width * height
   std::span<const Float3> front_normals;  // width * height, outward; length is ignored
-  std::span<const Float3> back_normals;   // width * height, outward (mostly -z)
+  std::span<const Float3> back_normals;   // width * height, outward (mostly away from the axis)
+  BodyMapViewAxis view_axis = BodyMapViewAxis::kZ;
 };
 
 // What the last Render drew.
