@@ -143,8 +143,8 @@ def lane_variant(r):  # the same maps with the batch kept to narrower lanes
     return "SSE2 lanes" in r["setting"] or "scalar lanes" in r["setting"]
 
 
-def default_maps(r):  # the bake's default body maps (bake config: N = 1024, slab only)
-    return r["family"] == "maps" and r["setting"] == "N=1024 nearest"
+def default_maps(r):  # the bake's default body maps (bake config: N = 1024, four layers)
+    return r["family"] == "maps" and r["setting"] == "N=1024 nearest layers=4"
 
 
 def default_hulls(r):  # the bake's default hulls and joint spheres, default runtime options

@@ -142,7 +142,7 @@ TEST(BakeConfig, ReferenceListsEveryParameterWithItsDefault) {
 
 TEST(BakeConfig, MapsLayersIsACountFromOneToFour) {
   BakeConfig config;
-  EXPECT_EQ(config.maps.layers, 1) << "paper A's slab alone by default";
+  EXPECT_EQ(config.maps.layers, 4) << "the slab and up to three air gaps by default";
   EXPECT_EQ(BakeConfigReference()["maps"]["layers"]["range"], "[1, 4]");
   Status s = ApplyBakeConfig({{"maps", {{"layers", 3}}}}, "c.json", &config);
   ASSERT_TRUE(s.ok()) << s.message();
@@ -157,6 +157,26 @@ TEST(BakeConfig, MapsLayersIsACountFromOneToFour) {
     EXPECT_NE(s.message().find("[1, 4]"), std::string::npos) << s.message();
     EXPECT_EQ(config.maps.layers, 3) << "a refused config changes nothing";
   }
+}
+
+TEST(BakeConfig, MapsViewAxisAndMaxError) {
+  BakeConfig config;
+  EXPECT_EQ(config.maps_view_axis, BakeConfig::MapViewAxis::kAuto);
+  EXPECT_EQ(config.maps_max_error_mm, 0.f) << "off: maps.resolution and maps.layers as given";
+  Status s =
+      ApplyBakeConfig({{"maps", {{"view_axis", "y"}, {"max_error", 1.5}}}}, "c.json", &config);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(config.maps_view_axis, BakeConfig::MapViewAxis::kY);
+  EXPECT_EQ(config.maps_max_error_mm, 1.5f);
+  EXPECT_EQ(BakeConfigToJson(config)["maps"]["view_axis"], "y");
+  s = ApplyBakeConfig({{"maps", {{"view_axis", "w"}}}}, "c.json", &config);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(s.message().rfind("c.json: /maps/view_axis: ", 0), 0u) << s.message();
+  s = ApplyBakeConfig({{"maps", {{"max_error", -1}}}}, "c.json", &config);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(s.message().rfind("c.json: /maps/max_error: ", 0), 0u) << s.message();
+  EXPECT_EQ(config.maps_view_axis, BakeConfig::MapViewAxis::kY) << "refused: nothing changes";
+  EXPECT_EQ(config.maps_max_error_mm, 1.5f);
 }
 
 TEST(NameSuggestions, IgnoreCaseAndThePrefixEveryNameShares) {

@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "body_map/map_error.h"
 #include "body_map_fixtures.h"
 #include "drape/bake/body_map_baker.h"
 
@@ -234,6 +235,31 @@ TEST(BodyMapBaker, TheViewAxisIsTheOneWithTheLeastAirInItsSlab) {
       EXPECT_TRUE(maps.IsInside({float(in_top[0]), float(in_top[1]), float(in_top[2])}));
     }
   }
+}
+
+// maps.max_error beyond reach: every setting tried, cheapest first, and the least error kept.
+TEST(BodyMapBaker, AnUnreachableErrorBudgetKeepsTheBestSettingTried) {
+  const Mesh table = Table(2, 1);
+  BodyMapOptions options;
+  MapSettingChoice choice;
+  ASSERT_TRUE(ChooseMapSetting(table.positions, table.triangles, options, 1e-6, &choice).ok());
+  EXPECT_FALSE(choice.within_budget);
+  ASSERT_EQ(choice.tried.size(), 8u);
+  double least = 1e300;
+  for (size_t k = 0; k < choice.tried.size(); ++k) {
+    least = std::min(least, choice.tried[k].error.p99_mm);
+    if (k > 0) {
+      EXPECT_GE(choice.tried[k].resolution, choice.tried[k - 1].resolution) << k;
+    }
+  }
+  EXPECT_EQ(choice.error.p99_mm, least);
+  EXPECT_EQ(choice.tried.front().resolution, 256u);
+  EXPECT_EQ(choice.tried.back().resolution, 2048u);
+  // A generous budget: the first setting.
+  ASSERT_TRUE(ChooseMapSetting(table.positions, table.triangles, options, 1e3, &choice).ok());
+  EXPECT_TRUE(choice.within_budget);
+  EXPECT_EQ(choice.tried.size(), 1u);
+  EXPECT_EQ(choice.resolution, 256u);
 }
 
 }  // namespace

@@ -50,6 +50,12 @@ const JsonSchema<BakeConfig>& MapsSection() {
               "resolution", "texels", 16, 8192,
               "N: texels along the square window's side (the texel budget N*N for a fitted window)",
               [](BakeConfig& c) -> uint32_t& { return c.maps.resolution; })
+          .Float("max_error", "mm", Closed(0, 1000),
+                 "0: maps.resolution and maps.layers as given; > 0: the cheapest resolution "
+                 "(256 to 2048) and layers (1 or 4) whose measured error at the rest pose (p99 "
+                 "over points near the body and in its box, against the exact mesh) is within "
+                 "this; the report gives the error of every setting tried",
+                 [](BakeConfig& c) -> float& { return c.maps_max_error_mm; })
           .Bool("fitted_window", "fit the window to the body's L x H instead of the paper's square",
                 [](BakeConfig& c) -> bool& { return c.maps.fitted_window; })
           .Float("epsilon", "m", Closed(0, 0.1),

@@ -28,6 +28,7 @@
 #include "drape/runtime/skinning.h"
 #include "fit/collider_fit.h"
 #include "fit/fit_report.h"
+#include "pipeline/map_stage.h"
 #include "regions/convex_pieces.h"
 #include "regions/interior_points.h"
 #include "regions/surface_spheres.h"
@@ -50,132 +51,6 @@ size_t HullBytes(const HullColliderData& h) {
   return h.vertices.size() * 12 + h.triangles.size() * 4 + h.triangle_planes.size() * 4 +
          h.planes.size() * 16 + sizeof(Obb) + k(h.upper) + k(h.lower) +
          h.map.cell_offsets.size() * 4 + h.map.cell_triangles.size() * 4;
-}
-
-const char* RendererName(MapRenderer r) { return r == MapRenderer::kCpu ? "cpu" : "osmesa"; }
-
-// The poses whose maps are baked: the rest pose, or every time of one clip at maps_clip_rate
-// (0 = each of the clip's resampled frames).
-struct MapPoseRequest {
-  int32_t clip = -1;
-  float time = 0.f;
-};
-
-// The poses the maps are baked at; refuses a clip the character lacks, naming where the clip
-// was named and listing the character's clips.
-Status MapPoseRequests(const std::string& input, const BakeConfig& config,
-                       const Character& character, std::vector<MapPoseRequest>* out) {
-  out->clear();
-  if (config.maps_clip.empty()) {
-    out->push_back({});
-    return Status::Ok();
-  }
-  int32_t c = -1;
-  const std::string origin =
-      config.maps_clip_origin.empty() ? std::string("/maps/clip") : config.maps_clip_origin;
-  if (Status s = detail::FindClipNamed(character.clips, config.maps_clip, origin, input, &c);
-      !s.ok())
-    return s;
-  const ClipData& clip = character.clips[static_cast<size_t>(c)];
-  const float rate = config.maps_clip_rate > 0.f ? config.maps_clip_rate : clip.sample_rate;
-  const uint32_t count = static_cast<uint32_t>(std::ceil(clip.duration * rate - 1e-3f)) + 1;
-  for (uint32_t k = 0; k < count; ++k)
-    out->push_back({c, std::min(static_cast<float>(k) / rate, clip.duration)});
-  return Status::Ok();
-}
-
-// The maps' view axis: the configured one, or the rest pose's least-air axis (reported with the
-// inside volume along each axis).
-Status ChooseViewAxis(const BakeConfig& config, const Regions& regions, const Character& character,
-                      BodyMapViewAxis* axis, json* report) {
-  switch (config.maps_view_axis) {
-    case BakeConfig::MapViewAxis::kX:
-      *axis = BodyMapViewAxis::kX;
-      break;
-    case BakeConfig::MapViewAxis::kY:
-      *axis = BodyMapViewAxis::kY;
-      break;
-    case BakeConfig::MapViewAxis::kZ:
-      *axis = BodyMapViewAxis::kZ;
-      break;
-    case BakeConfig::MapViewAxis::kAuto: {
-      ViewAxisChoice choice;
-      if (Status s = ChooseBodyMapViewAxis(regions.rest_positions, character.mesh.triangles,
-                                           config.maps, &choice);
-          !s.ok()) {
-        return Status(s.code(), "body maps: view axis: " + s.message());
-      }
-      *axis = choice.axis;
-      (*report)["inside_litres_by_axis"] = {{"x", choice.inside_volume[1] * 1e3},
-                                            {"y", choice.inside_volume[2] * 1e3},
-                                            {"z", choice.inside_volume[0] * 1e3}};
-      break;
-    }
-  }
-  (*report)["view_axis"] = BodyMapViewAxisName(*axis);
-  return Status::Ok();
-}
-
-Status BakeMaps(const BakeConfig& config, std::span<const MapPoseRequest> requests,
-                const Regions& regions, const Character& character, const std::string& preview_dir,
-                CharacterAsset* asset, json* report) {
-  BodyMapOptions options = config.maps;
-  if (Status s = ChooseViewAxis(config, regions, character, &options.view_axis, report); !s.ok())
-    return s;
-  SkeletonPose skeleton_pose;
-  if (Status s = skeleton_pose.Init(character.skeleton); !s.ok()) return s;
-  std::vector<Float3> posed(character.mesh.vertex_count());
-  asset->body_maps.epsilon = config.maps.epsilon;
-  asset->body_maps.resolution = config.maps.resolution;
-  asset->body_maps.fitted_window = config.maps.fitted_window;
-  for (size_t r = 0; r < requests.size(); ++r) {
-    const MapPoseRequest& request = requests[r];
-    std::span<const Float3> positions = regions.rest_positions;
-    if (request.clip >= 0) {
-      if (Status s = skeleton_pose.SampleClip(character.clips[request.clip], request.time, false);
-          !s.ok())
-        return s;
-      if (Status s = SkinMesh(character.mesh, skeleton_pose.skinning(), posed); !s.ok()) return s;
-      positions = posed;
-    }
-    BodyMapPose pose;
-    pose.clip = request.clip;
-    pose.time = request.time;
-    BodyMapPoseStats stats;
-    if (Status s = BakeBodyMapPose(positions, character.mesh.triangles, options, &pose, &stats);
-        !s.ok()) {
-      return Status(s.code(), "body maps: " + s.message());
-    }
-    const std::string name =
-        request.clip < 0 ? "rest"
-                         : character.clips[request.clip].name + "@" + std::to_string(request.time);
-    if (!preview_dir.empty() && (r == 0 || r + 1 == requests.size())) {
-      std::string prefix = "maps_" + name;
-      for (char& c : prefix)
-        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') c = '_';
-      if (Status s = WriteBodyMapPreview(pose, preview_dir, prefix); !s.ok()) return s;
-    }
-    asset->body_maps.poses.push_back(std::move(pose));
-    (*report)["poses"].push_back(
-        {{"pose", name},
-         {"resolution", config.maps.resolution},
-         {"window_texels", {stats.window_width, stats.window_height}},
-         {"rectangle_texels", {stats.width, stats.height}},
-         {"layout", config.maps.layout == BodyMapLayout::kRowSpans ? "spans" : "dense"},
-         {"stored_texels", stats.stored_texels},
-         {"texel_size_mm", stats.texel_size_mm},
-         {"coverage", stats.coverage},
-         {"bytes", stats.bytes},
-         {"render_ms_front", stats.render_ms_front},
-         {"render_ms_back", stats.render_ms_back},
-         {"renderer", stats.renderer},
-         {"silhouette_conflicts", stats.silhouette_conflicts},
-         {"layers", stats.layers},
-         {"gap_texels", stats.gap_texels},
-         {"dropped_gaps", stats.dropped_gaps},
-         {"gap_ms", stats.gap_ms}});
-  }
-  return Status::Ok();
 }
 
 // A character whose body is one region (no skeleton) may cut it into this many times
@@ -748,9 +623,10 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     for (const SceneGarment& g : scene->garments)
       if (g.type == GarmentType::kObj) result->input_files.push_back(g.obj_file);
   }
-  std::vector<MapPoseRequest> map_requests;
+  std::vector<detail::MapPoseRequest> map_requests;
   if (config.maps_enabled) {
-    if (Status s = MapPoseRequests(input, config, character, &map_requests); !s.ok()) return s;
+    if (Status s = detail::MapPoseRequests(input, config, character, &map_requests); !s.ok())
+      return s;
   }
   CharacterAsset& asset = result->asset;
   StartAsset(character, &asset, &report);
@@ -765,8 +641,10 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
 
   if (config.maps_enabled) {
     start = Clock::now();
-    json maps = {{"renderer", RendererName(config.maps.renderer)}, {"poses", json::array()}};
-    if (Status s = BakeMaps(config, map_requests, regions, character, preview_dir, &asset, &maps);
+    json maps = {{"renderer", detail::RendererName(config.maps.renderer)},
+                 {"poses", json::array()}};
+    if (Status s = detail::BakeMapStage(config, map_requests, regions, character, preview_dir,
+                                        &asset, &maps);
         !s.ok())
       return failed(s);
     report["body_maps"] = maps;

@@ -30,16 +30,23 @@ struct BakeConfig {
 
   bool maps_enabled = true;  // paper A: front/back depth and normal maps of the rest pose
   // Depth as unorm16 by default: its error (depth range / 65535, about 5 um on a person) is far
-  // below a texel, at half the bytes of float32.
+  // below a texel, at half the bytes of float32. Air gaps by default (4 layers: the slab and up
+  // to three gaps): paper A's slab alone misses 0.55-4.1 % of the contacts on real characters
+  // (arms before a robot's chest, a fox's parts seen from above) and the gaps take that to
+  // 0-0.03 % for 3-19 ns more per particle and a few percent more bytes (docs/ALGORITHMS.md §6.5).
   BodyMapOptions maps = [] {
     BodyMapOptions o;
     o.depth_encoding = DepthEncoding::kUnorm16;
+    o.layers = kMaxBodyMapLayers;
     return o;
   }();
   // The axis the maps are seen along: kAuto picks the one whose slab holds the least air at the
   // rest pose (ChooseBodyMapViewAxis), for every pose of the set; else that axis.
   enum class MapViewAxis : uint8_t { kAuto, kX, kY, kZ };
   MapViewAxis maps_view_axis = MapViewAxis::kAuto;
+  // Millimetres; 0: maps.resolution and maps.layers as given. > 0: the cheapest setting whose
+  // measured error at the rest pose is within it (ChooseMapSetting, body_map/map_error.h).
+  float maps_max_error_mm = 0.f;
   std::string maps_clip;  // empty: the rest pose; else every time of this clip at maps_clip_rate
   float maps_clip_rate = 0.f;  // Hz, >= 0; 0 = each of the clip's resampled frames
   // Where maps_clip was named ("config.json: /maps/clip", a scene's "/animation/clip"; empty:
