@@ -236,6 +236,45 @@ TEST(BodyMapRenderer, HostileInputIsAnErrorAndAnEmptyCollider) {
 
 // Maps an engine rendered on its GPU, loaded from the caller's arrays, answer as the maps they
 // were read from; bad arrays are refused naming the reason, and the collider is left empty.
+// One sphere above the other along the view axis: the air between them is a gap (outside),
+// with air_gaps; without, the slab fills it. Spheres that overlap leave no gap inside their union.
+TEST(BodyMapRenderer, TheAirBetweenPartsIsAGap) {
+  const MeshData mesh = TwoSpheres();  // the second sphere's bind centre is (0.5, 0, 0)
+  const Mat34 apart[2] = {Mat34{}, Translation(-0.5f, 0.f, 0.3f)};  // centre (0, 0, 0.3)
+  const Mat34 overlapping[2] = {Mat34{}, Translation(-0.5f, 0.f, 0.12f)};
+  BodyMapRenderer with_gaps, slab_only;
+  BodyMapRenderOptions options = Options();
+  ASSERT_TRUE(with_gaps.Init(mesh, options).ok());
+  options.air_gaps = false;
+  ASSERT_TRUE(slab_only.Init(mesh, options).ok());
+  BodyMapCollider gaps, slab;
+  ASSERT_TRUE(with_gaps.Render(apart, &gaps).ok());
+  ASSERT_TRUE(slab_only.Render(apart, &slab).ok());
+  EXPECT_EQ(gaps.layers(), 2u);
+  EXPECT_EQ(slab.layers(), 1u);
+  const Float3 between{0.f, 0.f, 0.15f}, in_lower{0.f, 0.f, 0.05f}, in_upper{0.f, 0.f, 0.25f};
+  EXPECT_FALSE(gaps.IsInside(between));
+  EXPECT_TRUE(slab.IsInside(between));
+  EXPECT_TRUE(gaps.IsInside(in_lower) && gaps.IsInside(in_upper));
+  EXPECT_GT(with_gaps.stats().gap_texels, 1000u);
+  EXPECT_EQ(slab_only.stats().gap_texels, 0u);
+  // A motion down through the gap stops on the lower sphere's top, not the upper one's bottom.
+  const ContactQuery q = gaps.Query(between, {0.f, 0.f, 0.f});
+  ASSERT_TRUE(q.contact);
+  EXPECT_NEAR(q.point.z, kRadius + kEpsilon, 2e-3f);
+  EXPECT_GT(q.normal.z, 0.9f);
+  // Overlapping (their offset surfaces overlap along the rays within 86 mm of the axis): the
+  // union is solid there; only the rays beyond it pass air between the two.
+  ASSERT_TRUE(with_gaps.Render(overlapping, &gaps).ok());
+  for (float x : {0.f, 0.04f, 0.08f}) {
+    const float h = std::sqrt((kRadius + kEpsilon) * (kRadius + kEpsilon) - x * x) - 2e-3f;
+    for (float z = -h; z < 0.12f + h; z += 0.005f) {
+      EXPECT_TRUE(gaps.IsInside({x, 0.f, z})) << x << ", " << z;
+    }
+  }
+  EXPECT_FALSE(gaps.IsInside({0.1f, 0.f, 0.06f}));  // the air between them at 100 mm
+}
+
 TEST(BodyMapRenderer, LoadsMapsTheEngineRendered) {
   const MeshData mesh = TwoSpheres();
   BodyMapRenderer renderer;

@@ -14,6 +14,7 @@
 #include "drape/runtime/normal_encoding.h"
 #include "drape/runtime/skinning.h"
 
+#include "body_map/raster_triangle.h"
 #include "drape/runtime/task_system.h"
 #include "tasks/parallel_for.h"
 
@@ -21,7 +22,9 @@ namespace drape {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr uint32_t kNoFace = std::numeric_limits<uint32_t>::max();
+using detail::kNoFace;
+using detail::NormalInterpolator;
+using detail::RasterTriangle;
 // Init reserves this much more than the bind pose's window in each dimension: a pose that
 // spreads the limbs needs a wider window.
 constexpr double kReserveGrowth = 1.5;
@@ -31,132 +34,6 @@ constexpr int64_t kVertexGrain = 4096;
 Status Invalid(const std::string& message) {
   return Status(StatusCode::kInvalidArgument, "BodyMapRenderer: " + message);
 }
-
-// One triangle set up for the rasterizer in window coordinates (texel units; texel (i, j) is
-// sampled at its centre (i + 1/2, j + 1/2)). Each edge is evaluated canonically, from its lower
-// to its higher vertex index, so the two triangles sharing an edge compute exactly negated values
-// and a texel centre on it is covered by both (the tests are inclusive): no crack, and a texel
-// covered twice keeps the same extreme depth whichever triangle draws it first.
-struct RasterTriangle {
-  struct Edge {
-    double ax, ay, dx, dy;  // canonical start vertex and its difference to the end vertex
-    double sign;            // +1 or -1: makes the value >= 0 inside the triangle
-    double RowTerm(double py) const { return dx * (py - ay); }
-    bool Inside(double row_term, double px) const {
-      return sign * (row_term - dy * (px - ax)) >= 0.0;
-    }
-    // Narrows [*lo, *hi] to about the texels inside the edge on this row, one texel generous on
-    // the side it cuts (the caller still tests each texel exactly). False: none inside.
-    bool Narrow(double row_term, int64_t* lo, int64_t* hi) const {
-      if (dy == 0.0) return Inside(row_term, 0.0);       // the same value all along the row
-      const double boundary = ax + row_term / dy - 0.5;  // texel index where the value is 0
-      if (!(std::fabs(boundary) < 1e15)) return true;
-      if (-sign * dy > 0.0) {
-        *lo = std::max(*lo, static_cast<int64_t>(std::floor(boundary)) - 1);
-      } else {
-        *hi = std::min(*hi, static_cast<int64_t>(std::ceil(boundary)) + 1);
-      }
-      return *lo <= *hi;
-    }
-  };
-  Edge edge[3];
-  double x0, y0;          // vertex 0
-  double grad_x, grad_y;  // dz per texel along x and y
-  double z0, z_min, z_max;
-  int64_t i_lo, i_hi, j_lo, j_hi;  // texel centres the triangle's box holds (may be empty)
-
-  // False when the triangle has no area in the window (it covers no texel centre).
-  bool SetUp(const Float3* vertices, const uint32_t v[3], double origin_x, double origin_y,
-             double inverse_texel, double width, double height) {
-    double x[3], y[3], z[3];
-    for (int k = 0; k < 3; ++k) {
-      x[k] = (static_cast<double>(vertices[v[k]].x) - origin_x) * inverse_texel;
-      y[k] = (static_cast<double>(vertices[v[k]].y) - origin_y) * inverse_texel;
-      z[k] = vertices[v[k]].z;
-    }
-    const double area2 = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-    if (!(area2 != 0.0)) return false;
-    const double orientation = area2 > 0.0 ? 1.0 : -1.0;
-    for (int k = 0; k < 3; ++k) {
-      int from = (k + 1) % 3, to = (k + 2) % 3;  // counter-clockwise: the inside is on the left
-      double sign = orientation;
-      if (v[from] > v[to]) {
-        std::swap(from, to);
-        sign = -sign;
-      }
-      edge[k] = {x[from], y[from], x[to] - x[from], y[to] - y[from], sign};
-    }
-    x0 = x[0];
-    y0 = y[0];
-    const double inverse_area2 = 1.0 / area2;
-    grad_x = ((z[1] - z[0]) * (y[2] - y[0]) - (z[2] - z[0]) * (y[1] - y[0])) * inverse_area2;
-    grad_y = ((z[2] - z[0]) * (x[1] - x[0]) - (z[1] - z[0]) * (x[2] - x[0])) * inverse_area2;
-    z0 = z[0];
-    z_min = std::min({z[0], z[1], z[2]});
-    z_max = std::max({z[0], z[1], z[2]});
-    // Centres c = i + 1/2 within [min, max]: i in [ceil(min - 1/2), floor(max - 1/2)], kept
-    // within the window before the conversion (a vertex far outside a region).
-    const auto index = [](double c, double size) {
-      return static_cast<int64_t>(std::clamp(c, -1.0, size));
-    };
-    i_lo = index(std::ceil(std::min({x[0], x[1], x[2]}) - 0.5), width);
-    i_hi = index(std::floor(std::max({x[0], x[1], x[2]}) - 0.5), width);
-    j_lo = index(std::ceil(std::min({y[0], y[1], y[2]}) - 0.5), height);
-    j_hi = index(std::floor(std::max({y[0], y[1], y[2]}) - 0.5), height);
-    return true;
-  }
-  // The plane's z at a texel centre, clamped to the vertices' range (a sliver's steep gradient
-  // cannot extrapolate past its corners).
-  float Depth(double px, double py) const {
-    const double z = z0 + grad_x * (px - x0) + grad_y * (py - y0);
-    return static_cast<float>(std::clamp(z, z_min, z_max));
-  }
-};
-
-// The normal rule at a texel centre: the triangle's vertex normals interpolated with the clamped
-// barycentrics; its face normal where they cancel; `fallback` where it has none. Set up once per
-// triangle and reused along a row, where neighbouring texels mostly share their triangle.
-class NormalInterpolator {
- public:
-  void SetUp(const Float3* offset, const Float3* normals, const uint32_t* triangles,
-             uint32_t triangle, Float3 face_normal, double origin_x, double origin_y,
-             double inverse_texel, Float3 fallback) {
-    const uint32_t* v = triangles + 3 * size_t{triangle};
-    double x[3], y[3];
-    for (int k = 0; k < 3; ++k) {
-      x[k] = (static_cast<double>(offset[v[k]].x) - origin_x) * inverse_texel;
-      y[k] = (static_cast<double>(offset[v[k]].y) - origin_y) * inverse_texel;
-      n_[k] = normals[v[k]];
-    }
-    const double inverse_area2 =
-        1.0 / ((x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]));
-    x0_ = x[0];
-    y0_ = y[0];
-    b1_x_ = (y[2] - y[0]) * inverse_area2;
-    b1_y_ = -(x[2] - x[0]) * inverse_area2;
-    b2_x_ = -(y[1] - y[0]) * inverse_area2;
-    b2_y_ = (x[1] - x[0]) * inverse_area2;
-    fallback_ = NormalizeOr(face_normal, fallback);
-    triangle_ = triangle;
-  }
-  uint32_t triangle() const { return triangle_; }
-  Float3 At(double px, double py) const {
-    const double dx = px - x0_, dy = py - y0_;
-    const double b1 = std::clamp(b1_x_ * dx + b1_y_ * dy, 0.0, 1.0);
-    const double b2 = std::clamp(b2_x_ * dx + b2_y_ * dy, 0.0, 1.0 - b1);
-    const float w1 = static_cast<float>(b1), w2 = static_cast<float>(b2);
-    // Unnormalised: the octahedral code divides by the L1 norm anyway.
-    const Float3 n = n_[0] * (1.f - w1 - w2) + n_[1] * w1 + n_[2] * w2;
-    return std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z) > 1e-6f ? n : fallback_;
-  }
-
- private:
-  uint32_t triangle_ = kNoFace;
-  double x0_ = 0.0, y0_ = 0.0;
-  double b1_x_ = 0.0, b1_y_ = 0.0, b2_x_ = 0.0, b2_y_ = 0.0;  // barycentric gradients
-  Float3 n_[3];
-  Float3 fallback_;
-};
 
 }  // namespace
 
@@ -243,8 +120,7 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   const double limit = o.max_side;
   reserved_texels_ = static_cast<size_t>(std::min(kReserveGrowth * side_x, limit) *
                                          std::min(kReserveGrowth * side_y, limit));
-  top_face_.reserve(reserved_texels_);
-  bottom_face_.reserve(reserved_texels_);
+  Reserve(reserved_texels_);
   mesh_ = &mesh;
   return Status::Ok();
 }
@@ -254,6 +130,7 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   if (maps == nullptr) return Invalid("no collider to render into");
   maps->Clear();
   stats_.width = stats_.height = stats_.triangles_drawn = stats_.valid_texels = 0;
+  stats_.gap_texels = 0;
   if (mesh_ == nullptr) return Invalid("not initialised (Init failed or was not called)");
   RenderRegion box;  // everywhere, or the region in the view frame
   if (region != nullptr) {
@@ -268,9 +145,14 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   if (window.width == 0) return Status::Ok();  // nothing of the body reaches the region
   Publish(window, maps);
   Rasterize(window, maps);
+  if (options_.air_gaps) {
+    RasterizeGapSurfaces(window);
+    PublishGaps(window, maps);
+  }
   ShadeNormals(window, maps);
   maps->Finish();
   stats_.valid_texels = maps->stats().valid_texels;
+  stats_.gap_texels = maps->stats().gap_texels;
   return Status::Ok();
 }
 
@@ -410,10 +292,29 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   maps->normals_.reserve(reserved_texels_);
   maps->blocks_.reserve(reserved_texels_ / 64 + options_.max_side / 4 + 1);  // 8x8 blocks
   if (options_.sampling == DepthSampling::kBilinear) maps->bilinear_ok_.reserve(reserved_texels_);
+  if (options_.air_gaps) {
+    // Gaps on up to an eighth of the texels (a human has them on a few percent).
+    maps->gap_texel_bits_.reserve(reserved_texels_ / 32 + 1);
+    maps->gap_word_first_.reserve(reserved_texels_ / 32 + 1);
+    maps->gaps_.reserve(reserved_texels_ / 8);
+    maps->gap_normals_.reserve(reserved_texels_ / 8);
+  }
   maps->slabs_.assign(texels, BodyMapCollider::Slab{-kInf, kInf});
   maps->normals_.resize(texels);
   top_face_.assign(texels, kNoFace);
   bottom_face_.assign(texels, kNoFace);
+  maps->gap_layers_ = options_.air_gaps ? 1u : 0u;
+  if (options_.air_gaps) {
+    exit_z_.assign(texels, -kInf);
+    entry_z_.assign(texels, -kInf);
+    exit_face_.assign(texels, kNoFace);
+    entry_face_.assign(texels, kNoFace);
+    entries_above_.assign(texels, 0);
+    exits_above_.assign(texels, 0);
+    entries_total_.assign(texels, 0);
+    exits_total_.assign(texels, 0);
+    crowded_.assign(texels, 0);
+  }
   maps->width_ = window.width;
   maps->height_ = window.height;
   maps->width_f_ = static_cast<float>(window.width);
@@ -431,6 +332,12 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
 void BodyMapRenderer::Reserve(size_t texels) {
   top_face_.reserve(texels);
   bottom_face_.reserve(texels);
+  if (!options_.air_gaps) return;
+  for (std::vector<float>* v : {&exit_z_, &entry_z_}) v->reserve(texels);
+  for (std::vector<uint32_t>* v : {&exit_face_, &entry_face_}) v->reserve(texels);
+  for (std::vector<uint16_t>* v : {&entries_above_, &exits_above_, &entries_total_, &exits_total_})
+    v->reserve(texels);
+  crowded_.reserve(texels);
 }
 
 // Stage 4: per texel the highest (front) and lowest (back) z of the triangles covering its
@@ -445,6 +352,7 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
   const uint32_t* tri = mesh_->triangles.data();
   BodyMapCollider::Slab* slabs = maps->slabs_.data();
+  const bool gaps = options_.air_gaps;
   detail::ParallelFor(band_count, 1, [&](int64_t band) {
     const int64_t row_begin = band * rows_per_band;
     const int64_t row_end = std::min(height, row_begin + rows_per_band);
@@ -462,6 +370,8 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
                    static_cast<double>(width), static_cast<double>(height))) {
         continue;
       }
+      // A surface leaving the body going along -z: a gap's upper boundary candidate.
+      const bool leaving = gaps && !r.entering;
       const int64_t j_begin = std::max(r.j_lo, row_begin), j_end = std::min(r.j_hi + 1, row_end);
       const int64_t i_begin = std::max<int64_t>(r.i_lo, 0), i_end = std::min(r.i_hi + 1, width);
       for (int64_t j = j_begin; j < j_end; ++j) {
@@ -488,6 +398,10 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
           if (z < s.bottom) {
             s.bottom = z;
             bottom_face_[k] = t;
+          }
+          if (leaving && z > exit_z_[k]) {
+            exit_z_[k] = z;
+            exit_face_[k] = t;
           }
         }
       }
@@ -588,8 +502,14 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
 size_t BodyMapRenderer::memory_bytes() const {
   return sizeof(*this) +
          (vertex_triangle_offsets_.capacity() + vertex_triangles_.capacity() + drawn_.capacity() +
-          top_face_.capacity() + bottom_face_.capacity()) *
+          top_face_.capacity() + bottom_face_.capacity() + exit_face_.capacity() +
+          entry_face_.capacity()) *
              sizeof(uint32_t) +
+         (exit_z_.capacity() + entry_z_.capacity()) * sizeof(float) +
+         (entries_above_.capacity() + exits_above_.capacity() + entries_total_.capacity() +
+          exits_total_.capacity()) *
+             sizeof(uint16_t) +
+         crowded_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *
              sizeof(Float3);
 }
