@@ -260,7 +260,8 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
     stats->maps_render_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - render_start)
             .count();
-    colliders.body_map = &rendered_maps_;
+    // Nothing of the body within the garments' reach this frame: no maps to collide with.
+    colliders.body_map = rendered_maps_.empty() ? nullptr : &rendered_maps_;
   } else if (has_maps_) {
     const float map_time = clip_ >= 0 ? ClipTimeOf(asset_->clips[static_cast<size_t>(clip_)], t1,
                                                    scene_->animation.loop)

@@ -129,6 +129,12 @@ TEST(BodyMapRenderer, TheRegionCutsTheWindowAndTheTriangles) {
       EXPECT_EQ(whole.IsInside({x, 0.013f, z}), cut.IsInside({x, 0.013f, z})) << x << " " << z;
     }
   }
+  // A region that cuts the body along the view axis (a blanket's box over a back) keeps whole
+  // slabs: a point inside the body and the region is inside, not between two halves of a shell.
+  region.min = {-0.2f, -0.2f, 0.06f};
+  region.max = {0.2f, 0.2f, 0.3f};
+  ASSERT_TRUE(renderer.Render(identity, &cut, &region).ok());
+  for (float z = 0.065f; z < 0.1f; z += 0.005f) EXPECT_TRUE(cut.IsInside({0.f, 0.01f, z})) << z;
   // A region the body does not reach: an empty collider, not an error.
   region.min = {5.f, 5.f, 5.f};
   region.max = {6.f, 6.f, 6.f};

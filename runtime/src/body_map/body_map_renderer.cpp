@@ -225,7 +225,11 @@ void BodyMapRenderer::ComputeNormals() {
   });
 }
 
-// Stage 2: the triangles whose offset box meets the region, ascending.
+// Stage 2: the triangles whose offset box meets the region across the view axis, ascending. Not
+// along it: a texel's slab needs every surface on its ray, or a region that cuts the body along
+// the axis (a blanket's box over a fox's back, seen from above) leaves the top surface without
+// the bottom one, a thin shell the cloth falls through. The air a part outside the region adds
+// in front of or behind the garment is the gap pass's to find.
 void BodyMapRenderer::CullTriangles(const RenderRegion& region) {
   drawn_.clear();
   const uint32_t* tri = mesh_->triangles.data();
@@ -234,8 +238,7 @@ void BodyMapRenderer::CullTriangles(const RenderRegion& region) {
     const Float3 a = offset_[tri[3 * t]], b = offset_[tri[3 * t + 1]], c = offset_[tri[3 * t + 2]];
     const bool reaches =
         std::max({a.x, b.x, c.x}) >= region.min.x && std::min({a.x, b.x, c.x}) <= region.max.x &&
-        std::max({a.y, b.y, c.y}) >= region.min.y && std::min({a.y, b.y, c.y}) <= region.max.y &&
-        std::max({a.z, b.z, c.z}) >= region.min.z && std::min({a.z, b.z, c.z}) <= region.max.z;
+        std::max({a.y, b.y, c.y}) >= region.min.y && std::min({a.y, b.y, c.y}) <= region.max.y;
     if (reaches) drawn_.push_back(t);  // reserved for every triangle at Init
   }
   stats_.triangles_drawn = static_cast<uint32_t>(drawn_.size());
