@@ -156,6 +156,11 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   return Status::Ok();
 }
 
+detail::RasterWindow BodyMapRenderer::RasterWindowOf(const Window& window) const {
+  return {window.origin_x, window.origin_y, window.width, window.height,
+          1.0 / static_cast<double>(options_.texel_size)};
+}
+
 Status BodyMapRenderer::CheckRegion(const RenderRegion& region) const {
   const float lo[3] = {region.min.x, region.min.y, region.min.z};
   const float hi[3] = {region.max.x, region.max.y, region.max.z};
@@ -345,71 +350,28 @@ void BodyMapRenderer::Reserve(size_t texels) {
 
 // Stage 4: per texel the highest (front) and lowest (back) z of the triangles covering its
 // centre, and which triangle it was (ties: the lower index, as triangles are drawn ascending).
-// Row bands run in parallel; each draws every triangle crossing its rows, so a texel is written
-// by one band only and the result does not depend on the banding.
 void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
-  const int64_t width = window.width, height = window.height;
-  const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};  // balance, not results
-  const int64_t rows_per_band = std::max<int64_t>(8, (height + bands - 1) / bands);
-  const int64_t band_count = (height + rows_per_band - 1) / rows_per_band;
-  const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
-  const uint32_t* tri = mesh_->triangles.data();
   BodyMapCollider::Slab* slabs = maps->slabs_.data();
   const bool gaps = options_.air_gaps;
-  detail::ParallelFor(band_count, 1, [&](int64_t band) {
-    const int64_t row_begin = band * rows_per_band;
-    const int64_t row_end = std::min(height, row_begin + rows_per_band);
-    for (uint32_t t : drawn_) {
-      const uint32_t* v = tri + 3 * size_t{t};
-      // Rows first, from the vertices alone: most triangles miss the band.
-      const double y_lo = std::min({offset_[v[0]].y, offset_[v[1]].y, offset_[v[2]].y});
-      const double y_hi = std::max({offset_[v[0]].y, offset_[v[1]].y, offset_[v[2]].y});
-      if ((y_hi - window.origin_y) * inverse_texel < static_cast<double>(row_begin) ||
-          (y_lo - window.origin_y) * inverse_texel > static_cast<double>(row_end) + 1.0) {
-        continue;
-      }
-      RasterTriangle r;
-      if (!r.SetUp(offset_.data(), v, window.origin_x, window.origin_y, inverse_texel,
-                   static_cast<double>(width), static_cast<double>(height))) {
-        continue;
-      }
-      // A surface leaving the body going along -z: a gap's upper boundary candidate.
-      const bool leaving = gaps && !r.entering;
-      const int64_t j_begin = std::max(r.j_lo, row_begin), j_end = std::min(r.j_hi + 1, row_end);
-      const int64_t i_begin = std::max<int64_t>(r.i_lo, 0), i_end = std::min(r.i_hi + 1, width);
-      for (int64_t j = j_begin; j < j_end; ++j) {
-        const double py = static_cast<double>(j) + 0.5;
-        const double row[3] = {r.edge[0].RowTerm(py), r.edge[1].RowTerm(py), r.edge[2].RowTerm(py)};
-        int64_t lo = i_begin, hi = i_end - 1;
-        if (!(r.edge[0].Narrow(row[0], &lo, &hi) && r.edge[1].Narrow(row[1], &lo, &hi) &&
-              r.edge[2].Narrow(row[2], &lo, &hi))) {
-          continue;
+  detail::RasterizeInBands(
+      offset_.data(), mesh_->triangles.data(), drawn_, RasterWindowOf(window),
+      [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, const double*) {
+        const float z = r.Depth(px, py);
+        BodyMapCollider::Slab& s = slabs[k];
+        if (z > s.top) {
+          s.top = z;
+          top_face_[k] = t;
         }
-        for (int64_t i = lo; i <= hi; ++i) {
-          const double px = static_cast<double>(i) + 0.5;
-          if (!(r.edge[0].Inside(row[0], px) && r.edge[1].Inside(row[1], px) &&
-                r.edge[2].Inside(row[2], px))) {
-            continue;
-          }
-          const float z = r.Depth(px, py);
-          const size_t k = static_cast<size_t>(j * width + i);
-          BodyMapCollider::Slab& s = slabs[k];
-          if (z > s.top) {
-            s.top = z;
-            top_face_[k] = t;
-          }
-          if (z < s.bottom) {
-            s.bottom = z;
-            bottom_face_[k] = t;
-          }
-          if (leaving && z > exit_z_[k]) {
-            exit_z_[k] = z;
-            exit_face_[k] = t;
-          }
+        if (z < s.bottom) {
+          s.bottom = z;
+          bottom_face_[k] = t;
         }
-      }
-    }
-  });
+        // A surface leaving the body going along -z: a gap's upper boundary candidate.
+        if (gaps && !r.entering && z > exit_z_[k]) {
+          exit_z_[k] = z;
+          exit_face_[k] = t;
+        }
+      });
 }
 
 // Stage 5: the outward normal of each covered texel's front and back surfaces, oct16.

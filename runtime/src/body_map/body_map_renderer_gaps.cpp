@@ -15,8 +15,6 @@
 #include "body_map/raster_triangle.h"
 #include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/normal_encoding.h"
-#include "drape/runtime/task_system.h"
-#include "tasks/parallel_for.h"
 
 namespace drape {
 namespace {
@@ -31,71 +29,33 @@ constexpr float kMinGap = 1e-4f;
 
 }  // namespace
 
-// Stage 4b: the entering and leaving surfaces around each texel's upper gap boundary. Row bands
-// as in Rasterize: a texel is written by one band only.
+// Stage 4b: the entering and leaving surfaces around each texel's upper gap boundary.
 void BodyMapRenderer::RasterizeGapSurfaces(const Window& window) {
-  const int64_t width = window.width, height = window.height;
-  const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};
-  const int64_t rows_per_band = std::max<int64_t>(8, (height + bands - 1) / bands);
-  const int64_t band_count = (height + rows_per_band - 1) / rows_per_band;
-  const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
-  const uint32_t* tri = mesh_->triangles.data();
-  detail::ParallelFor(band_count, 1, [&](int64_t band) {
-    const int64_t row_begin = band * rows_per_band;
-    const int64_t row_end = std::min(height, row_begin + rows_per_band);
-    for (uint32_t t : drawn_) {
-      const uint32_t* v = tri + 3 * size_t{t};
-      const double y_lo = std::min({offset_[v[0]].y, offset_[v[1]].y, offset_[v[2]].y});
-      const double y_hi = std::max({offset_[v[0]].y, offset_[v[1]].y, offset_[v[2]].y});
-      if ((y_hi - window.origin_y) * inverse_texel < static_cast<double>(row_begin) ||
-          (y_lo - window.origin_y) * inverse_texel > static_cast<double>(row_end) + 1.0) {
-        continue;
-      }
-      RasterTriangle r;
-      if (!r.SetUp(offset_.data(), v, window.origin_x, window.origin_y, inverse_texel,
-                   static_cast<double>(width), static_cast<double>(height))) {
-        continue;
-      }
-      const bool entering = r.entering;  // the drawn triangle's winding, as the bake's sweep
-      const int64_t j_begin = std::max(r.j_lo, row_begin), j_end = std::min(r.j_hi + 1, row_end);
-      const int64_t i_begin = std::max<int64_t>(r.i_lo, 0), i_end = std::min(r.i_hi + 1, width);
-      for (int64_t j = j_begin; j < j_end; ++j) {
-        const double py = static_cast<double>(j) + 0.5;
-        const double row[3] = {r.edge[0].RowTerm(py), r.edge[1].RowTerm(py), r.edge[2].RowTerm(py)};
-        int64_t lo = i_begin, hi = i_end - 1;
-        if (!(r.edge[0].Narrow(row[0], &lo, &hi) && r.edge[1].Narrow(row[1], &lo, &hi) &&
-              r.edge[2].Narrow(row[2], &lo, &hi))) {
-          continue;
+  detail::RasterizeInBands(
+      offset_.data(), mesh_->triangles.data(), drawn_, RasterWindowOf(window),
+      [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, const double* row) {
+        if (exit_face_[k] == kNoFace) return;  // nothing leaves here: no gap to bound
+        // Counted once per shared edge; searched for the lower boundary inclusively, so that a
+        // texel centre on a seam (vertices split at the same position, whose edge values are
+        // not exactly negated) can only spoil the count, which keeps the slab.
+        const bool once = r.edge[0].InsideOnce(row[0], px) && r.edge[1].InsideOnce(row[1], px) &&
+                          r.edge[2].InsideOnce(row[2], px);
+        const float z = r.Depth(px, py), upper = exit_z_[k];
+        if (!r.entering) {  // the drawn triangle's winding, as the bake's sweep
+          if (once) ++exits_total_[k];
+          if (z >= upper && once) ++exits_above_[k];
+          return;
         }
-        for (int64_t i = lo; i <= hi; ++i) {
-          const size_t k = static_cast<size_t>(j * width + i);
-          if (exit_face_[k] == kNoFace) continue;  // nothing leaves here: no gap to bound
-          const double px = static_cast<double>(i) + 0.5;
-          if (!(r.edge[0].Inside(row[0], px) && r.edge[1].Inside(row[1], px) &&
-                r.edge[2].Inside(row[2], px))) {
-            continue;
-          }
-          // Counted once per shared edge; searched for the lower boundary inclusively, so that a
-          // texel centre on a seam (vertices split at the same position, whose edge values are
-          // not exactly negated) can only spoil the count, which keeps the slab.
-          const bool once = r.edge[0].InsideOnce(row[0], px) && r.edge[1].InsideOnce(row[1], px) &&
-                            r.edge[2].InsideOnce(row[2], px);
-          const float z = r.Depth(px, py), upper = exit_z_[k];
-          if (once) ++(entering ? entries_total_ : exits_total_)[k];
-          if (!entering) {
-            if (z >= upper && once) ++exits_above_[k];
-          } else if (z > upper) {
-            if (once) ++entries_above_[k];
-          } else if (z > upper - kMinGap) {
-            crowded_[k] = 1;
-          } else if (z > entry_z_[k]) {
-            entry_z_[k] = z;
-            entry_face_[k] = t;
-          }
+        if (once) ++entries_total_[k];
+        if (z > upper) {
+          if (once) ++entries_above_[k];
+        } else if (z > upper - kMinGap) {
+          crowded_[k] = 1;
+        } else if (z > entry_z_[k]) {
+          entry_z_[k] = z;
+          entry_face_[k] = t;
         }
-      }
-    }
-  });
+      });
 }
 
 // Stage 4c: the gaps that pass, in row-major order, into the collider's compact gap storage,

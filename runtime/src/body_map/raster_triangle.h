@@ -6,8 +6,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 
 #include "drape/runtime/math.h"
+#include "drape/runtime/task_system.h"
+#include "tasks/parallel_for.h"
 
 namespace drape::detail {
 
@@ -149,5 +152,64 @@ class NormalInterpolator {
   Float3 n_[3];
   Float3 fallback_;
 };
+
+// The texel grid one render draws into: texel (i, j) is entry j * width + i.
+struct RasterWindow {
+  double origin_x = 0.0, origin_y = 0.0;  // metres, view frame
+  int64_t width = 0, height = 0;          // texels
+  double inverse_texel = 0.0;             // 1 / metres
+};
+
+// Calls fragment(t, r, k, px, row) for every texel centre the `drawn` triangles cover (edges
+// inclusive): t the triangle, r its set-up, k the texel's index, px its centre's x and row the
+// edge terms of its row (for RasterTriangle::Edge::InsideOnce); r.Depth(px, py) is its depth.
+// Row bands run in parallel, each drawing every triangle that crosses its rows, so a texel is
+// handled by one band only, its triangles in `drawn` order, whatever the banding: a fragment may
+// write texel k's entries without a lock and the result does not depend on the thread count.
+template <class Fragment>
+void RasterizeInBands(const Float3* vertices, const uint32_t* triangles,
+                      std::span<const uint32_t> drawn, const RasterWindow& w, Fragment&& fragment) {
+  const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};  // balance, not results
+  const int64_t rows_per_band = std::max<int64_t>(8, (w.height + bands - 1) / bands);
+  const int64_t band_count = (w.height + rows_per_band - 1) / rows_per_band;
+  ParallelFor(band_count, 1, [&](int64_t band) {
+    const int64_t row_begin = band * rows_per_band;
+    const int64_t row_end = std::min(w.height, row_begin + rows_per_band);
+    for (uint32_t t : drawn) {
+      const uint32_t* v = triangles + 3 * size_t{t};
+      // Rows first, from the vertices alone: most triangles miss the band.
+      const double y_lo = std::min({vertices[v[0]].y, vertices[v[1]].y, vertices[v[2]].y});
+      const double y_hi = std::max({vertices[v[0]].y, vertices[v[1]].y, vertices[v[2]].y});
+      if ((y_hi - w.origin_y) * w.inverse_texel < static_cast<double>(row_begin) ||
+          (y_lo - w.origin_y) * w.inverse_texel > static_cast<double>(row_end) + 1.0) {
+        continue;
+      }
+      RasterTriangle r;
+      if (!r.SetUp(vertices, v, w.origin_x, w.origin_y, w.inverse_texel,
+                   static_cast<double>(w.width), static_cast<double>(w.height))) {
+        continue;
+      }
+      const int64_t j_begin = std::max(r.j_lo, row_begin), j_end = std::min(r.j_hi + 1, row_end);
+      const int64_t i_begin = std::max<int64_t>(r.i_lo, 0), i_end = std::min(r.i_hi + 1, w.width);
+      for (int64_t j = j_begin; j < j_end; ++j) {
+        const double py = static_cast<double>(j) + 0.5;
+        const double row[3] = {r.edge[0].RowTerm(py), r.edge[1].RowTerm(py), r.edge[2].RowTerm(py)};
+        int64_t lo = i_begin, hi = i_end - 1;
+        if (!(r.edge[0].Narrow(row[0], &lo, &hi) && r.edge[1].Narrow(row[1], &lo, &hi) &&
+              r.edge[2].Narrow(row[2], &lo, &hi))) {
+          continue;
+        }
+        for (int64_t i = lo; i <= hi; ++i) {
+          const double px = static_cast<double>(i) + 0.5;
+          if (!(r.edge[0].Inside(row[0], px) && r.edge[1].Inside(row[1], px) &&
+                r.edge[2].Inside(row[2], px))) {
+            continue;
+          }
+          fragment(t, r, static_cast<size_t>(j * w.width + i), px, py, row);
+        }
+      }
+    }
+  });
+}
 
 }  // namespace drape::detail

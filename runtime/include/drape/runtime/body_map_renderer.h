@@ -27,6 +27,10 @@
 
 namespace drape {
 
+namespace detail {
+struct RasterWindow;  // body_map/raster_triangle.h
+}  // namespace detail
+
 struct BodyMapRenderOptions {
   float texel_size = 0.002f;  // metres, [1e-4, 1]: the maps' resolution
   float epsilon = 0.005f;     // metres, [0, 1]: the surface offset along the vertex normals
@@ -116,6 +120,7 @@ class BodyMapRenderer {
     double origin_x = 0.0, origin_y = 0.0;  // metres, a multiple of the texel size
     uint32_t width = 0, height = 0;         // texels
   };
+  detail::RasterWindow RasterWindowOf(const Window& window) const;
   Status CheckRegion(const RenderRegion& region) const;
   Status SkinAndOffset(std::span<const Mat34> skinning);
   void ComputeNormals();
