@@ -42,13 +42,26 @@ class BodyMapMethod final : public Method {
       const ContactQuery c = collider_.Query(previous[k], positions[k]);
       flags[k] = c.contact ? static_cast<uint8_t>(kCollisionContact | c.flags)
                            : static_cast<uint8_t>(kCollisionNone);
-      if (c.contact) ApplyResponse(c, BenchResponse(), &positions[k], &velocities[k]);
+      if (c.contact) RespondInViewFrame(c, &positions[k], &velocities[k]);
     }
     return true;
   }
   const BodyMapCollider& collider() const { return collider_; }
 
  private:
+  // The response as the batch applies it: in the maps' view frame (body_map_collider.h), whose
+  // sums run in another order than the asset frame's for a view axis other than z. The
+  // permutation is exact, so Query's answer maps back to the view frame's bits.
+  void RespondInViewFrame(ContactQuery c, Float3* position, Float3* velocity) const {
+    const BodyMapViewAxis axis = collider_.view_axis();
+    c.point = ToBodyMapView(axis, c.point);
+    c.normal = ToBodyMapView(axis, c.normal);
+    Float3 p = ToBodyMapView(axis, *position), v = ToBodyMapView(axis, *velocity);
+    ApplyResponse(c, BenchResponse(), &p, &v);
+    *position = FromBodyMapView(axis, p);
+    *velocity = FromBodyMapView(axis, v);
+  }
+
   BodyMapCollider collider_;
 };
 

@@ -33,6 +33,9 @@ constexpr SampleScene kSampleScenes[] = {
      "painted per vertex (`_MAX_DISTANCE`: 0 at the waist to 8 cm at the hem), on a floor"},
     {"robot_expressive_cape.json", "`RobotExpressive.glb` (shared assets)",
      "a cape on a rigid-part robot (4.4 m tall as authored), 18 hulls"},
+    {"fox_blanket.json", "`Fox.glb` (shared assets)",
+     "a blanket dropped on a quadruped's back while it looks around, body maps rendered per frame "
+     "and seen from above (the bake's least-air view axis), on a floor"},
     {"animated_human_skirt.json", "`Animated_Human.fbx` (shared assets)",
      "a skirt on Quaternius' Animated Human walking, written in the rest frame (its bind pose is "
      "scaled 100x against the rest pose), body maps rendered per frame + hulls"},

@@ -1,9 +1,9 @@
 #pragma once
 // Paper A's body maps for any pose the engine drives: skins the stored bind mesh with the frame's
 // skinning matrices, offsets it by epsilon along its vertex normals and rasterizes the front and
-// back surfaces (slab only, along the view axis the options name) straight into a
-// BodyMapCollider, over the window a region box allows. How it works and what it costs:
-// docs/ALGORITHMS.md §7.9, docs/PERFORMANCE.md.
+// back surfaces and the first air gap between them (along the view axis the options name)
+// straight into a BodyMapCollider, over the window a region box allows. How it works and what it
+// costs: docs/ALGORITHMS.md §7.9, docs/PERFORMANCE.md.
 //
 //   BodyMapRenderer renderer;
 //   renderer.Init(asset.mesh, {.texel_size = 0.002f, .epsilon = asset.body_maps.epsilon});
