@@ -9,7 +9,7 @@
 namespace drape {
 
 struct BodyMapColliderAccess {
-  // false for background; top and bottom are asset-frame z. With gap layers a top can be one ulp
+  // false for background; top and bottom are view-frame z'. With gap layers a top can be one ulp
   // above the maps' value: its lowest bit flags the texels with gaps for the lanes.
   static bool TexelSlab(const BodyMapCollider& c, uint32_t i, uint32_t j, float* top,
                         float* bottom) {
@@ -23,7 +23,7 @@ struct BodyMapColliderAccess {
   static Float3 TexelNormal(const BodyMapCollider& c, uint32_t i, uint32_t j, bool back) {
     return c.TexelNormal(i, j, back);
   }
-  // The air gaps of texel (i, j) from the front: upper[g], lower[g] (asset-frame z, arrays of
+  // The air gaps of texel (i, j) from the front: upper[g], lower[g] (view-frame z', arrays of
   // layers() - 1); returns their number (0 for background and gap-free texels).
   static uint32_t TexelGaps(const BodyMapCollider& c, uint32_t i, uint32_t j, float* upper,
                             float* lower) {

@@ -80,7 +80,7 @@ struct BodyMapPose {
   // Normals are the body's outward normals at those surfaces, so a gap's upper normal points
   // into the gap (-z side). Gap layers are stored only for the texels in gap_texels. At one
   // texel the gaps are filled in order and nested strictly inside the slab without touching:
-  // top > upper_1 > lower_1 > upper_2 > lower_2 > ... > bottom (asset-frame z).
+  // top > upper_1 > lower_1 > upper_2 > lower_2 > ... > bottom (view-frame z').
   uint8_t layers = 1;
   BodyMapViewAxis view_axis = BodyMapViewAxis::kZ;  // class version 4; the same in a whole set
   // The stored texels that hold at least one gap (positions n within layer 0, strictly

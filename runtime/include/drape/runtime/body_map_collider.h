@@ -1,6 +1,6 @@
 #pragma once
 // Paper A's image-space collider at run time: the front/back depth and normal maps of one posed
-// body (drape/formats/body_map_data.h) as a per-texel slab of asset-frame z, tested discretely,
+// body (drape/formats/body_map_data.h) as a per-texel slab along the view axis, tested discretely,
 // continuously along each particle's motion, and in batches with the response. How it works:
 // docs/ALGORITHMS.md §7; figures: docs/PERFORMANCE.md.
 //
