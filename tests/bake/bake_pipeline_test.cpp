@@ -39,6 +39,8 @@ struct CharacterCase {
   // fraction they classify wrongly (report body_maps.expected_error). A human's slab holds
   // little air; a creature's holds what remains between its parts seen from above.
   double max_misclassified;
+  // The axis the bake sees it along: a quadruped from above, a standing body from the front.
+  const char* view_axis;
 };
 
 class BakeEveryCharacter : public ::testing::TestWithParam<CharacterCase> {
@@ -234,18 +236,19 @@ TEST_P(BakeEveryCharacter, BodyMapsMisclassifyFewPointsBeyondTheBand) {
   EXPECT_LE(error["misclassified_beyond_band"].get<double>(), GetParam().max_misclassified)
       << "seen along " << result.report["body_maps"]["view_axis"].get<std::string>();
   EXPECT_LE(error["error_p99_mm"].get<double>(), error["error_max_mm"].get<double>());
+  EXPECT_EQ(result.report["body_maps"]["view_axis"].get<std::string>(), GetParam().view_axis);
 }
 
 INSTANTIATE_TEST_SUITE_P(
     SharedCharacters, BakeEveryCharacter,
-    ::testing::Values(CharacterCase{"", 0.002},
-                      CharacterCase{"RiggedSimple/RiggedSimple.gltf", 0.002},
-                      CharacterCase{"RiggedFigure/RiggedFigure.glb", 0.002},
-                      CharacterCase{"CesiumMan/CesiumMan.glb", 0.002},
-                      CharacterCase{"Fox/Fox.glb", 0.005},
-                      CharacterCase{"RobotExpressive/RobotExpressive.glb", 0.002},
-                      CharacterCase{"QuaterniusAnimatedHuman/Animated_Human.fbx", 0.002},
-                      CharacterCase{"QuaterniusSpider/Spider.fbx", 0.005}));
+    ::testing::Values(CharacterCase{"", 0.002, "z"},
+                      CharacterCase{"RiggedSimple/RiggedSimple.gltf", 0.002, "z"},
+                      CharacterCase{"RiggedFigure/RiggedFigure.glb", 0.002, "z"},
+                      CharacterCase{"CesiumMan/CesiumMan.glb", 0.002, "z"},
+                      CharacterCase{"Fox/Fox.glb", 0.005, "y"},
+                      CharacterCase{"RobotExpressive/RobotExpressive.glb", 0.002, "z"},
+                      CharacterCase{"QuaterniusAnimatedHuman/Animated_Human.fbx", 0.002, "z"},
+                      CharacterCase{"QuaterniusSpider/Spider.fbx", 0.005, "y"}));
 
 // The same input and config give byte-identical files at 1 and 2 threads and across runs.
 TEST(BakePipeline, BytesDoNotDependOnThreadCount) {
