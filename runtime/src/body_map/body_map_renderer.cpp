@@ -23,7 +23,6 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 using detail::kNoFace;
-using detail::NormalInterpolator;
 using detail::RasterTriangle;
 // Init reserves this much more than the bind pose's window in each dimension: a pose that
 // spreads the limbs needs a wider window.
@@ -36,6 +35,14 @@ Status Invalid(const std::string& message) {
 }
 
 }  // namespace
+
+// Out of line: the per-triangle shading type is internal (raster_triangle.h).
+BodyMapRenderer::BodyMapRenderer() = default;
+BodyMapRenderer::~BodyMapRenderer() = default;
+BodyMapRenderer::BodyMapRenderer(const BodyMapRenderer&) = default;
+BodyMapRenderer::BodyMapRenderer(BodyMapRenderer&&) noexcept = default;
+BodyMapRenderer& BodyMapRenderer::operator=(const BodyMapRenderer&) = default;
+BodyMapRenderer& BodyMapRenderer::operator=(BodyMapRenderer&&) noexcept = default;
 
 Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& options) {
   mesh_ = nullptr;
@@ -105,7 +112,10 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   normals_.resize(vertices);
   offset_.resize(vertices);
   face_normals_.resize(triangles);
+  shading_.resize(triangles);
   drawn_.reserve(triangles);
+  raster_.reserve(triangles);
+  raster_rows_.reserve(triangles);
 
   // The bind pose's window, grown: most poses then render without allocating.
   Float3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
@@ -145,8 +155,9 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   if (window.width == 0) return Status::Ok();  // nothing of the body reaches the region
   Publish(window, maps);
   Rasterize(window, maps);
+  SetUpShading(window);
   if (options_.air_gaps) {
-    RasterizeGapSurfaces(window);
+    RasterizeGapSurfaces(window, *maps);
     PublishGaps(window, maps);
   }
   ShadeNormals(window, maps);
@@ -346,16 +357,22 @@ void BodyMapRenderer::Reserve(size_t texels) {
   for (std::vector<uint16_t>* v : {&entries_above_, &exits_above_, &entries_total_, &exits_total_})
     v->reserve(texels);
   crowded_.reserve(texels);
+  gap_tiles_.reserve(texels / 64 + options_.max_side / 4 + 1);  // 8 x 8 tiles
 }
 
-// Stage 4: per texel the highest (front) and lowest (back) z of the triangles covering its
-// centre, and which triangle it was (ties: the lower index, as triangles are drawn ascending).
+// Stage 4: each drawn triangle set up once, then per texel the highest (front) and lowest (back)
+// z of the triangles covering its centre, and which triangle it was (ties: the lower index, as
+// triangles are drawn ascending).
 void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   BodyMapCollider::Slab* slabs = maps->slabs_.data();
   const bool gaps = options_.air_gaps;
+  const detail::RasterWindow w = RasterWindowOf(window);
+  raster_.resize(drawn_.size());  // reserved for every triangle at Init
+  raster_rows_.resize(drawn_.size());
+  detail::SetUpTriangles(offset_.data(), mesh_->triangles.data(), drawn_, w, raster_, raster_rows_);
   detail::RasterizeInBands(
-      offset_.data(), mesh_->triangles.data(), drawn_, RasterWindowOf(window),
-      [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, const double*) {
+      drawn_, raster_, raster_rows_, w, nullptr,
+      [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
         const float z = r.Depth(px, py);
         BodyMapCollider::Slab& s = slabs[k];
         if (z > s.top) {
@@ -374,15 +391,25 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
       });
 }
 
-// Stage 5: the outward normal of each covered texel's front and back surfaces, oct16.
-void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) const {
-  const int64_t width = window.width, height = window.height;
+// Stage 5: the normal rule of every drawn triangle, then the outward normal of each covered
+// texel's front and back surfaces, oct16.
+void BodyMapRenderer::SetUpShading(const Window& window) {
   const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
   const uint32_t* tri = mesh_->triangles.data();
+  const int64_t drawn = static_cast<int64_t>(drawn_.size());
+  detail::ParallelFor(drawn, kVertexGrain, [&](int64_t d) {
+    const uint32_t t = drawn_[d];
+    shading_[t].SetUp(offset_.data(), normals_.data(), tri + 3 * size_t{t}, face_normals_[t],
+                      window.origin_x, window.origin_y, inverse_texel);
+  });
+}
+
+void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) const {
+  const int64_t width = window.width, height = window.height;
   const std::array<uint16_t, 2> up = EncodeOct16({0.f, 0.f, 1.f});
+  constexpr Float3 kUp{0.f, 0.f, 1.f}, kDown{0.f, 0.f, -1.f};
   detail::ParallelFor(height, 8, [&](int64_t j) {
-    const double py = static_cast<double>(j) + 0.5;
-    NormalInterpolator front, back;
+    const float py = static_cast<float>(j) + 0.5f;
     for (int64_t i = 0; i < width; ++i) {
       const size_t k = static_cast<size_t>(j * width + i);
       BodyMapCollider::TexelNormals& out = maps->normals_[k];
@@ -391,17 +418,9 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
         out = {{up[0], up[1]}, {up[0], up[1]}};
         continue;
       }
-      if (front.triangle() != front_face) {
-        front.SetUp(offset_.data(), normals_.data(), tri, front_face, face_normals_[front_face],
-                    window.origin_x, window.origin_y, inverse_texel, Float3{0.f, 0.f, 1.f});
-      }
-      if (back.triangle() != back_face) {
-        back.SetUp(offset_.data(), normals_.data(), tri, back_face, face_normals_[back_face],
-                   window.origin_x, window.origin_y, inverse_texel, Float3{0.f, 0.f, -1.f});
-      }
-      const double px = static_cast<double>(i) + 0.5;
-      const std::array<uint16_t, 2> a = EncodeOct16(front.At(px, py));
-      const std::array<uint16_t, 2> b = EncodeOct16(back.At(px, py));
+      const float px = static_cast<float>(i) + 0.5f;
+      const std::array<uint16_t, 2> a = EncodeOct16(shading_[front_face].At(px, py, kUp));
+      const std::array<uint16_t, 2> b = EncodeOct16(shading_[back_face].At(px, py, kDown));
       out = {{a[0], a[1]}, {b[0], b[1]}};
     }
   });
@@ -476,7 +495,10 @@ size_t BodyMapRenderer::memory_bytes() const {
              sizeof(uint16_t) +
          crowded_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *
-             sizeof(Float3);
+             sizeof(Float3) +
+         shading_.capacity() * sizeof(detail::TriangleShading) +
+         raster_.capacity() * sizeof(detail::RasterTriangle) +
+         raster_rows_.capacity() * sizeof(detail::RasterRows) + gap_tiles_.capacity();
 }
 
 }  // namespace drape

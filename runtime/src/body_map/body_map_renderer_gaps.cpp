@@ -20,7 +20,6 @@ namespace drape {
 namespace {
 
 using detail::kNoFace;
-using detail::NormalInterpolator;
 using detail::RasterTriangle;
 
 // Gaps thinner than this (metres) are not kept, as the bake's (kMinBodyMapGap): touching parts
@@ -29,17 +28,29 @@ constexpr float kMinGap = 1e-4f;
 
 }  // namespace
 
-// Stage 4b: the entering and leaving surfaces around each texel's upper gap boundary.
-void BodyMapRenderer::RasterizeGapSurfaces(const Window& window) {
+// Stage 4b: the texels where a gap may lie (the highest surface leaving the body lies above
+// the back surface), then the entering and leaving surfaces around their upper gap boundary.
+void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps) {
+  const size_t width = window.width, height = window.height;
+  gap_tiles_.assign(detail::TileMask::TileCount(window.width, window.height), 0);
+  detail::TileMask tiles{(static_cast<int64_t>(width) + 7) >> detail::TileMask::kShift, gap_tiles_};
+  for (size_t j = 0; j < height; ++j) {
+    for (size_t i = 0; i < width; ++i) {
+      const size_t k = j * width + i;
+      // No room for a gap of kMinGap and its two boundaries above the back surface.
+      if (exit_face_[k] != kNoFace && !(exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap)) {
+        exit_face_[k] = kNoFace;
+      }
+      if (exit_face_[k] != kNoFace) tiles.Mark(static_cast<int64_t>(i), static_cast<int64_t>(j));
+    }
+  }
   detail::RasterizeInBands(
-      offset_.data(), mesh_->triangles.data(), drawn_, RasterWindowOf(window),
-      [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, const double* row) {
-        if (exit_face_[k] == kNoFace) return;  // nothing leaves here: no gap to bound
+      drawn_, raster_, raster_rows_, RasterWindowOf(window), &tiles,
+      [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool once) {
+        if (exit_face_[k] == kNoFace) return;  // no gap to bound here
         // Counted once per shared edge; searched for the lower boundary inclusively, so that a
         // texel centre on a seam (vertices split at the same position, whose edge values are
         // not exactly negated) can only spoil the count, which keeps the slab.
-        const bool once = r.edge[0].InsideOnce(row[0], px) && r.edge[1].InsideOnce(row[1], px) &&
-                          r.edge[2].InsideOnce(row[2], px);
         const float z = r.Depth(px, py), upper = exit_z_[k];
         if (!r.entering) {  // the drawn triangle's winding, as the bake's sweep
           if (once) ++exits_total_[k];
@@ -66,9 +77,6 @@ void BodyMapRenderer::PublishGaps(const Window& window, BodyMapCollider* maps) {
   maps->gap_texel_bits_.assign((texels + 31) / 32, 0u);
   maps->gaps_.clear();
   maps->gap_normals_.clear();
-  const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
-  const uint32_t* tri = mesh_->triangles.data();
-  NormalInterpolator upper_normal, lower_normal;
   for (size_t k = 0; k < texels; ++k) {
     const BodyMapCollider::Slab slab = maps->slabs_[k];
     const float upper = exit_z_[k], lower = entry_z_[k];
@@ -79,20 +87,12 @@ void BodyMapRenderer::PublishGaps(const Window& window, BodyMapCollider* maps) {
     if (!air) continue;
     maps->gap_texel_bits_[k >> 5] |= 1u << (k & 31u);
     maps->gaps_.push_back({upper, lower});
-    const double px = static_cast<double>(k % window.width) + 0.5;
-    const double py = static_cast<double>(k / window.width) + 0.5;
-    if (upper_normal.triangle() != exit_face_[k]) {
-      upper_normal.SetUp(offset_.data(), normals_.data(), tri, exit_face_[k],
-                         face_normals_[exit_face_[k]], window.origin_x, window.origin_y,
-                         inverse_texel, Float3{0.f, 0.f, -1.f});
-    }
-    if (lower_normal.triangle() != entry_face_[k]) {
-      lower_normal.SetUp(offset_.data(), normals_.data(), tri, entry_face_[k],
-                         face_normals_[entry_face_[k]], window.origin_x, window.origin_y,
-                         inverse_texel, Float3{0.f, 0.f, 1.f});
-    }
-    const std::array<uint16_t, 2> a = EncodeOct16(upper_normal.At(px, py));
-    const std::array<uint16_t, 2> b = EncodeOct16(lower_normal.At(px, py));
+    const float px = static_cast<float>(k % window.width) + 0.5f;
+    const float py = static_cast<float>(k / window.width) + 0.5f;
+    const std::array<uint16_t, 2> a =
+        EncodeOct16(shading_[exit_face_[k]].At(px, py, Float3{0.f, 0.f, -1.f}));
+    const std::array<uint16_t, 2> b =
+        EncodeOct16(shading_[entry_face_[k]].At(px, py, Float3{0.f, 0.f, 1.f}));
     maps->gap_normals_.push_back({{a[0], a[1]}, {b[0], b[1]}});
   }
   if (maps->gaps_.capacity() != capacity) ++stats_.grew;  // more gap texels than reserved

@@ -25,27 +25,29 @@ struct RasterTriangle {
   struct Edge {
     double ax, ay, dx, dy;  // canonical start vertex and its difference to the end vertex
     double sign;            // +1 or -1: makes the value >= 0 inside the triangle
+    double inverse_dy;      // 1 / dy, or 0 where dy is 0: Narrow's bound without a division
     double RowTerm(double py) const { return dx * (py - ay); }
-    bool Inside(double row_term, double px) const {
-      return sign * (row_term - dy * (px - ax)) >= 0.0;
-    }
-    // The same with a tie rule: a texel centre on an edge belongs to exactly one of the two
-    // triangles sharing it (their values are exactly negated, and so are their signs). For
-    // counting the surfaces along a texel's ray, where Inside would count a shared edge twice.
-    bool InsideOnce(double row_term, double px) const {
-      const double value = sign * (row_term - dy * (px - ax));
-      return value > 0.0 || (value == 0.0 && sign > 0.0);
-    }
+    // >= 0: the texel centre is inside the edge (inclusive).
+    double Value(double row_term, double px) const { return sign * (row_term - dy * (px - ax)); }
+    bool Inside(double row_term, double px) const { return Value(row_term, px) >= 0.0; }
+    // The tie rule: a texel centre on an edge belongs to exactly one of the two triangles
+    // sharing it (their values are exactly negated, and so are their signs). For counting the
+    // surfaces along a texel's ray, where Inside would count a shared edge twice.
+    bool CountsOnce(double value) const { return value > 0.0 || (value == 0.0 && sign > 0.0); }
     // Narrows [*lo, *hi] to about the texels inside the edge on this row, one texel generous on
     // the side it cuts (the caller still tests each texel exactly). False: none inside.
     bool Narrow(double row_term, int64_t* lo, int64_t* hi) const {
-      if (dy == 0.0) return Inside(row_term, 0.0);       // the same value all along the row
-      const double boundary = ax + row_term / dy - 0.5;  // texel index where the value is 0
+      if (dy == 0.0) return Inside(row_term, 0.0);  // the same value all along the row
+      // The texel index where the value is 0, to within rounding: the slack below covers it.
+      const double boundary = ax + row_term * inverse_dy - 0.5;
       if (!(std::fabs(boundary) < 1e15)) return true;
+      // Truncation and one texel more than floor / ceil needs: the library calls cost more
+      // than the texel (no SSE4.1 rounding in the baseline build).
+      const int64_t truncated = static_cast<int64_t>(boundary);
       if (-sign * dy > 0.0) {
-        *lo = std::max(*lo, static_cast<int64_t>(std::floor(boundary)) - 1);
+        *lo = std::max(*lo, truncated - 2);
       } else {
-        *hi = std::min(*hi, static_cast<int64_t>(std::ceil(boundary)) + 1);
+        *hi = std::min(*hi, truncated + 2);
       }
       return *lo <= *hi;
     }
@@ -79,7 +81,8 @@ struct RasterTriangle {
         std::swap(from, to);
         sign = -sign;
       }
-      edge[k] = {x[from], y[from], x[to] - x[from], y[to] - y[from], sign};
+      const double dy = y[to] - y[from];
+      edge[k] = {x[from], y[from], x[to] - x[from], dy, sign, dy != 0.0 ? 1.0 / dy : 0.0};
     }
     x0 = x[0];
     y0 = y[0];
@@ -108,49 +111,45 @@ struct RasterTriangle {
   }
 };
 
-// The normal rule at a texel centre: the triangle's vertex normals interpolated with the clamped
-// barycentrics; its face normal where they cancel; `fallback` where it has none. Set up once per
-// triangle and reused along a row, where neighbouring texels mostly share their triangle.
-class NormalInterpolator {
- public:
-  void SetUp(const Float3* offset, const Float3* normals, const uint32_t* triangles,
-             uint32_t triangle, Float3 face_normal, double origin_x, double origin_y,
-             double inverse_texel, Float3 fallback) {
-    const uint32_t* v = triangles + 3 * size_t{triangle};
+// The normal rule of one triangle at a texel centre: its vertex normals interpolated with the
+// clamped barycentrics; its face normal where they cancel; the caller's fallback where it has
+// none. Set up once per drawn triangle and render (texels of a row mostly share their
+// triangle, and the next row meets the same ones). 72 bytes.
+struct TriangleShading {
+  float x0, y0;                  // vertex 0, texels
+  float b1_x, b1_y, b2_x, b2_y;  // barycentric gradients, per texel
+  Float3 n0, n1, n2;             // vertex normals
+  Float3 face;                   // unit face normal, or zero
+
+  void SetUp(const Float3* offset, const Float3* normals, const uint32_t* v, Float3 face_normal,
+             double origin_x, double origin_y, double inverse_texel) {
     double x[3], y[3];
     for (int k = 0; k < 3; ++k) {
       x[k] = (static_cast<double>(offset[v[k]].x) - origin_x) * inverse_texel;
       y[k] = (static_cast<double>(offset[v[k]].y) - origin_y) * inverse_texel;
-      n_[k] = normals[v[k]];
     }
-    const double inverse_area2 =
-        1.0 / ((x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]));
-    x0_ = x[0];
-    y0_ = y[0];
-    b1_x_ = (y[2] - y[0]) * inverse_area2;
-    b1_y_ = -(x[2] - x[0]) * inverse_area2;
-    b2_x_ = -(y[1] - y[0]) * inverse_area2;
-    b2_y_ = (x[1] - x[0]) * inverse_area2;
-    fallback_ = NormalizeOr(face_normal, fallback);
-    triangle_ = triangle;
+    const double area2 = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    const double inverse_area2 = area2 != 0.0 ? 1.0 / area2 : 0.0;  // a sliver: vertex 0's normal
+    x0 = static_cast<float>(x[0]);
+    y0 = static_cast<float>(y[0]);
+    b1_x = static_cast<float>((y[2] - y[0]) * inverse_area2);
+    b1_y = static_cast<float>(-(x[2] - x[0]) * inverse_area2);
+    b2_x = static_cast<float>(-(y[1] - y[0]) * inverse_area2);
+    b2_y = static_cast<float>((x[1] - x[0]) * inverse_area2);
+    n0 = normals[v[0]];
+    n1 = normals[v[1]];
+    n2 = normals[v[2]];
+    face = NormalizeOr(face_normal, Float3{0.f, 0.f, 0.f});
   }
-  uint32_t triangle() const { return triangle_; }
-  Float3 At(double px, double py) const {
-    const double dx = px - x0_, dy = py - y0_;
-    const double b1 = std::clamp(b1_x_ * dx + b1_y_ * dy, 0.0, 1.0);
-    const double b2 = std::clamp(b2_x_ * dx + b2_y_ * dy, 0.0, 1.0 - b1);
-    const float w1 = static_cast<float>(b1), w2 = static_cast<float>(b2);
-    // Unnormalised: the octahedral code divides by the L1 norm anyway.
-    const Float3 n = n_[0] * (1.f - w1 - w2) + n_[1] * w1 + n_[2] * w2;
-    return std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z) > 1e-6f ? n : fallback_;
+  // Unnormalised: the octahedral code divides by the L1 norm anyway.
+  Float3 At(float px, float py, Float3 fallback) const {
+    const float dx = px - x0, dy = py - y0;
+    const float b1 = std::clamp(b1_x * dx + b1_y * dy, 0.f, 1.f);
+    const float b2 = std::clamp(b2_x * dx + b2_y * dy, 0.f, 1.f - b1);
+    const Float3 n = n0 * (1.f - b1 - b2) + n1 * b1 + n2 * b2;
+    if (std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z) > 1e-6f) return n;
+    return face.x != 0.f || face.y != 0.f || face.z != 0.f ? face : fallback;
   }
-
- private:
-  uint32_t triangle_ = kNoFace;
-  double x0_ = 0.0, y0_ = 0.0;
-  double b1_x_ = 0.0, b1_y_ = 0.0, b2_x_ = 0.0, b2_y_ = 0.0;  // barycentric gradients
-  Float3 n_[3];
-  Float3 fallback_;
 };
 
 // The texel grid one render draws into: texel (i, j) is entry j * width + i.
@@ -160,55 +159,106 @@ struct RasterWindow {
   double inverse_texel = 0.0;             // 1 / metres
 };
 
-// Calls fragment(t, r, k, px, row) for every texel centre the `drawn` triangles cover (edges
-// inclusive): t the triangle, r its set-up, k the texel's index, px its centre's x and row the
-// edge terms of its row (for RasterTriangle::Edge::InsideOnce); r.Depth(px, py) is its depth.
-// Row bands run in parallel, each drawing every triangle that crosses its rows, so a texel is
-// handled by one band only, its triangles in `drawn` order, whatever the banding: a fragment may
-// write texel k's entries without a lock and the result does not depend on the thread count.
+// Walks the texel centres of rows [j_begin, j_end) and columns [i_begin, i_end) of r's box.
 template <class Fragment>
-void RasterizeInBands(const Float3* vertices, const uint32_t* triangles,
-                      std::span<const uint32_t> drawn, const RasterWindow& w, Fragment&& fragment) {
+void DrawTriangleRows(uint32_t t, const RasterTriangle& r, int64_t j_begin, int64_t j_end,
+                      int64_t i_begin, int64_t i_end, int64_t width, Fragment& fragment) {
+  constexpr int64_t kNarrowFrom = 5;  // texels: a narrower box is tested texel by texel
+  const RasterTriangle::Edge* e = r.edge;
+  for (int64_t j = j_begin; j < j_end; ++j) {
+    const double py = static_cast<double>(j) + 0.5;
+    const double row[3] = {e[0].RowTerm(py), e[1].RowTerm(py), e[2].RowTerm(py)};
+    int64_t lo = i_begin, hi = i_end - 1;
+    if (i_end - i_begin >= kNarrowFrom &&
+        !(e[0].Narrow(row[0], &lo, &hi) && e[1].Narrow(row[1], &lo, &hi) &&
+          e[2].Narrow(row[2], &lo, &hi))) {
+      continue;
+    }
+    for (int64_t i = lo; i <= hi; ++i) {
+      const double px = static_cast<double>(i) + 0.5;
+      const double v0 = e[0].Value(row[0], px), v1 = e[1].Value(row[1], px);
+      const double v2 = e[2].Value(row[2], px);
+      if (!(v0 >= 0.0 && v1 >= 0.0 && v2 >= 0.0)) continue;
+      const bool once = e[0].CountsOnce(v0) && e[1].CountsOnce(v1) && e[2].CountsOnce(v2);
+      fragment(t, r, static_cast<size_t>(j * width + i), px, py, once);
+    }
+  }
+}
+
+// Calls fragment(t, r, k, px, py, once) for every texel centre the `drawn` triangles cover
+// (edges inclusive): t the triangle, r its set-up (set_up[d] for drawn[d]), k the texel's index,
+// (px, py) its centre, and once whether the centre counts for this triangle when the surfaces
+// along the ray are counted (a centre on an edge two triangles share counts for exactly one of
+// them); r.Depth(px, py) is its depth. tiles: null, or the tiles to draw (TileMask); a triangle
+// whose box meets none is skipped. Row bands run in parallel,
+// each drawing every triangle that crosses its rows, so a texel is handled by one band only, its
+// triangles in `drawn` order, whatever the banding: a fragment may write texel k's entries
+// without a lock and the result does not depend on the thread count.
+// Which 8 x 8-texel tiles of the window hold texels a pass needs: the gap pass skips the
+// triangles whose box meets none (most of a body has no second surface to find).
+struct TileMask {
+  static constexpr int kShift = 3;  // 8 texels
+  int64_t tiles_x = 0;
+  std::span<uint8_t> flags;  // tiles_x * tiles_y entries
+  static size_t TileCount(int64_t width, int64_t height) {
+    return static_cast<size_t>(((width + 7) >> kShift) * ((height + 7) >> kShift));
+  }
+  void Mark(int64_t i, int64_t j) {
+    flags[static_cast<size_t>((j >> kShift) * tiles_x + (i >> kShift))] = 1;
+  }
+  // Any tile of texels [i_begin, i_end) x [j_begin, j_end) (non-empty, within the window) marked.
+  bool Any(int64_t i_begin, int64_t i_end, int64_t j_begin, int64_t j_end) const {
+    for (int64_t tj = j_begin >> kShift; tj <= (j_end - 1) >> kShift; ++tj) {
+      for (int64_t ti = i_begin >> kShift; ti <= (i_end - 1) >> kShift; ++ti) {
+        if (flags[static_cast<size_t>(tj * tiles_x + ti)] != 0) return true;
+      }
+    }
+    return false;
+  }
+};
+
+// The rows a set-up triangle's box holds, kept apart from the set-up: each row band scans every
+// triangle's rows, and a 200-byte set-up per triangle would stream through the cache.
+struct RasterRows {
+  int32_t first, last;  // texel rows, within [-1, height]; first > last: none
+};
+
+template <class Fragment>
+void RasterizeInBands(std::span<const uint32_t> drawn, std::span<const RasterTriangle> set_up,
+                      std::span<const RasterRows> rows, const RasterWindow& w,
+                      const TileMask* tiles, Fragment&& fragment) {
   const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};  // balance, not results
   const int64_t rows_per_band = std::max<int64_t>(8, (w.height + bands - 1) / bands);
   const int64_t band_count = (w.height + rows_per_band - 1) / rows_per_band;
   ParallelFor(band_count, 1, [&](int64_t band) {
     const int64_t row_begin = band * rows_per_band;
     const int64_t row_end = std::min(w.height, row_begin + rows_per_band);
-    for (uint32_t t : drawn) {
-      const uint32_t* v = triangles + 3 * size_t{t};
-      // Rows first, from the vertices alone: most triangles miss the band.
-      const double y_lo = std::min({vertices[v[0]].y, vertices[v[1]].y, vertices[v[2]].y});
-      const double y_hi = std::max({vertices[v[0]].y, vertices[v[1]].y, vertices[v[2]].y});
-      if ((y_hi - w.origin_y) * w.inverse_texel < static_cast<double>(row_begin) ||
-          (y_lo - w.origin_y) * w.inverse_texel > static_cast<double>(row_end) + 1.0) {
-        continue;
-      }
-      RasterTriangle r;
-      if (!r.SetUp(vertices, v, w.origin_x, w.origin_y, w.inverse_texel,
-                   static_cast<double>(w.width), static_cast<double>(w.height))) {
-        continue;
-      }
-      const int64_t j_begin = std::max(r.j_lo, row_begin), j_end = std::min(r.j_hi + 1, row_end);
+    for (size_t d = 0; d < drawn.size(); ++d) {
+      const int64_t j_begin = std::max<int64_t>(rows[d].first, row_begin);
+      const int64_t j_end = std::min<int64_t>(rows[d].last + 1, row_end);
+      if (j_begin >= j_end) continue;
+      const RasterTriangle& r = set_up[d];
       const int64_t i_begin = std::max<int64_t>(r.i_lo, 0), i_end = std::min(r.i_hi + 1, w.width);
-      for (int64_t j = j_begin; j < j_end; ++j) {
-        const double py = static_cast<double>(j) + 0.5;
-        const double row[3] = {r.edge[0].RowTerm(py), r.edge[1].RowTerm(py), r.edge[2].RowTerm(py)};
-        int64_t lo = i_begin, hi = i_end - 1;
-        if (!(r.edge[0].Narrow(row[0], &lo, &hi) && r.edge[1].Narrow(row[1], &lo, &hi) &&
-              r.edge[2].Narrow(row[2], &lo, &hi))) {
-          continue;
-        }
-        for (int64_t i = lo; i <= hi; ++i) {
-          const double px = static_cast<double>(i) + 0.5;
-          if (!(r.edge[0].Inside(row[0], px) && r.edge[1].Inside(row[1], px) &&
-                r.edge[2].Inside(row[2], px))) {
-            continue;
-          }
-          fragment(t, r, static_cast<size_t>(j * w.width + i), px, py, row);
-        }
-      }
+      if (j_begin >= j_end || i_begin >= i_end) continue;  // also a triangle with no area
+      if (tiles != nullptr && !tiles->Any(i_begin, i_end, j_begin, j_end)) continue;
+      DrawTriangleRows(drawn[d], r, j_begin, j_end, i_begin, i_end, w.width, fragment);
     }
+  });
+}
+
+// Sets up set_up[d] for each drawn[d] in parallel; a triangle with no area gets an empty box.
+inline void SetUpTriangles(const Float3* vertices, const uint32_t* triangles,
+                           std::span<const uint32_t> drawn, const RasterWindow& w,
+                           std::span<RasterTriangle> set_up, std::span<RasterRows> rows) {
+  ParallelFor(static_cast<int64_t>(drawn.size()), 2048, [&](int64_t d) {
+    const size_t n = static_cast<size_t>(d);
+    RasterTriangle& r = set_up[n];
+    if (!r.SetUp(vertices, triangles + 3 * size_t{drawn[n]}, w.origin_x, w.origin_y,
+                 w.inverse_texel, static_cast<double>(w.width), static_cast<double>(w.height))) {
+      r.i_lo = r.j_lo = 0;
+      r.i_hi = r.j_hi = -1;
+    }
+    rows[n] = {static_cast<int32_t>(r.j_lo), static_cast<int32_t>(r.j_hi)};  // |j| <= 16385
   });
 }
 

@@ -28,7 +28,10 @@
 namespace drape {
 
 namespace detail {
-struct RasterWindow;  // body_map/raster_triangle.h
+struct RasterWindow;     // body_map/raster_triangle.h
+struct RasterTriangle;   // body_map/raster_triangle.h
+struct RasterRows;       // body_map/raster_triangle.h
+struct TriangleShading;  // body_map/raster_triangle.h
 }  // namespace detail
 
 struct BodyMapRenderOptions {
@@ -87,6 +90,13 @@ struct BodyMapRenderStats {
 
 class BodyMapRenderer {
  public:
+  BodyMapRenderer();
+  ~BodyMapRenderer();
+  BodyMapRenderer(const BodyMapRenderer&);
+  BodyMapRenderer(BodyMapRenderer&&) noexcept;
+  BodyMapRenderer& operator=(const BodyMapRenderer&);
+  BodyMapRenderer& operator=(BodyMapRenderer&&) noexcept;
+
   // Keeps a reference to `mesh`, which must outlive the renderer. Checks the mesh (indices,
   // influences, finite positions) and the options, and reserves buffers for 1.5x the bind
   // pose's window (allocates; the first Render into a collider allocates its grid once). On error
@@ -127,8 +137,9 @@ class BodyMapRenderer {
   void CullTriangles(const RenderRegion& region);
   Status PlaceWindow(const RenderRegion& region, Window* window) const;
   void Rasterize(const Window& window, BodyMapCollider* maps);
-  void RasterizeGapSurfaces(const Window& window);  // the gap pass
+  void RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps);  // the gap pass
   void PublishGaps(const Window& window, BodyMapCollider* maps);
+  void SetUpShading(const Window& window);
   void ShadeNormals(const Window& window, BodyMapCollider* maps) const;
   void Publish(const Window& window, BodyMapCollider* maps);
   void Reserve(size_t texels);
@@ -140,13 +151,16 @@ class BodyMapRenderer {
   // Per vertex: the triangles around it (compressed rows), for gathered normals.
   std::vector<uint32_t> vertex_triangle_offsets_;
   std::vector<uint32_t> vertex_triangles_;
-  std::vector<Float3> posed_;          // skinned vertices
-  std::vector<Float3> normals_;        // unit vertex normals (zero where undefined)
-  std::vector<Float3> offset_;         // posed + epsilon * normal
-  std::vector<Float3> face_normals_;   // per triangle, unnormalised (twice the area)
-  std::vector<uint32_t> drawn_;        // triangles that reach the region, ascending
-  std::vector<uint32_t> top_face_;     // per texel: the triangle of the front surface
-  std::vector<uint32_t> bottom_face_;  // per texel: the triangle of the back surface
+  std::vector<Float3> posed_;                     // skinned vertices
+  std::vector<Float3> normals_;                   // unit vertex normals (zero where undefined)
+  std::vector<Float3> offset_;                    // posed + epsilon * normal
+  std::vector<Float3> face_normals_;              // per triangle, unnormalised (twice the area)
+  std::vector<uint32_t> drawn_;                   // triangles that reach the region, ascending
+  std::vector<detail::RasterTriangle> raster_;    // per drawn triangle, window coordinates
+  std::vector<detail::RasterRows> raster_rows_;   // per drawn triangle, its rows
+  std::vector<detail::TriangleShading> shading_;  // per triangle; set for the drawn ones
+  std::vector<uint32_t> top_face_;                // per texel: the triangle of the front surface
+  std::vector<uint32_t> bottom_face_;             // per texel: the triangle of the back surface
   // The gap pass (air_gaps), per texel: the highest surface leaving the body going along -z
   // (the gap's upper boundary) and its triangle; the highest entering one below it (the lower
   // boundary) and its triangle; the surfaces entering and leaving above it; whether a surface
@@ -155,6 +169,7 @@ class BodyMapRenderer {
   std::vector<uint32_t> exit_face_, entry_face_;
   std::vector<uint16_t> entries_above_, exits_above_, entries_total_, exits_total_;
   std::vector<uint8_t> crowded_;
+  std::vector<uint8_t> gap_tiles_;  // per 8 x 8 tile: whether a gap may lie in it
   size_t reserved_texels_ = 0;
 };
 
