@@ -267,9 +267,9 @@ TEST_P(OnCharacters, BoneMapsHoldThePosedBody) {
 
 // The runtime's BodyMapRenderer against the bake's reference rasterizer at the same pose: maps
 // rendered on the baked grid hold the same texels, the same depths (float against double
-// arithmetic) and the same normals as the maps the bake makes of the posed mesh; each rendered
-// air gap is the bake's first gap (the bake sweeps every surface, up to three gaps), and a texel
-// the renderer leaves solid where the bake has a gap is rare.
+// arithmetic) and the same normals as the maps the bake makes of the posed mesh; the rendered air
+// gaps are the bake's (both keep up to three per texel, top down), and a gap the renderer
+// misses is rare.
 TEST_P(OnCharacters, RenderedMapsAgreeWithTheBake) {
   PosedCharacter posed_character;
   PoseBetweenKeys(GetParam(), &posed_character);
@@ -316,16 +316,16 @@ TEST_P(OnCharacters, RenderedMapsAgreeWithTheBake) {
       if (in_bake != in_render) ++mismatched;
       if (!(in_bake && in_render)) continue;
       ++valid;
-      float bu[3], bl[3], ru[1], rl[1];
+      float bu[3], bl[3], ru[3], rl[3];
       const uint32_t bg = BodyMapColliderAccess::TexelGaps(baked, i, j, bu, bl);
       const uint32_t rg =
           BodyMapColliderAccess::TexelGaps(rendered, uint32_t(ri), uint32_t(rj), ru, rl);
-      baked_gaps += bg > 0 ? 1 : 0;
+      baked_gaps += bg;
       rendered_gaps += rg;
-      if (rg > 0 && bg == 0) ++false_gaps;
-      if (rg > 0 && bg > 0) {
+      if (rg > bg) false_gaps += rg - bg;
+      for (uint32_t g = 0; g < std::min(rg, bg); ++g) {  // the same gaps, top down
         max_gap_depth = std::max(
-            {max_gap_depth, std::fabs(double(bu[0]) - ru[0]), std::fabs(double(bl[0]) - rl[0])});
+            {max_gap_depth, std::fabs(double(bu[g]) - ru[g]), std::fabs(double(bl[g]) - rl[g])});
       }
       max_depth = std::max({max_depth, std::fabs(double(bt) - rt), std::fabs(double(bb) - rb)});
       for (bool back : {false, true}) {
@@ -342,8 +342,9 @@ TEST_P(OnCharacters, RenderedMapsAgreeWithTheBake) {
   EXPECT_LE(mismatched, valid / 5000) << mismatched << " of " << valid;
   EXPECT_LT(max_depth, 2e-5) << "metres";  // float against double: 3 um measured
   EXPECT_LT(max_angle, 0.5) << "degrees";
-  EXPECT_EQ(rendered.layers(), 2u);
-  // No air the bake does not see; most of the bake's first gaps found.
+  EXPECT_GE(rendered.layers(), 2u);
+  EXPECT_LE(rendered.layers(), 4u);
+  // No air the bake does not see; most of the bake's gaps found, at every depth.
   EXPECT_LE(false_gaps, valid / 5000) << false_gaps << " of " << rendered_gaps;
   EXPECT_GE(double(rendered_gaps), 0.8 * double(baked_gaps))
       << rendered_gaps << " of " << baked_gaps;

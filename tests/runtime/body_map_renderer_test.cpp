@@ -251,7 +251,7 @@ TEST(BodyMapRenderer, TheAirBetweenPartsIsAGap) {
   BodyMapRenderer with_gaps, slab_only;
   BodyMapRenderOptions options = Options();
   ASSERT_TRUE(with_gaps.Init(mesh, options).ok());
-  options.air_gaps = false;
+  options.air_gaps = 0;
   ASSERT_TRUE(slab_only.Init(mesh, options).ok());
   BodyMapCollider gaps, slab;
   ASSERT_TRUE(with_gaps.Render(apart, &gaps).ok());
@@ -279,6 +279,37 @@ TEST(BodyMapRenderer, TheAirBetweenPartsIsAGap) {
     }
   }
   EXPECT_FALSE(gaps.IsInside({0.1f, 0.f, 0.06f}));  // the air between them at 100 mm
+}
+
+// Four spheres stacked along the view axis with air between them: three gaps along the central
+// rays, found top down as the bake's sweep finds them; air_gaps caps how many are kept.
+TEST(BodyMapRenderer, StackedPartsKeepEveryGapUpToTheCap) {
+  const MeshData mesh = test::SkinnedSpheres(4, kRadius);  // bind centres (0.5 s, 0, 0)
+  Mat34 stack[4];
+  for (int s = 0; s < 4; ++s) stack[s] = Translation(-0.5f * float(s), 0.f, 0.3f * float(s));
+  const float between[3] = {0.15f, 0.45f, 0.75f};  // the air between sphere s and s + 1
+  for (uint32_t cap : {1u, 2u, 3u}) {
+    BodyMapRenderOptions options = Options();
+    options.air_gaps = cap;
+    BodyMapRenderer renderer;
+    ASSERT_TRUE(renderer.Init(mesh, options).ok());
+    BodyMapCollider maps;
+    ASSERT_TRUE(renderer.Render(stack, &maps).ok());
+    EXPECT_EQ(maps.layers(), cap + 1) << cap;
+    for (int s = 0; s < 4; ++s) {
+      EXPECT_TRUE(maps.IsInside({0.f, 0.f, 0.3f * float(s)})) << cap << ", sphere " << s;
+    }
+    // The cap keeps the upper gaps; the deeper air stays inside the slab.
+    for (uint32_t g = 0; g < 3; ++g) {
+      EXPECT_EQ(maps.IsInside({0.f, 0.f, between[2 - g]}), g >= cap) << cap << ", gap " << g;
+    }
+  }
+  BodyMapRenderOptions too_many = Options();
+  too_many.air_gaps = 4;
+  BodyMapRenderer refused;
+  const Status s = refused.Init(mesh, too_many);
+  EXPECT_EQ(s.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("air_gaps 4"), std::string::npos) << s.message();
 }
 
 TEST(BodyMapRenderer, LoadsMapsTheEngineRendered) {

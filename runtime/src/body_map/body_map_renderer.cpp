@@ -63,6 +63,11 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   if (o.sampling != DepthSampling::kNearest && o.sampling != DepthSampling::kBilinear) {
     return Invalid("unknown depth sampling");
   }
+  constexpr uint32_t kMaxGaps = uint32_t{kMaxBodyMapLayers} - 1u;
+  if (o.air_gaps > kMaxGaps) {
+    return Invalid("air_gaps " + std::to_string(o.air_gaps) + " is outside [0, " +
+                   std::to_string(kMaxGaps) + "]");
+  }
   if (static_cast<uint8_t>(o.view_axis) > 2) {
     return Invalid("view_axis " + std::to_string(static_cast<int>(o.view_axis)) +
                    " is not 0 (z), 1 (x) or 2 (y)");
@@ -156,8 +161,8 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   Publish(window, maps);
   Rasterize(window, maps);
   SetUpShading(window);
-  if (options_.air_gaps) {
-    RasterizeGapSurfaces(window, *maps);
+  if (options_.air_gaps > 0) {
+    FindGaps(window, *maps);
     PublishGaps(window, maps);
   }
   ShadeNormals(window, maps);
@@ -311,28 +316,29 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   maps->normals_.reserve(reserved_texels_);
   maps->blocks_.reserve(reserved_texels_ / 64 + options_.max_side / 4 + 1);  // 8x8 blocks
   if (options_.sampling == DepthSampling::kBilinear) maps->bilinear_ok_.reserve(reserved_texels_);
-  if (options_.air_gaps) {
+  if (options_.air_gaps > 0) {
     // Gaps on up to an eighth of the texels (a human has them on a few percent).
     maps->gap_texel_bits_.reserve(reserved_texels_ / 32 + 1);
     maps->gap_word_first_.reserve(reserved_texels_ / 32 + 1);
-    maps->gaps_.reserve(reserved_texels_ / 8);
-    maps->gap_normals_.reserve(reserved_texels_ / 8);
+    maps->gaps_.reserve(reserved_texels_ / 8 * options_.air_gaps);
+    maps->gap_normals_.reserve(reserved_texels_ / 8 * options_.air_gaps);
   }
   maps->slabs_.assign(texels, BodyMapCollider::Slab{-kInf, kInf});
   maps->normals_.resize(texels);
   top_face_.assign(texels, kNoFace);
   bottom_face_.assign(texels, kNoFace);
-  maps->gap_layers_ = options_.air_gaps ? 1u : 0u;
-  if (options_.air_gaps) {
+  maps->gap_layers_ = options_.air_gaps > 0 ? 1u : 0u;  // PublishGaps sets the deepest found
+  if (options_.air_gaps > 0) {
     exit_z_.assign(texels, -kInf);
-    entry_z_.assign(texels, -kInf);
     exit_face_.assign(texels, kNoFace);
-    entry_face_.assign(texels, kNoFace);
-    entries_above_.assign(texels, 0);
-    exits_above_.assign(texels, 0);
-    entries_total_.assign(texels, 0);
-    exits_total_.assign(texels, 0);
-    crowded_.assign(texels, 0);
+    // Set by each gap pass over every texel.
+    for (std::vector<float>* v : {&entry_z_, &below_z_}) v->resize(texels);
+    entry_face_.resize(texels);
+    for (std::vector<uint16_t>* v :
+         {&entries_above_, &exits_above_, &entries_total_, &exits_total_}) {
+      v->resize(texels);
+    }
+    crowded_.resize(texels);
   }
   maps->width_ = window.width;
   maps->height_ = window.height;
@@ -351,8 +357,9 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
 void BodyMapRenderer::Reserve(size_t texels) {
   top_face_.reserve(texels);
   bottom_face_.reserve(texels);
-  if (!options_.air_gaps) return;
-  for (std::vector<float>* v : {&exit_z_, &entry_z_}) v->reserve(texels);
+  if (options_.air_gaps == 0) return;
+  for (std::vector<float>* v : {&exit_z_, &entry_z_, &below_z_}) v->reserve(texels);
+  found_.reserve(texels / 8 * options_.air_gaps);  // as the collider's gaps
   for (std::vector<uint32_t>* v : {&exit_face_, &entry_face_}) v->reserve(texels);
   for (std::vector<uint16_t>* v : {&entries_above_, &exits_above_, &entries_total_, &exits_total_})
     v->reserve(texels);
@@ -365,7 +372,7 @@ void BodyMapRenderer::Reserve(size_t texels) {
 // triangles are drawn ascending).
 void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   BodyMapCollider::Slab* slabs = maps->slabs_.data();
-  const bool gaps = options_.air_gaps;
+  const bool gaps = options_.air_gaps > 0;
   const detail::RasterWindow w = RasterWindowOf(window);
   raster_.resize(drawn_.size());  // reserved for every triangle at Init
   raster_rows_.resize(drawn_.size());
@@ -489,7 +496,8 @@ size_t BodyMapRenderer::memory_bytes() const {
           top_face_.capacity() + bottom_face_.capacity() + exit_face_.capacity() +
           entry_face_.capacity()) *
              sizeof(uint32_t) +
-         (exit_z_.capacity() + entry_z_.capacity()) * sizeof(float) +
+         (exit_z_.capacity() + entry_z_.capacity() + below_z_.capacity()) * sizeof(float) +
+         found_.capacity() * sizeof(FoundGap) +
          (entries_above_.capacity() + exits_above_.capacity() + entries_total_.capacity() +
           exits_total_.capacity()) *
              sizeof(uint16_t) +

@@ -11,8 +11,8 @@
 //   renderer.Render(pose.skinning(), &maps, &garment_reach);  // per frame
 //   maps.CollideBatch(previous, positions, velocities, flags, params);
 //
-// Baked poses (BodyMapCollider::Build) stay exact for the poses a bake saw and hold up to three
-// air gaps per texel; rendered maps hold the first (options.air_gaps).
+// Baked poses (BodyMapCollider::Build) stay exact for the poses a bake saw; both hold up to three
+// air gaps per texel (options.air_gaps).
 
 #include <cstddef>
 #include <cstdint>
@@ -45,11 +45,12 @@ struct BodyMapRenderOptions {
   // The asset axis the maps are seen along (body_map_data.h); a baked pose's view_axis keeps
   // rendered and baked maps in one frame.
   BodyMapViewAxis view_axis = BodyMapViewAxis::kZ;
-  // One air gap per texel (the collider's layers() = 2): the first air below the front surface,
-  // from a second raster pass that counts the surfaces along each texel's ray. Without it the
-  // air between an arm and the chest is inside; a texel whose surfaces do not nest there (an
-  // open or inconsistently wound mesh) keeps its slab. About 1.6x the raster time.
-  bool air_gaps = true;
+  // Air gaps per texel, [0, 3] (the collider's layers() is 1 + the deepest found): the air below
+  // the front surface, gap by gap going down, from raster passes that count the surfaces along
+  // each texel's ray. Without them the air between an arm and the chest is inside; a texel whose
+  // surfaces do not nest there (an open or inconsistently wound mesh) keeps its slab. The first
+  // gap costs about 1.6x the raster time; each deeper one a pass over the texels that have one.
+  uint32_t air_gaps = 3;
 };
 
 // An asset-frame box: only triangles that reach it are drawn and the window is cut to it. The
@@ -125,6 +126,13 @@ class BodyMapRenderer {
   std::span<const Float3> posed_vertices() const { return posed_; }
   size_t memory_bytes() const;  // the renderer's buffers, not the collider's
 
+  // One air gap the gap passes found (internal; public for the passes' helpers).
+  struct FoundGap {
+    uint32_t texel, level;  // row-major texel; level 0: the first gap below the front
+    float upper, lower;     // view-frame z of its boundaries
+    uint32_t upper_face, lower_face;
+  };
+
  private:
   struct Window {                           // the texel grid of one render
     double origin_x = 0.0, origin_y = 0.0;  // metres, a multiple of the texel size
@@ -137,7 +145,13 @@ class BodyMapRenderer {
   void CullTriangles(const RenderRegion& region);
   Status PlaceWindow(const RenderRegion& region, Window* window) const;
   void Rasterize(const Window& window, BodyMapCollider* maps);
-  void RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps);  // the gap pass
+  // The gap passes (body_map_renderer_gaps.cpp).
+  void FindGaps(const Window& window, const BodyMapCollider& maps);
+  void FindUpperBoundariesBelow(const Window& window, size_t begin, size_t end);
+  void RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps, bool all,
+                            size_t begin, size_t end);
+  size_t CollectGaps(const Window& window, const BodyMapCollider& maps, uint32_t level, bool all,
+                     size_t begin, size_t end);
   void PublishGaps(const Window& window, BodyMapCollider* maps);
   void SetUpShading(const Window& window);
   void ShadeNormals(const Window& window, BodyMapCollider* maps) const;
@@ -169,6 +183,8 @@ class BodyMapRenderer {
   std::vector<uint32_t> exit_face_, entry_face_;
   std::vector<uint16_t> entries_above_, exits_above_, entries_total_, exits_total_;
   std::vector<uint8_t> crowded_;
+  std::vector<float> below_z_;      // per texel: the last gap's lower boundary, -inf: none
+  std::vector<FoundGap> found_;     // the gaps found, level by level
   std::vector<uint8_t> gap_tiles_;  // per 8 x 8 tile: whether a gap may lie in it
   size_t reserved_texels_ = 0;
 };
