@@ -314,17 +314,20 @@ def hull_bake(doc, gb):
 
 def following_maps(doc, gb, rows):
     """Maps that follow a pose no bake saw: per character (first posed body) the rest pose's maps,
-    the maps rendered from the skinned mesh, and the per-bone local maps; then the costs."""
-    kinds = (("the rest pose's maps", "rest maps (not following)"),
-             ("rendered from the skinned mesh", "rendered per pose"),
-             ("per-bone local maps", "bone maps"))
+    the maps rendered from the skinned mesh at the rest maps' texel and at 2x and 4x it, and the
+    per-bone local maps; then the costs."""
+    rendered_label = "rendered from the skinned mesh"
     table = {}
     for r in rows:
         if not r["posed"]:
             continue
-        for prefix, label in kinds:
-            if r["setting"].startswith(prefix):
-                table.setdefault(r["base"], {})[label] = r
+        by_kind = table.setdefault(r["base"], {"rendered": []})
+        if r["setting"].startswith("the rest pose's maps"):
+            by_kind["rest"] = r
+        elif r["setting"].startswith("per-bone local maps"):
+            by_kind["bones"] = r
+        elif r["setting"].startswith(rendered_label):
+            by_kind["rendered"].append(r)  # finest texel first, as the sweep measures them
     p = "bench_following_maps"
     if not table and p not in gb:
         return
@@ -344,16 +347,30 @@ def following_maps(doc, gb, rows):
     doc.add("## Maps that follow any pose", "",
             "At each character's first measured pose (a clip time between keys, which no default "
             "bake holds): missed % / penetration p99 mm / ns per particle (1 thread). Rendered: "
-            "`BodyMapRenderer` at the rest maps' texel, whole body; bone maps: `BoneMapCollider` "
-            "at the automatic texel (the rest pose's size / 600), 3 layers." + costs, "",
-            "| character | " + " | ".join(label for _, label in kinds) + " |",
-            "|---|---|---|---|")
+            "`BodyMapRenderer`, whole body, at the rest maps' texel (N = 1024 over the body) and "
+            "at 2x and 4x it; its cells give missed % / penetration p99 mm / ms to render the "
+            "pose (1 thread) / texel mm. Bone maps: `BoneMapCollider` at the automatic texel (the "
+            "rest pose's size / 600), 3 layers." + costs, "",
+            "| character | rest maps (not following) | rendered, rest texel | rendered, 2x | "
+            "rendered, 4x | bone maps |",
+            "|---|---|---|---|---|---|")
+    texel_ms = re.compile(r"\(([0-9.]+) mm texel, whole body: ([0-9.]+) ms per pose")
+
+    def cell(r):
+        return "–" if r is None else (f"{100 * r['missed_rate']:.2f} / "
+                                      f"{r['penetration_p99_mm']:.1f} / "
+                                      f"{ns(r['ns_per_particle_1t'])}")
+
+    def rendered_cell(r):
+        if r is None:
+            return "–"
+        m = texel_ms.search(r["setting"])
+        cost = f"{m.group(2)} ms / {m.group(1)} mm" if m else "–"
+        return f"{100 * r['missed_rate']:.2f} / {r['penetration_p99_mm']:.1f} / {cost}"
+
     for character, by_kind in table.items():
-        cells = []
-        for _, label in kinds:
-            r = by_kind.get(label)
-            cells.append("–" if r is None else
-                         f"{100 * r['missed_rate']:.2f} / {r['penetration_p99_mm']:.1f} / "
-                         f"{ns(r['ns_per_particle_1t'])}")
+        rendered = (by_kind["rendered"] + [None] * 3)[:3]
+        cells = ([cell(by_kind.get("rest"))] + [rendered_cell(r) for r in rendered] +
+                 [cell(by_kind.get("bones"))])
         doc.add(f"| {character} | " + " | ".join(cells) + " |")
     doc.source("speed against error, posed bodies" + (f"; {p}" if costs else ""))

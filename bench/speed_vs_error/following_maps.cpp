@@ -61,23 +61,26 @@ void Measurement::MeasureFollowingMaps(const Context& context, const bake::Chara
                                       "the rest pose's maps (N = 1024), not following the pose",
                                       stats.bytes));
 
-  // Rendered from the skinned mesh on the rest maps' grid.
-  BodyMapRenderOptions render;
-  render.texel_size = rest_maps.texel_size;
-  render.epsilon = o.epsilon;
-  render.grid_x = rest_maps.origin_x;
-  render.grid_y = rest_maps.origin_y;
-  render.view_axis = rest_maps.view_axis;
-  BodyMapRenderer renderer;
-  BodyMapCollider rendered;
-  if (!renderer.Init(character.mesh, render).ok()) Fail(label + ": cannot set up the renderer");
-  const double ms = RenderMilliseconds(&renderer, skinning, &rendered);
-  char setting[160];
-  std::snprintf(setting, sizeof(setting),
-                "rendered from the skinned mesh (%.1f mm texel, whole body: %.1f ms per pose, "
-                "1 thread)",
-                render.texel_size * 1e3, ms);
-  Measure(context, *MakeBodyMapMethod(std::move(rendered), setting, 0));
+  // Rendered from the skinned mesh on the rest maps' grid, at its texel and at 2x and 4x it
+  // (N = 1024, 512, 256 over the body): the error each render millisecond buys.
+  for (const int coarser : {1, 2, 4}) {
+    BodyMapRenderOptions render;
+    render.texel_size = rest_maps.texel_size * static_cast<float>(coarser);
+    render.epsilon = o.epsilon;
+    render.grid_x = rest_maps.origin_x;
+    render.grid_y = rest_maps.origin_y;
+    render.view_axis = rest_maps.view_axis;
+    BodyMapRenderer renderer;
+    BodyMapCollider rendered;
+    if (!renderer.Init(character.mesh, render).ok()) Fail(label + ": cannot set up the renderer");
+    const double ms = RenderMilliseconds(&renderer, skinning, &rendered);
+    char setting[160];
+    std::snprintf(setting, sizeof(setting),
+                  "rendered from the skinned mesh (%.1f mm texel, whole body: %.2f ms per pose, "
+                  "1 thread)",
+                  render.texel_size * 1e3, ms);
+    Measure(context, *MakeBodyMapMethod(std::move(rendered), setting, 0));
+  }
 
   // Per-bone local maps, baked once at the bind pose.
   bake::BoneMapOptions bones;
@@ -91,6 +94,7 @@ void Measurement::MeasureFollowingMaps(const Context& context, const bake::Chara
   }
   size_t bytes = 0;
   for (const bake::BoneMapStats& b : bone_stats) bytes += b.bytes;
+  char setting[160];
   std::snprintf(setting, sizeof(setting), "per-bone local maps (%.1f mm texel, %zu bones)",
                 bones.texel_size * 1e3, bone_maps.maps.size());
   Measure(context, *MakeBoneMapMethod(bone_maps, character.skeleton.joint_count(), skinning,
