@@ -323,7 +323,9 @@ TEST_P(OnCharacters, RenderedMapsAgreeWithTheBake) {
       baked_gaps += bg;
       rendered_gaps += rg;
       if (rg > bg) false_gaps += rg - bg;
-      for (uint32_t g = 0; g < std::min(rg, bg); ++g) {  // the same gaps, top down
+      // The same gaps, top down, where the bake kept all of its (it keeps the three thickest;
+      // the renderer the three nearest the front).
+      for (uint32_t g = 0; bg < 3 && g < std::min(rg, bg); ++g) {
         max_gap_depth = std::max(
             {max_gap_depth, std::fabs(double(bu[g]) - ru[g]), std::fabs(double(bl[g]) - rl[g])});
       }
@@ -346,17 +348,19 @@ TEST_P(OnCharacters, RenderedMapsAgreeWithTheBake) {
   EXPECT_LE(rendered.layers(), 4u);
   // No air the bake does not see; most of the bake's gaps found, at every depth.
   EXPECT_LE(false_gaps, valid / 5000) << false_gaps << " of " << rendered_gaps;
-  EXPECT_GE(double(rendered_gaps), 0.8 * double(baked_gaps))
+  EXPECT_GE(double(rendered_gaps), 0.98 * double(baked_gaps))
       << rendered_gaps << " of " << baked_gaps;
   EXPECT_LT(max_gap_depth, 2e-5) << "metres";
 }
 
-INSTANTIATE_TEST_SUITE_P(Characters, OnCharacters,
-                         ::testing::Values(Case{"mannequin", ""},
-                                           Case{"CesiumMan", "CesiumMan/CesiumMan.glb"},
-                                           Case{"Fox", "Fox/Fox.glb"},
-                                           Case{"RiggedFigure", "RiggedFigure/RiggedFigure.glb"}),
-                         [](const auto& param_info) { return std::string(param_info.param.name); });
+INSTANTIATE_TEST_SUITE_P(
+    Characters, OnCharacters,
+    ::testing::Values(Case{"mannequin", ""}, Case{"CesiumMan", "CesiumMan/CesiumMan.glb"},
+                      Case{"Fox", "Fox/Fox.glb"},
+                      Case{"RiggedFigure", "RiggedFigure/RiggedFigure.glb"},
+                      Case{"Animated_Human", "QuaterniusAnimatedHuman/Animated_Human.fbx"},
+                      Case{"RobotExpressive", "RobotExpressive/RobotExpressive.glb"}),
+    [](const auto& param_info) { return std::string(param_info.param.name); });
 
 }  // namespace
 }  // namespace drape::bake

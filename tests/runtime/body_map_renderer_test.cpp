@@ -312,6 +312,31 @@ TEST(BodyMapRenderer, StackedPartsKeepEveryGapUpToTheCap) {
   EXPECT_NE(s.message().find("air_gaps 4"), std::string::npos) << s.message();
 }
 
+// A part sunk into another (an arm into the torso) above a third with air between: the highest
+// surface leaving the body along the central rays is the sunk part's, still inside the other, so
+// the gap lies below the next leaving surface; the renderer searches on there, as the bake's
+// sweep finds it.
+TEST(BodyMapRenderer, AGapBelowPartsSunkIntoEachOther) {
+  const MeshData mesh = test::SkinnedSpheres(3, kRadius);  // bind centres (0.5 s, 0, 0)
+  const float centre_z[3] = {0.f, 0.3f, 0.38f};            // the third sunk into the second
+  Mat34 pose[3];
+  for (int s = 0; s < 3; ++s) pose[s] = Translation(-0.5f * float(s), 0.f, centre_z[s]);
+  BodyMapRenderer renderer;
+  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+  BodyMapCollider maps;
+  ASSERT_TRUE(renderer.Render(pose, &maps).ok());
+  EXPECT_FALSE(maps.IsInside({0.f, 0.f, 0.15f}));  // the air between the lowest and the others
+  EXPECT_FALSE(maps.IsInside({0.03f, 0.02f, 0.15f}));
+  for (const float z : {0.f, 0.25f, 0.3f, 0.4f, 0.45f}) {
+    EXPECT_TRUE(maps.IsInside({0.f, 0.f, z})) << z;
+  }
+  // Seen from below it is the same body: one gap, found on the first pass.
+  const Mat34 upside_down[3] = {Translation(0.f, 0.f, 0.38f), Translation(-0.5f, 0.f, 0.08f),
+                                Translation(-1.f, 0.f, 0.f)};
+  ASSERT_TRUE(renderer.Render(upside_down, &maps).ok());
+  EXPECT_FALSE(maps.IsInside({0.f, 0.f, 0.23f}));
+}
+
 TEST(BodyMapRenderer, LoadsMapsTheEngineRendered) {
   const MeshData mesh = TwoSpheres();
   BodyMapRenderer renderer;

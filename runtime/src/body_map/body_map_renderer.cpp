@@ -333,6 +333,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
     exit_face_.assign(texels, kNoFace);
     // Set by each gap pass over every texel.
     for (std::vector<float>* v : {&entry_z_, &below_z_}) v->resize(texels);
+    gap_count_.resize(texels);
     entry_face_.resize(texels);
     for (std::vector<uint16_t>* v :
          {&entries_above_, &exits_above_, &entries_total_, &exits_total_}) {
@@ -360,6 +361,9 @@ void BodyMapRenderer::Reserve(size_t texels) {
   if (options_.air_gaps == 0) return;
   for (std::vector<float>* v : {&exit_z_, &entry_z_, &below_z_}) v->reserve(texels);
   found_.reserve(texels / 8 * options_.air_gaps);  // as the collider's gaps
+  gap_count_.reserve(texels);
+  searching_.reserve(texels);  // a pass may search on every texel
+  next_searching_.reserve(texels);
   for (std::vector<uint32_t>* v : {&exit_face_, &entry_face_}) v->reserve(texels);
   for (std::vector<uint16_t>* v : {&entries_above_, &exits_above_, &entries_total_, &exits_total_})
     v->reserve(texels);
@@ -497,7 +501,8 @@ size_t BodyMapRenderer::memory_bytes() const {
           entry_face_.capacity()) *
              sizeof(uint32_t) +
          (exit_z_.capacity() + entry_z_.capacity() + below_z_.capacity()) * sizeof(float) +
-         found_.capacity() * sizeof(FoundGap) +
+         found_.capacity() * sizeof(FoundGap) + gap_count_.capacity() +
+         (searching_.capacity() + next_searching_.capacity()) * sizeof(uint32_t) +
          (entries_above_.capacity() + exits_above_.capacity() + entries_total_.capacity() +
           exits_total_.capacity()) *
              sizeof(uint16_t) +

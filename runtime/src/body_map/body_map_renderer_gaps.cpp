@@ -32,52 +32,53 @@ constexpr float kMinGap = 1e-4f;
 
 }  // namespace
 
-// Stage 4b: the air gaps, level by level, into found_ (level order, row-major in a level). The
-// first level looks at every texel; each deeper one only at the texels where the level above
-// found a gap (found_[begin, end)).
+// Stage 4b: the air gaps into found_, pass by pass going down. The first pass looks at every
+// texel; each later one only at the texels still searching (searching_): those that found a gap
+// and may hold more, and those whose candidate was not one because another part encloses it (an
+// arm sunk into the torso leaves the body below its exit) and whose ray has deeper surfaces.
 void BodyMapRenderer::FindGaps(const Window& window, const BodyMapCollider& maps) {
   found_.clear();
+  searching_.clear();
   const size_t texels = static_cast<size_t>(window.width) * window.height;
   std::fill(below_z_.begin(), below_z_.begin() + static_cast<std::ptrdiff_t>(texels), -kInf);
-  size_t begin = 0, end = 0;
-  for (uint32_t level = 0; level < options_.air_gaps; ++level) {
-    const bool first = level == 0;
-    if (!first) FindUpperBoundariesBelow(window, begin, end);
-    RasterizeGapSurfaces(window, maps, first, begin, end);
-    const size_t found = CollectGaps(window, maps, level, first, begin, end);
-    begin = end;
-    end = found;
-    if (begin == end) break;  // nothing at this level: nothing deeper either
+  std::fill(gap_count_.begin(), gap_count_.begin() + static_cast<std::ptrdiff_t>(texels), 0);
+  // Each pass rasterizes the searching texels' tiles twice; a ray with more nested parts than
+  // this keeps what the passes found.
+  const uint32_t max_passes = 2 * options_.air_gaps;
+  for (uint32_t pass = 0; pass < max_passes; ++pass) {
+    const bool first = pass == 0;
+    if (!first) FindUpperBoundariesBelow(window);
+    RasterizeGapSurfaces(window, maps, first);
+    CollectGaps(window, maps, first);
+    if (searching_.empty()) break;
   }
 }
 
-// Calls visit(k) for every texel of a level: all of them, or those of found_[begin, end).
+// Calls visit(k) for the texels of a pass: all of them, or the searching ones.
 template <class Visit>
-void ForLevelTexels(size_t texels, bool all, std::span<const BodyMapRenderer::FoundGap> above,
-                    Visit&& visit) {
+void ForPassTexels(size_t texels, bool all, std::span<const uint32_t> searching, Visit&& visit) {
   if (all) {
     for (size_t k = 0; k < texels; ++k) visit(k);
   } else {
-    for (const BodyMapRenderer::FoundGap& g : above) visit(size_t{g.texel});
+    for (const uint32_t k : searching) visit(size_t{k});
   }
 }
 
-// The next level's upper boundaries: per texel whose gap above has its lower boundary at
-// below_z_, the highest surface leaving the body below it.
-void BodyMapRenderer::FindUpperBoundariesBelow(const Window& window, size_t begin, size_t end) {
+// The next candidate upper boundaries: per searching texel, the highest surface leaving the body
+// below below_z_ (its last gap's lower boundary, or the candidate that failed).
+void BodyMapRenderer::FindUpperBoundariesBelow(const Window& window) {
   const int64_t width = window.width;
   gap_tiles_.assign(detail::TileMask::TileCount(window.width, window.height), 0);
   detail::TileMask tiles{(width + 7) >> detail::TileMask::kShift, gap_tiles_};
-  for (size_t n = begin; n < end; ++n) {
-    const size_t k = found_[n].texel;
+  for (const uint32_t k : searching_) {
     exit_z_[k] = -kInf;
     exit_face_[k] = kNoFace;
-    tiles.Mark(static_cast<int64_t>(k) % width, static_cast<int64_t>(k) / width);
+    tiles.Mark(int64_t{k} % width, int64_t{k} / width);
   }
   detail::RasterizeInBands(
       drawn_, raster_, raster_rows_, RasterWindowOf(window), &tiles,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
-        if (r.entering) return;  // below_z_ is -inf but at candidates
+        if (r.entering) return;  // below_z_ is -inf but where searching
         const float z = r.Depth(px, py);
         if (z < below_z_[k] - kMinGap && z > exit_z_[k]) {
           exit_z_[k] = z;
@@ -86,17 +87,16 @@ void BodyMapRenderer::FindUpperBoundariesBelow(const Window& window, size_t begi
       });
 }
 
-// At the level's texels, where a gap may lie below the upper boundary in exit_z_ (it lies above
-// the back surface); then the entering and leaving surfaces around it. Texels outside the level
-// have no exit face (CollectGaps clears it), so the pass leaves them alone.
+// At the pass's texels, where a gap may lie below the candidate upper boundary in exit_z_ (it
+// lies above the back surface); then the entering and leaving surfaces around it. Texels out of
+// the pass have no exit face (CollectGaps clears it), so the pass leaves them alone.
 void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps,
-                                           bool all, size_t begin, size_t end) {
+                                           bool all) {
   const int64_t width = window.width;
   const size_t texels = static_cast<size_t>(window.width) * window.height;
   gap_tiles_.assign(detail::TileMask::TileCount(window.width, window.height), 0);
   detail::TileMask tiles{(width + 7) >> detail::TileMask::kShift, gap_tiles_};
-  const std::span<const FoundGap> above(found_.data() + begin, end - begin);
-  ForLevelTexels(texels, all, above, [&](size_t k) {
+  ForPassTexels(texels, all, searching_, [&](size_t k) {
     // No room for a gap of kMinGap and its two boundaries above the back surface.
     if (exit_face_[k] != kNoFace && !(exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap)) {
       exit_face_[k] = kNoFace;
@@ -133,30 +133,40 @@ void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCo
       });
 }
 
-// The level's gaps that pass the tests, appended to found_; below_z_ keeps their lower
-// boundaries for the next level, and the texels without one lose their exit face (-inf and
-// none: out of the next level). Returns found_'s new size.
-size_t BodyMapRenderer::CollectGaps(const Window& window, const BodyMapCollider& maps,
-                                    uint32_t level, bool all, size_t begin, size_t end) {
+// The pass's gaps that pass the tests, appended to found_, and the texels to search on
+// (searching_, ascending): below a gap while the texel holds fewer than air_gaps, or below a
+// candidate that was no gap because the body continues under it (the surfaces above it do not
+// balance, or one lies within kMinGap below it) while the whole ray balances. The others lose
+// their exit face (out of the next pass).
+void BodyMapRenderer::CollectGaps(const Window& window, const BodyMapCollider& maps, bool all) {
   const size_t texels = static_cast<size_t>(window.width) * window.height;
-  // By index: found_ grows below (within its reserve, or counted as growth at publication).
-  for (size_t n = all ? 0 : begin; n < (all ? texels : end); ++n) {
-    const size_t k = all ? n : size_t{found_[n].texel};
+  next_searching_.clear();
+  ForPassTexels(texels, all, searching_, [&](size_t k) {
     const BodyMapCollider::Slab slab = maps.slabs_[k];
     const float upper = exit_z_[k], lower = entry_z_[k];
-    const bool air = exit_face_[k] != kNoFace && entry_face_[k] != kNoFace && !crowded_[k] &&
-                     entries_above_[k] != 0 && entries_above_[k] == exits_above_[k] &&
-                     entries_total_[k] == exits_total_[k] && upper < slab.top - kMinGap &&
+    const bool candidate = exit_face_[k] != kNoFace && entries_total_[k] == exits_total_[k];
+    const bool enclosed = entries_above_[k] != exits_above_[k] || crowded_[k];
+    const bool air = candidate && !enclosed && entry_face_[k] != kNoFace &&
+                     entries_above_[k] != 0 && upper < slab.top - kMinGap &&
                      lower > slab.bottom + kMinGap && upper - lower > kMinGap;
-    below_z_[k] = air ? lower : -kInf;
-    if (!air) {
-      exit_face_[k] = kNoFace;
-      continue;
+    bool search_on = false;
+    if (air) {
+      found_.push_back(
+          {static_cast<uint32_t>(k), gap_count_[k]++, upper, lower, exit_face_[k], entry_face_[k]});
+      below_z_[k] = lower;
+      search_on = gap_count_[k] < options_.air_gaps;
+    } else if (candidate && enclosed) {
+      below_z_[k] = upper;  // the next exit below this one may open the gap
+      search_on = true;
     }
-    found_.push_back(
-        {static_cast<uint32_t>(k), level, upper, lower, exit_face_[k], entry_face_[k]});
-  }
-  return found_.size();
+    if (search_on) {
+      next_searching_.push_back(static_cast<uint32_t>(k));
+    } else {
+      below_z_[k] = -kInf;
+      exit_face_[k] = kNoFace;
+    }
+  });
+  searching_.swap(next_searching_);
 }
 
 // Stage 4c: the gaps found, per texel in level order (top down), into the collider's compact gap

@@ -128,7 +128,7 @@ class BodyMapRenderer {
 
   // One air gap the gap passes found (internal; public for the passes' helpers).
   struct FoundGap {
-    uint32_t texel, level;  // row-major texel; level 0: the first gap below the front
+    uint32_t texel, level;  // row-major texel; level 0: the first gap below the front (0-2)
     float upper, lower;     // view-frame z of its boundaries
     uint32_t upper_face, lower_face;
   };
@@ -147,11 +147,9 @@ class BodyMapRenderer {
   void Rasterize(const Window& window, BodyMapCollider* maps);
   // The gap passes (body_map_renderer_gaps.cpp).
   void FindGaps(const Window& window, const BodyMapCollider& maps);
-  void FindUpperBoundariesBelow(const Window& window, size_t begin, size_t end);
-  void RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps, bool all,
-                            size_t begin, size_t end);
-  size_t CollectGaps(const Window& window, const BodyMapCollider& maps, uint32_t level, bool all,
-                     size_t begin, size_t end);
+  void FindUpperBoundariesBelow(const Window& window);
+  void RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps, bool all);
+  void CollectGaps(const Window& window, const BodyMapCollider& maps, bool all);
   void PublishGaps(const Window& window, BodyMapCollider* maps);
   void SetUpShading(const Window& window);
   void ShadeNormals(const Window& window, BodyMapCollider* maps) const;
@@ -183,9 +181,11 @@ class BodyMapRenderer {
   std::vector<uint32_t> exit_face_, entry_face_;
   std::vector<uint16_t> entries_above_, exits_above_, entries_total_, exits_total_;
   std::vector<uint8_t> crowded_;
-  std::vector<float> below_z_;      // per texel: the last gap's lower boundary, -inf: none
-  std::vector<FoundGap> found_;     // the gaps found, level by level
-  std::vector<uint8_t> gap_tiles_;  // per 8 x 8 tile: whether a gap may lie in it
+  std::vector<float> below_z_;      // per texel: where the next search starts, -inf: not searching
+  std::vector<uint8_t> gap_count_;  // per texel: the gaps found
+  std::vector<uint32_t> searching_, next_searching_;  // texels, ascending
+  std::vector<FoundGap> found_;                       // the gaps found, pass by pass
+  std::vector<uint8_t> gap_tiles_;                    // per 8 x 8 tile: whether a gap may lie in it
   size_t reserved_texels_ = 0;
 };
 
