@@ -1,14 +1,15 @@
 // BodyMapRenderer's air gaps (options.air_gaps): the air below each texel's front surface, gap
 // by gap going down. The first raster pass found the highest surface leaving the body going
-// along -z (the first gap's upper boundary); a gap pass counts the surfaces above it, each texel
-// centre on a shared edge counted once, and finds the highest surface entering the body below it
-// (the lower boundary). The range between them is air when as many surfaces enter as leave above
-// the upper boundary (the winding count is 0 just below it) and along the whole ray (the count
-// ends at 0, as the bake's sweep requires), and none lies within kMinGap below it. The next gap's
-// upper boundary is the highest surface leaving below that lower boundary (one more raster pass,
-// over the texels that had a gap), and so on. Surfaces enter where the drawn (offset) triangle
-// runs counter-clockwise in the window, as in the bake. Where a test fails the texel keeps what
-// it has above, the conservative answer (docs/ALGORITHMS.md §7.9).
+// along -z (the first candidate upper boundary); a gap pass counts the surfaces above it, each
+// texel centre on a shared edge counted once, and finds the highest surface entering the body
+// below it (the lower boundary). The range between them is air when as many surfaces enter as
+// leave above the upper boundary (the winding count is 0 just below it) and along the whole ray
+// (the count ends at 0, as the bake's sweep requires), and none lies within kMinGap below it.
+// The next candidate is the highest surface leaving below that lower boundary, or below the
+// candidate itself when another part still encloses it (one more raster pass over the texels
+// still searching), and so on. Surfaces enter where the drawn (offset) triangle runs
+// counter-clockwise in the window, as in the bake. Where the ray does not balance the texel
+// keeps what it has, the conservative answer (docs/ALGORITHMS.md §7.9).
 #include <algorithm>
 #include <array>
 #include <cstdint>
