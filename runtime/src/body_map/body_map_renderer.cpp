@@ -331,7 +331,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   if (options_.air_gaps > 0) {
     exit_z_.assign(texels, -kInf);
     exit_face_.assign(texels, kNoFace);
-    // Set by each gap pass over every texel.
+    // Set by the gap passes at the texels they look at (FindGaps).
     for (std::vector<float>* v : {&entry_z_, &below_z_}) v->resize(texels);
     gap_count_.resize(texels);
     entry_face_.resize(texels);

@@ -34,8 +34,9 @@ struct RasterTriangle {
     // sharing it (their values are exactly negated, and so are their signs). For counting the
     // surfaces along a texel's ray, where Inside would count a shared edge twice.
     bool CountsOnce(double value) const { return value > 0.0 || (value == 0.0 && sign > 0.0); }
-    // Narrows [*lo, *hi] to about the texels inside the edge on this row, one texel generous on
-    // the side it cuts (the caller still tests each texel exactly). False: none inside.
+    // Narrows [*lo, *hi] to about the texels inside the edge on this row, a texel or two
+    // generous on the side it cuts (the caller still tests each texel exactly). False: none
+    // inside.
     bool Narrow(double row_term, int64_t* lo, int64_t* hi) const {
       if (dy == 0.0) return Inside(row_term, 0.0);  // the same value all along the row
       // The texel index where the value is 0, to within rounding: the slack below covers it.
@@ -185,15 +186,6 @@ void DrawTriangleRows(uint32_t t, const RasterTriangle& r, int64_t j_begin, int6
   }
 }
 
-// Calls fragment(t, r, k, px, py, once) for every texel centre the `drawn` triangles cover
-// (edges inclusive): t the triangle, r its set-up (set_up[d] for drawn[d]), k the texel's index,
-// (px, py) its centre, and once whether the centre counts for this triangle when the surfaces
-// along the ray are counted (a centre on an edge two triangles share counts for exactly one of
-// them); r.Depth(px, py) is its depth. tiles: null, or the tiles to draw (TileMask); a triangle
-// whose box meets none is skipped. Row bands run in parallel,
-// each drawing every triangle that crosses its rows, so a texel is handled by one band only, its
-// triangles in `drawn` order, whatever the banding: a fragment may write texel k's entries
-// without a lock and the result does not depend on the thread count.
 // Which 8 x 8-texel tiles of the window hold texels a pass needs: the gap pass skips the
 // triangles whose box meets none (most of a body has no second surface to find).
 struct TileMask {
@@ -223,6 +215,15 @@ struct RasterRows {
   int32_t first, last;  // texel rows, within [-1, height]; first > last: none
 };
 
+// Calls fragment(t, r, k, px, py, once) for every texel centre the `drawn` triangles cover
+// (edges inclusive): t the triangle, r its set-up (set_up[d] for drawn[d], rows[d] its rows), k
+// the texel's index, (px, py) its centre, and once whether the centre counts for this triangle
+// when the surfaces along the ray are counted (a centre on an edge two triangles share counts
+// for exactly one of them); r.Depth(px, py) is its depth. tiles: null, or the tiles to draw; a
+// triangle whose box meets none is skipped. Row bands run in parallel, each drawing every
+// triangle that crosses its rows, so a texel is handled by one band only, its triangles in
+// `drawn` order, whatever the banding: a fragment may write texel k's entries without a lock
+// and the result does not depend on the thread count.
 template <class Fragment>
 void RasterizeInBands(std::span<const uint32_t> drawn, std::span<const RasterTriangle> set_up,
                       std::span<const RasterRows> rows, const RasterWindow& w,

@@ -126,14 +126,12 @@ class BodyMapRenderer {
   std::span<const Float3> posed_vertices() const { return posed_; }
   size_t memory_bytes() const;  // the renderer's buffers, not the collider's
 
-  // One air gap the gap passes found (internal; public for the passes' helpers).
-  struct FoundGap {
+ private:
+  struct FoundGap {         // one air gap the gap passes found
     uint32_t texel, level;  // row-major texel; level 0: the first gap below the front (0-2)
     float upper, lower;     // view-frame z of its boundaries
     uint32_t upper_face, lower_face;
   };
-
- private:
   struct Window {                           // the texel grid of one render
     double origin_x = 0.0, origin_y = 0.0;  // metres, a multiple of the texel size
     uint32_t width = 0, height = 0;         // texels
@@ -173,10 +171,11 @@ class BodyMapRenderer {
   std::vector<detail::TriangleShading> shading_;  // per triangle; set for the drawn ones
   std::vector<uint32_t> top_face_;                // per texel: the triangle of the front surface
   std::vector<uint32_t> bottom_face_;             // per texel: the triangle of the back surface
-  // The gap pass (air_gaps), per texel: the highest surface leaving the body going along -z
-  // (the gap's upper boundary) and its triangle; the highest entering one below it (the lower
-  // boundary) and its triangle; the surfaces entering and leaving above it; whether a surface
-  // lies too close below it to leave a gap; the surfaces entering and leaving along the ray.
+  // The gap passes (air_gaps), per texel: the highest surface leaving the body going along -z
+  // below where the search is (the candidate upper boundary) and its triangle; the highest
+  // entering one below it (the lower boundary) and its triangle; the surfaces entering and
+  // leaving above it; whether a surface lies too close below it to leave a gap; the surfaces
+  // entering and leaving along the ray.
   std::vector<float> exit_z_, entry_z_;
   std::vector<uint32_t> exit_face_, entry_face_;
   std::vector<uint16_t> entries_above_, exits_above_, entries_total_, exits_total_;
