@@ -43,6 +43,11 @@ std::vector<float> Texels(const BodyMapCollider& maps) {
       const Float3 f = BodyMapColliderAccess::TexelNormal(maps, i, j, false);
       const Float3 b = BodyMapColliderAccess::TexelNormal(maps, i, j, true);
       out.insert(out.end(), {valid ? 1.f : 0.f, top, bottom, f.x, f.y, f.z, b.x, b.y, b.z});
+      float upper[3] = {}, lower[3] = {};
+      const uint32_t gaps = BodyMapColliderAccess::TexelGaps(maps, i, j, upper, lower);
+      out.push_back(static_cast<float>(gaps));
+      out.insert(out.end(), upper, upper + gaps);
+      out.insert(out.end(), lower, lower + gaps);
     }
   }
   return out;
@@ -142,26 +147,32 @@ TEST(BodyMapRenderer, TheRegionCutsTheWindowAndTheTriangles) {
   EXPECT_TRUE(cut.empty());
 }
 
+// Slabs, normals and gaps, bit for bit: two spheres turned and overlapping, and three where one
+// sinks into another above the third (gaps found on later passes).
 TEST(BodyMapRenderer, IdenticalBitsAtAnyThreadCount) {
-  const MeshData mesh = TwoSpheres();
-  BodyMapRenderer renderer;
-  ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
-  const Mat34 pose[2] = {
+  const MeshData two = TwoSpheres(), three = test::SkinnedSpheres(3, kRadius);
+  const std::vector<Mat34> overlapping = {
       Mat34{}, Multiply(Translation(-0.3f, 0.05f, 0.04f),
                         Mat34{{0.8f, -0.6f, 0.f, 0.f, 0.6f, 0.8f, 0.f, 0.f, 0.f, 0.f, 1.f, 0.f}})};
-  std::vector<float> reference;
-  for (int threads : {1, 2, 3, 4}) {
-    test::UseWorkers(threads);
-    BodyMapCollider maps;
-    ASSERT_TRUE(renderer.Render(pose, &maps).ok());
-    const std::vector<float> texels = Texels(maps);
-    if (reference.empty()) {
-      reference = texels;
-      continue;
+  const std::vector<Mat34> sunk = {Mat34{}, Translation(-0.5f, 0.01f, 0.3f),
+                                   Translation(-1.f, -0.02f, 0.38f)};
+  for (const auto& [mesh, pose] : {std::pair{&two, &overlapping}, std::pair{&three, &sunk}}) {
+    BodyMapRenderer renderer;
+    ASSERT_TRUE(renderer.Init(*mesh, Options()).ok());
+    std::vector<float> reference;
+    for (int threads : {1, 2, 3, 4}) {
+      test::UseWorkers(threads);
+      BodyMapCollider maps;
+      ASSERT_TRUE(renderer.Render(*pose, &maps).ok());
+      const std::vector<float> texels = Texels(maps);
+      if (reference.empty()) {
+        reference = texels;
+        continue;
+      }
+      ASSERT_EQ(texels.size(), reference.size());
+      EXPECT_EQ(std::memcmp(texels.data(), reference.data(), texels.size() * sizeof(float)), 0)
+          << threads << " threads";
     }
-    ASSERT_EQ(texels.size(), reference.size());
-    EXPECT_EQ(std::memcmp(texels.data(), reference.data(), texels.size() * sizeof(float)), 0)
-        << threads << " threads";
   }
   test::UseDefaultWorkers();
 }
