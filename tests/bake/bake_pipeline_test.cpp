@@ -235,7 +235,10 @@ TEST_P(BakeEveryCharacter, BodyMapsMisclassifyFewPointsBeyondTheBand) {
   EXPECT_EQ(error["samples"].get<int>(), 20000);
   EXPECT_LE(error["misclassified_beyond_band"].get<double>(), GetParam().max_misclassified)
       << "seen along " << result.report["body_maps"]["view_axis"].get<std::string>();
-  EXPECT_LE(error["error_p99_mm"].get<double>(), error["error_max_mm"].get<double>());
+  // 99 in 100 points are classified right or lie within two texels of the offset surface, the
+  // band the misclassified count leaves out (measured: 0.08-1.4 texels on these characters).
+  const double texel_mm = result.report["body_maps"]["poses"][0]["texel_size_mm"].get<double>();
+  EXPECT_LE(error["error_p99_mm"].get<double>(), 2.0 * texel_mm) << texel_mm << " mm texels";
   EXPECT_EQ(result.report["body_maps"]["view_axis"].get<std::string>(), GetParam().view_axis);
 }
 
