@@ -50,18 +50,8 @@ void BodyMapRenderer::FindGaps(const Window& window, const BodyMapCollider& maps
     const bool first = pass == 0;
     if (!first) FindUpperBoundariesBelow(window);
     RasterizeGapSurfaces(window, maps, first);
-    CollectGaps(window, maps, first);
+    CollectGaps(maps);
     if (searching_.empty()) break;
-  }
-}
-
-// Calls visit(k) for the texels of a pass: all of them, or the searching ones.
-template <class Visit>
-void ForPassTexels(size_t texels, bool all, std::span<const uint32_t> searching, Visit&& visit) {
-  if (all) {
-    for (size_t k = 0; k < texels; ++k) visit(k);
-  } else {
-    for (const uint32_t k : searching) visit(size_t{k});
   }
 }
 
@@ -97,18 +87,31 @@ void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCo
   const size_t texels = static_cast<size_t>(window.width) * window.height;
   gap_tiles_.assign(detail::TileMask::TileCount(window.width, window.height), 0);
   detail::TileMask tiles{(width + 7) >> detail::TileMask::kShift, gap_tiles_};
-  ForPassTexels(texels, all, searching_, [&](size_t k) {
+  // The candidates, ascending: on the first pass every texel with one, later the searching
+  // texels that still have one. Only they are reset, drawn and collected.
+  const auto keep = [&](size_t k) {
     // No room for a gap of kMinGap and its two boundaries above the back surface.
     if (exit_face_[k] != kNoFace && !(exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap)) {
       exit_face_[k] = kNoFace;
     }
-    if (exit_face_[k] == kNoFace) return;
+    if (exit_face_[k] == kNoFace) return false;
     entry_z_[k] = -kInf;
     entry_face_[k] = kNoFace;
     entries_above_[k] = exits_above_[k] = entries_total_[k] = exits_total_[k] = 0;
     crowded_[k] = 0;
     tiles.Mark(static_cast<int64_t>(k) % width, static_cast<int64_t>(k) / width);
-  });
+    return true;
+  };
+  if (all) {
+    searching_.clear();
+    for (size_t k = 0; k < texels; ++k) {
+      if (keep(k)) searching_.push_back(static_cast<uint32_t>(k));  // reserved for every texel
+    }
+  } else {
+    searching_.erase(std::remove_if(searching_.begin(), searching_.end(),
+                                    [&](uint32_t k) { return !keep(size_t{k}); }),
+                     searching_.end());
+  }
   detail::RasterizeInBands(
       drawn_, raster_, raster_rows_, RasterWindowOf(window), &tiles,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool once) {
@@ -139,10 +142,9 @@ void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCo
 // candidate that was no gap because the body continues under it (the surfaces above it do not
 // balance, or one lies within kMinGap below it) while the whole ray balances. The others lose
 // their exit face (out of the next pass).
-void BodyMapRenderer::CollectGaps(const Window& window, const BodyMapCollider& maps, bool all) {
-  const size_t texels = static_cast<size_t>(window.width) * window.height;
+void BodyMapRenderer::CollectGaps(const BodyMapCollider& maps) {
   next_searching_.clear();
-  ForPassTexels(texels, all, searching_, [&](size_t k) {
+  for (const uint32_t k : searching_) {
     const BodyMapCollider::Slab slab = maps.slabs_[k];
     const float upper = exit_z_[k], lower = entry_z_[k];
     const bool candidate = exit_face_[k] != kNoFace && entries_total_[k] == exits_total_[k];
@@ -166,7 +168,7 @@ void BodyMapRenderer::CollectGaps(const Window& window, const BodyMapCollider& m
       below_z_[k] = -kInf;
       exit_face_[k] = kNoFace;
     }
-  });
+  }
   searching_.swap(next_searching_);
 }
 
