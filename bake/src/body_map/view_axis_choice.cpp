@@ -41,8 +41,8 @@ Status ChooseBodyMapViewAxis(std::span<const Float3> positions, std::span<const 
   probe.layout = BodyMapLayout::kDense;
   probe.renderer = MapRenderer::kCpu;  // deterministic, and cheap at this resolution
   // The slab alone: with gap layers every axis holds about the body's volume (the gaps take the
-  // air out), yet the axis still decides how many texels need gaps, and the maps rendered at run
-  // time keep one gap at most.
+  // air out), yet the axis still decides how many texels need gaps, each of which costs the maps
+  // bytes and the renderer a pass.
   probe.layers = 1;
   ViewAxisChoice result;
   for (BodyMapViewAxis axis : {BodyMapViewAxis::kZ, BodyMapViewAxis::kX, BodyMapViewAxis::kY}) {

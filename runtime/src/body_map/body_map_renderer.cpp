@@ -335,11 +335,9 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
     for (std::vector<float>* v : {&entry_z_, &below_z_}) v->resize(texels);
     gap_count_.resize(texels);
     entry_face_.resize(texels);
-    for (std::vector<uint16_t>* v :
-         {&entries_above_, &exits_above_, &entries_total_, &exits_total_}) {
-      v->resize(texels);
-    }
-    crowded_.resize(texels);
+    winding_above_.resize(texels);
+    winding_total_.resize(texels);
+    gap_flags_.resize(texels);
   }
   maps->width_ = window.width;
   maps->height_ = window.height;
@@ -365,9 +363,9 @@ void BodyMapRenderer::Reserve(size_t texels) {
   searching_.reserve(texels);  // a pass may search on every texel
   next_searching_.reserve(texels);
   for (std::vector<uint32_t>* v : {&exit_face_, &entry_face_}) v->reserve(texels);
-  for (std::vector<uint16_t>* v : {&entries_above_, &exits_above_, &entries_total_, &exits_total_})
-    v->reserve(texels);
-  crowded_.reserve(texels);
+  winding_above_.reserve(texels);
+  winding_total_.reserve(texels);
+  gap_flags_.reserve(texels);
   gap_tiles_.reserve(texels / 64 + options_.max_side / 4 + 1);  // 8 x 8 tiles
 }
 
@@ -503,10 +501,8 @@ size_t BodyMapRenderer::memory_bytes() const {
          (exit_z_.capacity() + entry_z_.capacity() + below_z_.capacity()) * sizeof(float) +
          found_.capacity() * sizeof(FoundGap) + gap_count_.capacity() +
          (searching_.capacity() + next_searching_.capacity()) * sizeof(uint32_t) +
-         (entries_above_.capacity() + exits_above_.capacity() + entries_total_.capacity() +
-          exits_total_.capacity()) *
-             sizeof(uint16_t) +
-         crowded_.capacity() +
+         (winding_above_.capacity() + winding_total_.capacity()) * sizeof(int16_t) +
+         gap_flags_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *
              sizeof(Float3) +
          shading_.capacity() * sizeof(detail::TriangleShading) +

@@ -30,6 +30,9 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // Gaps thinner than this (metres) are not kept, as the bake's (kMinBodyMapGap): touching parts
 // and folded offset slivers, far below epsilon and a texel.
 constexpr float kMinGap = 1e-4f;
+// gap_flags_ bits: a surface lies within kMinGap below the candidate; one enters above it (a
+// seam texel can leave the counts balanced with nothing counted above).
+constexpr uint8_t kCrowded = 1, kEnteredAbove = 2;
 
 }  // namespace
 
@@ -97,8 +100,8 @@ void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCo
     if (exit_face_[k] == kNoFace) return false;
     entry_z_[k] = -kInf;
     entry_face_[k] = kNoFace;
-    entries_above_[k] = exits_above_[k] = entries_total_[k] = exits_total_[k] = 0;
-    crowded_[k] = 0;
+    winding_above_[k] = winding_total_[k] = 0;
+    gap_flags_[k] = 0;
     tiles.Mark(static_cast<int64_t>(k) % width, static_cast<int64_t>(k) / width);
     return true;
   };
@@ -121,15 +124,18 @@ void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCo
         // not exactly negated) can only spoil the count, which keeps the slab.
         const float z = r.Depth(px, py), upper = exit_z_[k];
         if (!r.entering) {  // the drawn triangle's winding, as the bake's sweep
-          if (once) ++exits_total_[k];
-          if (z >= upper && once) ++exits_above_[k];
+          if (once) --winding_total_[k];
+          if (z >= upper && once) --winding_above_[k];
           return;
         }
-        if (once) ++entries_total_[k];
+        if (once) ++winding_total_[k];
         if (z > upper) {
-          if (once) ++entries_above_[k];
+          if (once) {
+            ++winding_above_[k];
+            gap_flags_[k] |= kEnteredAbove;
+          }
         } else if (z > upper - kMinGap) {
-          crowded_[k] = 1;
+          gap_flags_[k] |= kCrowded;
         } else if (z > entry_z_[k]) {
           entry_z_[k] = z;
           entry_face_[k] = t;
@@ -147,10 +153,10 @@ void BodyMapRenderer::CollectGaps(const BodyMapCollider& maps) {
   for (const uint32_t k : searching_) {
     const BodyMapCollider::Slab slab = maps.slabs_[k];
     const float upper = exit_z_[k], lower = entry_z_[k];
-    const bool candidate = exit_face_[k] != kNoFace && entries_total_[k] == exits_total_[k];
-    const bool enclosed = entries_above_[k] != exits_above_[k] || crowded_[k];
+    const bool candidate = exit_face_[k] != kNoFace && winding_total_[k] == 0;
+    const bool enclosed = winding_above_[k] != 0 || (gap_flags_[k] & kCrowded) != 0;
     const bool air = candidate && !enclosed && entry_face_[k] != kNoFace &&
-                     entries_above_[k] != 0 && upper < slab.top - kMinGap &&
+                     (gap_flags_[k] & kEnteredAbove) != 0 && upper < slab.top - kMinGap &&
                      lower > slab.bottom + kMinGap && upper - lower > kMinGap;
     bool search_on = false;
     if (air) {

@@ -84,10 +84,10 @@ Status BakeBodyMapPose(std::span<const Float3> positions, std::span<const uint32
 // The view axis whose slab holds the least air: the body baked along x, y and z at
 // min(options.resolution, kViewAxisProbeResolution) with options' epsilon and one layer, and
 // the inside volume of each slab compared (with gap layers every axis holds about the body's
-// volume).
-// The air under a quadruped's belly, or between a human's legs seen from the front, is inside the
-// slab; seen from above or from the side it is not. z is kept unless another axis holds at least
-// kViewAxisMinGain less volume, so near-ties keep the paper's view. docs/ALGORITHMS.md §6.9.
+// volume). The air under a quadruped's belly, or between a human's legs seen from the front, is
+// inside the slab; seen from above or from the side it is not. z is kept unless another axis
+// holds at least kViewAxisMinGain less volume, so near-ties keep the paper's view.
+// docs/ALGORITHMS.md §6.9.
 inline constexpr uint32_t kViewAxisProbeResolution = 128;
 inline constexpr double kViewAxisMinGain = 0.03;  // fraction of z's inside volume
 struct ViewAxisChoice {

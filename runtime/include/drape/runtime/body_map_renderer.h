@@ -173,13 +173,12 @@ class BodyMapRenderer {
   std::vector<uint32_t> bottom_face_;             // per texel: the triangle of the back surface
   // The gap passes (air_gaps), per texel: the highest surface leaving the body going along -z
   // below where the search is (the candidate upper boundary) and its triangle; the highest
-  // entering one below it (the lower boundary) and its triangle; the surfaces entering and
-  // leaving above it; whether a surface lies too close below it to leave a gap; the surfaces
-  // entering and leaving along the ray.
+  // entering one below it (the lower boundary) and its triangle; the winding count just below the
+  // candidate and at the end of the ray (surfaces entering less leaving); flags (gaps.cpp).
   std::vector<float> exit_z_, entry_z_;
   std::vector<uint32_t> exit_face_, entry_face_;
-  std::vector<uint16_t> entries_above_, exits_above_, entries_total_, exits_total_;
-  std::vector<uint8_t> crowded_;
+  std::vector<int16_t> winding_above_, winding_total_;
+  std::vector<uint8_t> gap_flags_;
   std::vector<float> below_z_;      // per texel: where the next search starts, -inf: not searching
   std::vector<uint8_t> gap_count_;  // per texel: the gaps found
   std::vector<uint32_t> searching_, next_searching_;  // texels, ascending
