@@ -184,6 +184,8 @@ nlohmann::json FrameJson(const FrameStats& f) {
           {"shape_contacts", f.shape_contacts},
           {"inside_particles", f.inside_particles},
           {"max_penetration_mm", f.max_penetration * 1000.f},
+          {"held_inside_particles", f.held_inside_particles},
+          {"held_max_penetration_mm", f.held_max_penetration * 1000.f},
           {"max_stretch", f.max_stretch},
           {"nan", !f.finite},
           {"rss_bytes", f.rss_bytes},

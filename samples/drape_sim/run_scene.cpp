@@ -70,6 +70,19 @@ std::string RenderNote(const bake::Scene& scene, const RunSummary& summary) {
   return text;
 }
 
+// " (held particles: up to 20 inside, 100.5 mm deep, where the scene put them)" when the scene
+// holds particles inside a collider (a waistband drawn inside the hips): apart from the
+// penetration figure, which is the simulated particles'.
+std::string HeldNote(const RunSummary& summary) {
+  if (summary.held_inside_particles_max == 0) return "";
+  char text[128];
+  std::snprintf(text, sizeof(text),
+                " (held particles: up to %u inside, %.1f mm deep, where the scene put them)",
+                summary.held_inside_particles_max,
+                static_cast<double>(summary.held_max_penetration) * 1000.0);
+  return text;
+}
+
 // Model only what the scene needs: the colliders its garments can reach, the poses it plays.
 // With scene.prune the others leave the asset, each listed in *left_out.
 Status KeepReachable(const bake::Scene& scene, CharacterAsset* asset, bake::SceneReach* reach,
@@ -354,6 +367,8 @@ int RunScene(const RunOptions& options) {
                        {"max_penetration_frame", summary.max_penetration_frame},
                        {"frames_with_particles_inside", summary.frames_with_inside},
                        {"inside_particles_max", summary.inside_particles_max},
+                       {"held_inside_particles_max", summary.held_inside_particles_max},
+                       {"held_max_penetration_mm", summary.held_max_penetration * 1000.f},
                        {"max_stretch", loop.stretch_max},
                        {"nan_frames", summary.nan_frames},
                        {"rss_peak_bytes", rss_peak},
@@ -394,12 +409,12 @@ int RunScene(const RunOptions& options) {
   constexpr double kMiB = 1024.0 * 1024.0;
   std::printf(
       "drape-sim: %lld frames, %.2f ms/step mean (%.2f p99, %.2f max)%s, %.0f contacts/frame, "
-      "max penetration %.2f mm, %u NaN frames; RSS peak %.1f MiB, %+.1f MiB after frame 100; "
+      "max penetration %.2f mm%s, %u NaN frames; RSS peak %.1f MiB, %+.1f MiB after frame 100; "
       "%lld pictures, %s; %.1f s\n",
       static_cast<long long>(simulated), summary.step_ms_mean, summary.step_ms_p99,
       summary.step_ms_max, RenderNote(scene, summary).c_str(),
       totals["contacts_mean"].get<double>(), static_cast<double>(summary.max_penetration) * 1000.0,
-      summary.nan_frames, static_cast<double>(rss_peak) / kMiB,
+      HeldNote(summary).c_str(), summary.nan_frames, static_cast<double>(rss_peak) / kMiB,
       static_cast<double>(summary.rss_growth) / kMiB, static_cast<long long>(loop.written),
       animation.c_str(), Seconds(wall_start));
   return 0;

@@ -86,6 +86,9 @@ RunSummary SummarizeRun(std::span<const FrameStats> frames) {
     if (!f.finite) ++summary.nan_frames;
     if (f.inside_particles > 0) ++summary.frames_with_inside;
     summary.inside_particles_max = std::max(summary.inside_particles_max, f.inside_particles);
+    summary.held_inside_particles_max =
+        std::max(summary.held_inside_particles_max, f.held_inside_particles);
+    summary.held_max_penetration = std::max(summary.held_max_penetration, f.held_max_penetration);
     if (f.max_penetration > summary.max_penetration) {
       summary.max_penetration = f.max_penetration;
       summary.max_penetration_frame = f.frame;
@@ -211,6 +214,8 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
     if (Status s = garment->solver.Init(garment->cloth, garment_settings); !s.ok())
       return Status(s.code(), at + s.message());
     garment->state.Reset(garment->cloth);
+    garment->held.assign(garment->cloth.particle_count(), 0);
+    for (const uint32_t i : garment->cloth.kinematic_particles()) garment->held[i] = 1;
     if (garment->cloth.skinned()) {  // at its skinned positions
       if (Status s = garment->solver.Reset(&garment->state, {}, skin_start_); !s.ok())
         return Status(s.code(), at + s.message());
@@ -374,8 +379,8 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
   // runtime's task system (tasks/parallel_for.h), each chunk's figures in its own slot, combined
   // in chunk order.
   struct ChunkFigures {
-    uint32_t inside = 0;
-    float deepest = 0.f;
+    uint32_t inside = 0, held_inside = 0;
+    float deepest = 0.f, held_deepest = 0.f;
     bool finite = true;
   };
   constexpr int64_t kChunk = 1024;
@@ -402,13 +407,20 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
           if (q.inside_end) depth = std::max(depth, q.depth);
         }
         if (depth < 0.f) continue;
-        ++figures.inside;
-        figures.deepest = std::max(figures.deepest, depth);
+        if (g->held[static_cast<size_t>(i)] != 0) {
+          ++figures.held_inside;
+          figures.held_deepest = std::max(figures.held_deepest, depth);
+        } else {
+          ++figures.inside;
+          figures.deepest = std::max(figures.deepest, depth);
+        }
       }
     });
     for (const ChunkFigures& figures : chunks) {
       stats->inside_particles += figures.inside;
       stats->max_penetration = std::max(stats->max_penetration, figures.deepest);
+      stats->held_inside_particles += figures.held_inside;
+      stats->held_max_penetration = std::max(stats->held_max_penetration, figures.held_deepest);
       stats->finite = stats->finite && figures.finite;
     }
   }

@@ -33,11 +33,16 @@ struct FrameStats {
   uint32_t hull_contacts = 0;      // hulls and spheres, summed over substeps
   uint32_t body_map_contacts = 0;  // summed over substeps
   uint32_t shape_contacts = 0;     // the scene's engine shapes, summed over substeps
-  // After the step, at the frame's end pose: particles inside a collider the scene uses and the
-  // deepest of them (metres), from HullColliderSet::Query and BodyMapCollider::Query of the
-  // particle's position (a point query).
+  // After the step, at the frame's end pose: simulated particles inside a collider the scene uses
+  // and the deepest of them (metres), from HullColliderSet::Query and BodyMapCollider::Query of
+  // the particle's position (a point query).
   uint32_t inside_particles = 0;
   float max_penetration = 0.f;
+  // The same for the held particles (attached, pinned, skinned with max distance 0): the scene
+  // puts them where they are (a waistband drawn inside the hips) and no collider moves them, so
+  // they are counted apart from what the solver answers for.
+  uint32_t held_inside_particles = 0;
+  float held_max_penetration = 0.f;
   float max_stretch = 0.f;      // max over stretch springs of L / R - 1
   bool finite = true;           // every position and velocity finite
   uint64_t rss_bytes = 0;       // the process's resident set size after the frame (0: unknown)
@@ -60,13 +65,15 @@ struct RunSummary {
   // only when n < 10, is left out), overall mean, median and p99 (nearest rank), max.
   std::vector<double> step_ms_tenths;
   double step_ms_mean = 0.0, step_ms_median = 0.0, step_ms_p99 = 0.0, step_ms_max = 0.0;
-  double measure_ms_mean = 0.0;        // the per-frame point queries, ms
-  double maps_render_ms_mean = 0.0;    // rendering each frame's maps (rendered maps only), ms
-  uint32_t nan_frames = 0;             // frames with a non-finite position or velocity
-  uint32_t frames_with_inside = 0;     // frames ending with a particle inside a collider
-  uint32_t inside_particles_max = 0;   // most particles inside at the end of one frame
-  float max_penetration = 0.f;         // metres, deepest over the run
-  int64_t max_penetration_frame = -1;  // the first frame reaching it (-1: none inside)
+  double measure_ms_mean = 0.0;            // the per-frame point queries, ms
+  double maps_render_ms_mean = 0.0;        // rendering each frame's maps (rendered maps only), ms
+  uint32_t nan_frames = 0;                 // frames with a non-finite position or velocity
+  uint32_t frames_with_inside = 0;         // frames ending with a simulated particle inside
+  uint32_t inside_particles_max = 0;       // most particles inside at the end of one frame
+  float max_penetration = 0.f;             // metres, deepest over the run
+  int64_t max_penetration_frame = -1;      // the first frame reaching it (-1: none inside)
+  uint32_t held_inside_particles_max = 0;  // held particles: most inside at the end of one frame
+  float held_max_penetration = 0.f;        // held particles: metres, deepest over the run
   // Resident set size, bytes (0: unknown): after the first 100 frames (frame 99, or the last
   // frame of a shorter run), after the last frame, and the growth between them (may be < 0).
   uint64_t rss_after_100_frames = 0, rss_end = 0;
@@ -120,6 +127,7 @@ class SceneSimulation {
     ClothSolver solver;
     ClothState state;
     std::vector<Float3> start_positions;
+    std::vector<uint8_t> held;  // per particle: 1 when kinematic (Cloth::kinematic_particles)
   };
 
   Status Pose(float time, std::vector<Mat34>* skinning);

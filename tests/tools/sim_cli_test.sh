@@ -14,7 +14,7 @@ pass() { passed=$((passed + 1)); }
 
 MANNEQUIN="$SOURCE/samples/mannequin/mannequin.gltf"
 # The demo scene, small: 96 px pictures of every 3rd frame, OBJ output.
-write_scene() {  # write_scene FILE HULL_DELTA GARMENT_TYPE JOINT
+write_scene() {  # write_scene FILE HULL_DELTA GARMENT_TYPE JOINT [TOP_RADIUS]
   cat >"$1" <<JSON
 {
   "character": "$MANNEQUIN",
@@ -22,7 +22,7 @@ write_scene() {  # write_scene FILE HULL_DELTA GARMENT_TYPE JOINT
   "animation": {"clip": "walk", "start": 0.0, "duration": 3.0, "settle": 0.5},
   "garments": [{
     "name": "skirt", "type": "$3", "anchor": "hips",
-    "shape": {"top_center": [0, 0.03, 0], "top_radius": 0.185, "bottom_radius": 0.34,
+    "shape": {"top_center": [0, 0.03, 0], "top_radius": ${5:-0.185}, "bottom_radius": 0.34,
               "length": 0.42, "segments": 64, "rings": 24},
     "attach": {"joint": "$4", "ring": "waist"}
   }],
@@ -65,11 +65,28 @@ if [ -s "$STATS" ]; then
   contacts=$(json_number "$STATS" contacts_max)
   [ "${contacts:-0}" -gt 0 ] && pass || fail "no contacts in 12 frames (contacts_max=${contacts:-none})"
   [ "$(grep -c '"step_ms"' "$STATS")" = "12" ] && pass || fail "stats.json should list 12 frames"
+  [ "$(grep -c '"held_inside_particles"' "$STATS")" = "12" ] && pass ||
+    fail "stats.json should count the held particles inside apart, every frame"
 else
   fail "stats.json missing"
 fi
 [ -s "$OUT/reach.json" ] && grep -q '"reachable": false' "$OUT/reach.json" && pass ||
   fail "reach.json missing or leaves nothing out (the feet are out of a skirt's reach)"
+
+# --- 1b. A waistband drawn inside the hips: its held particles stay there (no collider moves a
+# held particle); they are counted apart and named in the summary line, and the penetration
+# figure is the simulated particles' alone.
+write_scene "$WORK/inside.json" 0.005 skirt hips 0.09
+if "$SIM" "$WORK/inside.json" -o "$WORK/inside" --frames 3 --threads 1 >"$WORK/inside.out" 2>&1; then
+  held=$(json_number "$WORK/inside/stats.json" held_inside_particles_max)
+  [ "${held:-0}" -gt 0 ] && pass || fail "a waistband inside the hips: held_inside_particles_max=${held:-none}"
+  grep -q "held particles: up to $held inside" "$WORK/inside.out" && pass ||
+    fail "the summary line does not name the held particles inside: $(cat "$WORK/inside.out")"
+  inside=$(json_number "$WORK/inside/stats.json" inside_particles_max)
+  [ "${inside:-64}" -lt 64 ] && pass || fail "the held ring counted as simulated particles inside (${inside:-none})"
+else
+  fail "waistband-inside run exited non-zero: $(cat "$WORK/inside.out")"
+fi
 
 # --- 2. Second run: the cached asset is reused (log line and unchanged file).
 before=$(mtime "$OUT/character.drape")
