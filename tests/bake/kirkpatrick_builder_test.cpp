@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "drape/runtime/exact_orientation.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
 #include "hull/hull_collider_set_access.h"
@@ -104,6 +105,42 @@ void ExpectWellFormed(const KirkpatrickHierarchy& k, size_t planes, const std::s
     EXPECT_LE(k.child_offsets[n + 1] - k.child_offsets[n], 12u) << what;
   }
   EXPECT_GT(leaves_on_planes, 0u) << what;
+}
+
+// The exact orientation every topological decision uses (and the runtime's validation at load):
+// its floating-point filter must never decide a sign the exact sum would not. Points on a grid of
+// 2^-10 with integer coordinates below 2^20 have an integer determinant in 2^-20 units (the
+// points lie within 64 steps of each other: computed exactly in 64 bits); a third point on or next
+// to the line through the first two (one grid step off) is where the filter's bound matters.
+TEST(KirkpatrickBuilderTest, ExactOrientationMatchesIntegerArithmetic) {
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<int64_t> coord(-(int64_t{1} << 20), int64_t{1} << 20);
+  std::uniform_int_distribution<int64_t> step(-64, 64), nudge(-1, 1);
+  const auto grid = [](int64_t k) { return static_cast<float>(std::ldexp(double(k), -10)); };
+  int collinear = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const int64_t ax = coord(rng), ay = coord(rng);
+    const int64_t dx = step(rng), dy = step(rng);
+    const int64_t t = step(rng);
+    // c on the line a + t (b - a) / ... : b = a + d, c = a + t d, then nudged by a grid step.
+    const int64_t bx = ax + dx, by = ay + dy;
+    const int64_t cx = ax + t * dx + (trial % 2 == 0 ? nudge(rng) : 0);
+    const int64_t cy = ay + t * dy + (trial % 3 == 0 ? nudge(rng) : 0);
+    const int64_t det = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax);  // |.| < 2^20: exact
+    const int expected = det > 0 ? 1 : (det < 0 ? -1 : 0);
+    collinear += expected == 0;
+    ASSERT_EQ(Orient2dExact(grid(ax), grid(ay), grid(bx), grid(by), grid(cx), grid(cy)), expected)
+        << "a (" << ax << ", " << ay << ") b (" << bx << ", " << by << ") c (" << cx << ", " << cy
+        << ")";
+  }
+  EXPECT_GT(collinear, 10000);  // the exact path is exercised, not only the filter
+  // Magnitudes far apart: the product of the differences rounds, the sign must not.
+  const float big = 1e30f, tiny = 1e-30f;
+  EXPECT_EQ(Orient2dExact(0.f, 0.f, big, 0.f, big, tiny), 1);
+  EXPECT_EQ(Orient2dExact(0.f, 0.f, big, 0.f, big, -tiny), -1);
+  EXPECT_EQ(Orient2dExact(-big, -big, big, big, 1.f, std::nextafter(1.f, 2.f)), 1);
+  EXPECT_EQ(Orient2dExact(-big, -big, big, big, 1.f, 1.f), 0);
+  EXPECT_EQ(Orient2dExact(tiny, 0.f, 0.f, tiny, 0.f, 0.f), 1);
 }
 
 TEST(KirkpatrickBuilderTest, PlanarHierarchyLocatesEveryPointOfAJitteredGrid) {

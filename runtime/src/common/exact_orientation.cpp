@@ -32,6 +32,27 @@ int SignOfExactSum(const double* terms, int count) {
 }  // namespace
 
 int Orient2dExact(float ax, float ay, float bx, float by, float cx, float cy) {
+  // Shewchuk's filter (orient2d, stage A): the double determinant's sign is certain when it
+  // exceeds its rounding bound (3 + 16 eps) eps (|left| + |right|), eps = 2^-53. Float inputs are
+  // exact in double and their products cannot underflow, so the bound holds for every input; the
+  // exact sum below decides only near-collinear points (most of a Kirkpatrick build's tests are
+  // far from it: the filter answers them at a fraction of the cost).
+  const double left = (double(ax) - cx) * (double(by) - cy);
+  const double right = (double(ay) - cy) * (double(bx) - cx);
+  const double det = left - right;
+  double sum;
+  if (left > 0.0) {
+    if (right <= 0.0) return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
+    sum = left + right;
+  } else if (left < 0.0) {
+    if (right >= 0.0) return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
+    sum = -left - right;
+  } else {  // left is exactly 0 (a difference is): the sign is right's, negated
+    return right > 0.0 ? -1 : (right < 0.0 ? 1 : 0);
+  }
+  constexpr double kEpsilon = 1.1102230246251565e-16;  // 2^-53
+  constexpr double kBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+  if (det >= kBound * sum || -det >= kBound * sum) return det > 0.0 ? 1 : -1;
   const double terms[6] = {double(bx) * cy,  -double(bx) * ay, -double(ax) * cy,
                            -double(by) * cx, double(by) * ax,  double(ay) * cx};
   return SignOfExactSum(terms, 6);
