@@ -232,8 +232,11 @@ std::vector<double> BloatOf(const BloatSamples& samples, const MeshReference& bo
 #pragma omp parallel for schedule(dynamic, 64)
   for (int64_t i = 0; i < static_cast<int64_t>(bloat.size()); ++i) {
     const double* q = &samples.points[3 * static_cast<size_t>(i)];
-    const double outside = body.WindingNumber(q) > 0.5 ? 0.0 : body.Distance(q);
-    bloat[i] = std::max(0.0, outside - samples.delta[i]);
+    // The distance first: a sample within its delta of the surface has no bloat inside or out,
+    // so only the others need the winding number (the costlier query).
+    const double distance = body.Distance(q);
+    const bool beyond = distance > samples.delta[i] && !(body.WindingNumber(q) > 0.5);
+    bloat[i] = beyond ? distance - samples.delta[i] : 0.0;
   }
   return bloat;
 }

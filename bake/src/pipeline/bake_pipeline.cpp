@@ -213,7 +213,7 @@ void MarkInternalPlanes(const Mat34& collider_to_asset, const MeshReference& bod
         centroid[g] * static_cast<float>(1.0 / area[g]) + hull->planes[g].normal * 0.002f;
     const Float3 at = TransformPoint(collider_to_asset, local);
     const double q[3] = {at.x, at.y, at.z};
-    if (body.Inside(q) && body.Distance(q) > delta + 0.002) hull->plane_internal[g] = 1;
+    if (body.Distance(q) > delta + 0.002 && body.Inside(q)) hull->plane_internal[g] = 1;
   }
   size_t internal = 0;
   for (size_t p = 0; p < planes; ++p) {

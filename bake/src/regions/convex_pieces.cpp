@@ -69,7 +69,9 @@ double Bloat(const Context& c, const std::vector<Vec3>& points, double stop_abov
     for (const auto& t : hull.triangles) {
       const Vec3 p = hull.points[t[0]] * w[0] + hull.points[t[1]] * w[1] + hull.points[t[2]] * w[2];
       const double q[3] = {p.x, p.y, p.z};
-      if (!c.body.Inside(q)) worst = std::max(worst, c.body.Distance(q));
+      // The distance first: only a sample farther than the worst so far needs the winding number.
+      const double distance = c.body.Distance(q);
+      if (distance > worst && !c.body.Inside(q)) worst = distance;
       if (worst > stop_above) return worst;
     }
   }
