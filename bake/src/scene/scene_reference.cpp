@@ -124,9 +124,12 @@ reach) and what was left out and why. A garment with a part held by nothing reac
 
 Per frame: `step_ms` (solver wall time, all garments), `contacts` (particles in contact in the
 last substep), `hull_contacts` / `body_map_contacts` (summed over substeps), `inside_particles` and
-`max_penetration_mm` (after the step, at the frame's end pose, by the colliders' own point
-queries: `HullColliderSet::Query`, `BodyMapCollider::Query`), `measure_ms` (the wall time of those
-queries, not in `step_ms`), `max_stretch` (max L/R - 1 over stretch springs), `nan`, `rss_bytes`
+`max_penetration_mm` (the simulated particles, after the step, at the frame's end pose, by the
+colliders' own point queries: `HullColliderSet::Query`, `BodyMapCollider::Query`),
+`held_inside_particles` and `held_max_penetration_mm` (the same for the held particles: attached,
+pinned, or skinned with max distance 0; no collider moves them, so one inside is where the scene
+put it, e.g. a waistband drawn inside the hips), `measure_ms` (the wall time of those queries, not
+in `step_ms`), `max_stretch` (max L/R - 1 over stretch springs), `nan`, `rss_bytes`
 (the process's resident set size after the frame: resident pages of `/proc/self/statm` times the
 page size; 0 where it cannot be read). Settle frames are not listed.
 
@@ -141,6 +144,7 @@ page size; 0 where it cannot be read). Settle frames are not listed.
 | `contacts_mean`, `contacts_max` | per frame |
 | `max_penetration_mm`, `max_penetration_frame` | the deepest particle inside a collider at the end of any frame, and the first frame reaching it (-1: none) |
 | `frames_with_particles_inside`, `inside_particles_max` | frames ending with a particle inside; the most particles inside at the end of one frame |
+| `held_inside_particles_max`, `held_max_penetration_mm` | the held particles inside a collider: the most at the end of one frame, the deepest (also in the summary line) |
 | `max_stretch`, `nan_frames` | over the run |
 | `rss_peak_bytes` | the peak resident set size (`VmHWM` of `/proc/self/status`) after the last frame: the bake, the setup and the simulation, not the writing of stats.json |
 | `rss_after_100_frames_bytes`, `rss_end_bytes`, `rss_growth_bytes` | `rss_bytes` of frame 99 (the last frame of a shorter run) and of the last frame, and end - after 100 (may be negative) |
