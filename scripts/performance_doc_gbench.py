@@ -309,6 +309,16 @@ def hull_bake(doc, gb):
                 f"hulls (slowest bone {mm(value(gb, p, 'BM_CesiumManHulls', (), 'max_bone_ms'))} "
                 f"ms, mean {mm(value(gb, p, 'BM_CesiumManHulls', (), 'mean_tris'), 0)} "
                 "triangles).")
+    whole = [value(gb, p, "BM_WholeBake", (k,), "real_time") for k in range(3)]
+    if all(whole):
+        hulls = [value(gb, p, "BM_WholeBake", (k,), "hulls") for k in range(3)]
+        joints = [value(gb, p, "BM_WholeBake", (k,), "joints") for k in range(3)]
+        doc.add("", "The whole bake (`BakeCharacter`, default config, wall time on the bake's "
+                f"OpenMP team): Animated_Human ({joints[0]:.0f} joints) rescaled to 1.75 m "
+                f"{whole[0] / 1000:.2f} s ({hulls[0]:.0f} hulls), as its file gives it (5.3 m "
+                f"tall, so more convex pieces under the same max_bloat in metres) "
+                f"{whole[1] / 1000:.2f} s ({hulls[1]:.0f} hulls); CesiumMan ({joints[2]:.0f} "
+                f"joints) {whole[2] / 1000:.2f} s ({hulls[2]:.0f} hulls).")
     source(doc, p)
 
 

@@ -6,6 +6,9 @@
 //    Modes: 0 = edge collapse (default), 1 = plane removal, 2 = none.
 //  BM_HullBakeObb/<obb mode>: the same 400-point bone with the covariance or the CGAL OBB.
 //  BM_CesiumManHulls: every bone of CesiumMan (rigid threshold 0.99), one thread, default options.
+//  BM_WholeBake/<character>: BakeCharacter with the default config, wall time on the bake's
+//    OpenMP team: 0 Animated_Human rescaled to 1.75 m (import.unit_scale), 1 Animated_Human as
+//    its file gives it (5.3 m tall: max_bloat is in metres, so more convex pieces), 2 CesiumMan.
 //  BM_KirkpatrickBuild/<levels>: both point-location hierarchies of a tilted ellipsoid hull
 //    (icosphere subdivided `levels` times: 80, 320, 1280 faces; default options, so the auto axis
 //    builds all three). Counters: levels and nodes per side, mean_tests (node tests per location).
@@ -22,6 +25,7 @@
 #include <vector>
 
 #include "drape/bake/bake_config.h"
+#include "drape/bake/bake_pipeline.h"
 #include "drape/bake/hull_builder.h"
 #include "drape/bake/importer.h"
 #include "drape/bake/kirkpatrick_builder.h"
@@ -167,6 +171,36 @@ void BM_CesiumManHulls(benchmark::State& state) {
   state.counters["mean_tris"] = built > 0 ? triangles / built : 0.0;
 }
 BENCHMARK(BM_CesiumManHulls)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The whole bake of a shared character (import, regions, maps, hulls and their convex pieces,
+// spheres, capsules, the fit measure, validation) with the default config.
+void BM_WholeBake(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  const std::string path = test::CharacterPath(
+      which == 2 ? "CesiumMan/CesiumMan.glb" : "QuaterniusAnimatedHuman/Animated_Human.fbx");
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError(("shared asset absent: " + path).c_str());
+    return;
+  }
+  BakeConfig config;
+  // The FBX's units give a 5.26 m body at unit_scale 0.01; this makes it 1.75 m.
+  if (which == 0) config.import.unit_scale = 0.01 * 1.75 / 5.2596;
+  BakeResult result;
+  for (auto _ : state) {
+    if (!BakeCharacter(path, config, &result).ok()) {
+      state.SkipWithError(("bake failed: " + path).c_str());
+      return;
+    }
+  }
+  state.counters["joints"] = static_cast<double>(result.asset.skeleton.joint_count());
+  state.counters["hulls"] = static_cast<double>(result.asset.hulls.size());
+}
+BENCHMARK(BM_WholeBake)
+    ->ArgName("character")
+    ->DenseRange(0, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 // The elongated hull of the Kirkpatrick and map-table tests: a tilted ellipsoid 12 x 50 x 16 cm.
 HullColliderData TiltedEllipsoid(int levels) {
