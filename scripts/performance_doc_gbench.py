@@ -302,23 +302,28 @@ def hull_bake(doc, gb):
     if any(t for _, t, _ in obb):
         doc.add("", "OBB of the 400-point bone: " + "; ".join(
             f"{label} {mm(t, 2)} ms, {mm(v, 1)} cm³" for label, t, v in obb) + ".")
+    # Every bone of CesiumMan and the whole bakes: one paragraph (the page stays under 300 lines).
+    sentences = []
     bones = value(gb, p, "BM_CesiumManHulls", (), "bones")
     if bones:
-        doc.add("", f"Every bone of CesiumMan, one thread, CPU time: "
-                f"{mm(value(gb, p, 'BM_CesiumManHulls', (), 'cpu_time'))} ms for {bones:.0f} "
-                f"hulls (slowest bone {mm(value(gb, p, 'BM_CesiumManHulls', (), 'max_bone_ms'))} "
-                f"ms, mean {mm(value(gb, p, 'BM_CesiumManHulls', (), 'mean_tris'), 0)} "
-                "triangles).")
+        sentences.append(
+            f"Every bone of CesiumMan, one thread, CPU time: "
+            f"{mm(value(gb, p, 'BM_CesiumManHulls', (), 'cpu_time'))} ms for {bones:.0f} "
+            f"hulls (slowest bone {mm(value(gb, p, 'BM_CesiumManHulls', (), 'max_bone_ms'))} "
+            f"ms, mean {mm(value(gb, p, 'BM_CesiumManHulls', (), 'mean_tris'), 0)} triangles).")
     whole = [value(gb, p, "BM_WholeBake", (k,), "real_time") for k in range(3)]
     if all(whole):
         hulls = [value(gb, p, "BM_WholeBake", (k,), "hulls") for k in range(3)]
         joints = [value(gb, p, "BM_WholeBake", (k,), "joints") for k in range(3)]
-        doc.add("", "The whole bake (`BakeCharacter`, default config, wall time on the bake's "
-                f"OpenMP team): Animated_Human ({joints[0]:.0f} joints) rescaled to 1.75 m "
-                f"{whole[0] / 1000:.2f} s ({hulls[0]:.0f} hulls), as its file gives it (5.3 m "
-                f"tall, so more convex pieces under the same max_bloat in metres) "
-                f"{whole[1] / 1000:.2f} s ({hulls[1]:.0f} hulls); CesiumMan ({joints[2]:.0f} "
-                f"joints) {whole[2] / 1000:.2f} s ({hulls[2]:.0f} hulls).")
+        sentences.append(
+            "The whole bake (`BakeCharacter`, default config, wall time on the bake's OpenMP "
+            f"team): Animated_Human ({joints[0]:.0f} joints) rescaled to 1.75 m "
+            f"{whole[0] / 1000:.2f} s ({hulls[0]:.0f} hulls), as its file gives it (5.3 m tall, "
+            f"so more convex pieces under the same max_bloat in metres) {whole[1] / 1000:.2f} s "
+            f"({hulls[1]:.0f} hulls); CesiumMan ({joints[2]:.0f} joints) {whole[2] / 1000:.2f} s "
+            f"({hulls[2]:.0f} hulls).")
+    if sentences:
+        doc.add("", " ".join(sentences))
     source(doc, p)
 
 
