@@ -109,9 +109,10 @@ void ExpectWellFormed(const KirkpatrickHierarchy& k, size_t planes, const std::s
 
 // The exact orientation every topological decision uses (and the runtime's validation at load):
 // its floating-point filter must never decide a sign the exact sum would not. Points on a grid of
-// 2^-10 with integer coordinates below 2^20 have an integer determinant in 2^-20 units (the
-// points lie within 64 steps of each other: computed exactly in 64 bits); a third point on or next
-// to the line through the first two (one grid step off) is where the filter's bound matters.
+// 2^-10 with integer coordinates below 2^21 have an integer determinant in 2^-20 units (the
+// points lie within 4 200 steps of each other: computed exactly in 64 bits); a third point on the
+// line through the first two, or one grid step off it, leaves the collinear ones to the exact sum.
+// Where the double arithmetic rounds (magnitudes 60 orders apart), the signs are checked by hand.
 TEST(KirkpatrickBuilderTest, ExactOrientationMatchesIntegerArithmetic) {
   std::mt19937_64 rng(7);
   std::uniform_int_distribution<int64_t> coord(-(int64_t{1} << 20), int64_t{1} << 20);
@@ -122,7 +123,7 @@ TEST(KirkpatrickBuilderTest, ExactOrientationMatchesIntegerArithmetic) {
     const int64_t ax = coord(rng), ay = coord(rng);
     const int64_t dx = step(rng), dy = step(rng);
     const int64_t t = step(rng);
-    // c on the line a + t (b - a) / ... : b = a + d, c = a + t d, then nudged by a grid step.
+    // b = a + d and c = a + t d, c nudged by a grid step in some trials.
     const int64_t bx = ax + dx, by = ay + dy;
     const int64_t cx = ax + t * dx + (trial % 2 == 0 ? nudge(rng) : 0);
     const int64_t cy = ay + t * dy + (trial % 3 == 0 ? nudge(rng) : 0);
@@ -134,7 +135,8 @@ TEST(KirkpatrickBuilderTest, ExactOrientationMatchesIntegerArithmetic) {
         << ")";
   }
   EXPECT_GT(collinear, 10000);  // the exact path is exercised, not only the filter
-  // Magnitudes far apart: the product of the differences rounds, the sign must not.
+  // Magnitudes far apart: the differences and their products round, the sign must not (the
+  // third case is collinear in double arithmetic and not in exact arithmetic).
   const float big = 1e30f, tiny = 1e-30f;
   EXPECT_EQ(Orient2dExact(0.f, 0.f, big, 0.f, big, tiny), 1);
   EXPECT_EQ(Orient2dExact(0.f, 0.f, big, 0.f, big, -tiny), -1);
