@@ -214,8 +214,6 @@ Status SceneSimulation::Init(const bake::Scene& scene, const CharacterAsset& ass
     if (Status s = garment->solver.Init(garment->cloth, garment_settings); !s.ok())
       return Status(s.code(), at + s.message());
     garment->state.Reset(garment->cloth);
-    garment->held.assign(garment->cloth.particle_count(), 0);
-    for (const uint32_t i : garment->cloth.kinematic_particles()) garment->held[i] = 1;
     if (garment->cloth.skinned()) {  // at its skinned positions
       if (Status s = garment->solver.Reset(&garment->state, {}, skin_start_); !s.ok())
         return Status(s.code(), at + s.message());
@@ -387,6 +385,7 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
   std::vector<ChunkFigures> chunks;
   for (const auto& g : garments_) {
     const ClothState& state = g->state;
+    const std::span<const float> inverse_masses = g->cloth.inverse_masses();
     const auto n = static_cast<int64_t>(state.positions.size());
     chunks.assign(static_cast<size_t>((n + kChunk - 1) / kChunk), ChunkFigures{});
     detail::ParallelRanges(n, kChunk, [&](int64_t begin, int64_t end) {
@@ -407,7 +406,7 @@ void SceneSimulation::Measure(const BodyMapCollider* body_map, FrameStats* stats
           if (q.inside_end) depth = std::max(depth, q.depth);
         }
         if (depth < 0.f) continue;
-        if (g->held[static_cast<size_t>(i)] != 0) {
+        if (inverse_masses[static_cast<size_t>(i)] == 0.f) {  // held: kinematic
           ++figures.held_inside;
           figures.held_deepest = std::max(figures.held_deepest, depth);
         } else {

@@ -127,7 +127,6 @@ class SceneSimulation {
     ClothSolver solver;
     ClothState state;
     std::vector<Float3> start_positions;
-    std::vector<uint8_t> held;  // per particle: 1 when kinematic (Cloth::kinematic_particles)
   };
 
   Status Pose(float time, std::vector<Mat34>* skinning);

@@ -41,11 +41,12 @@ int Orient2dExact(float ax, float ay, float bx, float by, float cx, float cy) {
   const double right = (double(ay) - cy) * (double(bx) - cx);
   const double det = left - right;
   double sum;
+  // The products' signs are exact (rounding keeps a sign and 0 is exact): opposite signs decide.
   if (left > 0.0) {
-    if (right <= 0.0) return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
+    if (right <= 0.0) return 1;
     sum = left + right;
   } else if (left < 0.0) {
-    if (right >= 0.0) return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
+    if (right >= 0.0) return -1;
     sum = -left - right;
   } else {  // left is exactly 0 (a difference is): the sign is right's, negated
     return right > 0.0 ? -1 : (right < 0.0 ? 1 : 0);
