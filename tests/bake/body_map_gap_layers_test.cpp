@@ -339,6 +339,35 @@ TEST(BodyMapBaker, GapsThinnerThanTheMinimumAreNotStored) {
   EXPECT_EQ(stats.dropped_gaps, 0u);
 }
 
+// A part of zero thickness (both sides of a square at one height, as the two sides of a part
+// seen edge-on meet on its silhouette) above or below a block: no body, so layer 0 ends at the
+// block and the air between them is no gap, as the run-time renderer draws it
+// (BodyMapRenderer.APartSeenEdgeOnDoesNotFillTheAir).
+TEST(BodyMapBaker, APartSeenEdgeOnDoesNotFillTheAir) {
+  for (const double sliver_z : {-0.3, 0.3}) {
+    SCOPED_TRACE(sliver_z);
+    Mesh mesh;
+    AddPortableBox(&mesh, -0.20, -0.20, -0.10, 0.20, 0.20, 0.00);
+    AddQuad(&mesh, -0.1, -0.1, 0.1, 0.1, sliver_z, true);
+    AddQuad(&mesh, -0.1, -0.1, 0.1, 0.1, sliver_z, false);
+    BodyMapOptions o = DenseGapOptions(160, 3);
+    o.epsilon = 0.f;
+    BodyMapPoseStats stats;
+    const BodyMapPose pose = BakeOrDie(mesh, o, &stats);
+    const uint32_t ci = pose.width / 2, cj = pose.height / 2;
+    ASSERT_TRUE(Inside(TexelCentre(pose, ci, cj), -0.1, -0.1, 0.1, 0.1));
+    const BodyMapTexel front = ReadBodyMapTexel(pose, 0, ci, cj);
+    const BodyMapTexel back = ReadBodyMapTexel(pose, 1, ci, cj);
+    ASSERT_TRUE(front.valid && back.valid);
+    EXPECT_NEAR(pose.front_z - front.depth, 0.0, 1e-6);
+    EXPECT_NEAR(pose.front_z - pose.depth_range + back.depth, -0.1, 1e-6);
+    EXPECT_NEAR(front.normal.z, 1.0, 1e-6);
+    EXPECT_NEAR(back.normal.z, -1.0, 1e-6);
+    EXPECT_FALSE(ReadBodyMapTexel(pose, 0, ci, cj, 1).valid);
+    EXPECT_EQ(stats.gap_texels, 0u);
+  }
+}
+
 TEST(BodyMapBaker, GapLayersLeaveTheSlabByteIdentical) {
   const Mesh scene = GapScene();
   // Hashes of layers = 1 bakes recorded before gap layers existed (the same meshes and options):

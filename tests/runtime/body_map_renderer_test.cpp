@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "body_map/body_map_collider_access.h"
@@ -346,6 +347,45 @@ TEST(BodyMapRenderer, AGapBelowPartsSunkIntoEachOther) {
                                 Translation(-1.f, 0.f, 0.f)};
   ASSERT_TRUE(renderer.Render(upside_down, &maps).ok());
   EXPECT_FALSE(maps.IsInside({0.f, 0.f, 0.23f}));
+}
+
+// A part seen edge-on at either end of the ray (a texel centre on the silhouette of an arm
+// swinging back): its two sides meet at one depth, thinner than any gap. It is no body: the slab
+// ends at the air next to it, instead of taking in the air between it and the rest of the body
+// (a whole texel column called inside, up to 0.75 m from the body on a walking human).
+TEST(BodyMapRenderer, APartSeenEdgeOnDoesNotFillTheAir) {
+  for (const float sliver_z : {-0.3f, 0.3f}) {
+    MeshData mesh = test::SkinnedSpheres(1, kRadius);
+    // A square of zero thickness (both sides, sharing the vertices, so the vertex normals cancel
+    // and the offset leaves it flat) over the sphere's central rays.
+    const uint32_t base = mesh.vertex_count();
+    for (const auto& [x, y] :
+         {std::pair{-0.05f, -0.05f}, {0.05f, -0.05f}, {0.05f, 0.05f}, {-0.05f, 0.05f}}) {
+      mesh.positions.push_back({x, y, sliver_z});
+      mesh.influence_joints.push_back(0);
+      mesh.influence_weights.push_back(1.f);
+      mesh.influence_offsets.push_back(mesh.influence_offsets.back() + 1);
+    }
+    for (const uint32_t v : {0u, 1u, 2u, 0u, 2u, 3u, 0u, 2u, 1u, 0u, 3u, 2u}) {
+      mesh.triangles.push_back(base + v);
+    }
+    BodyMapRenderer renderer;
+    ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+    BodyMapCollider maps;
+    const Mat34 rest[1] = {Mat34{}};
+    ASSERT_TRUE(renderer.Render(rest, &maps).ok());
+    for (const float x : {0.f, 0.02f, -0.045f}) {
+      EXPECT_TRUE(maps.IsInside({x, 0.01f, 0.f})) << sliver_z << ", " << x;
+      EXPECT_FALSE(maps.IsInside({x, 0.01f, sliver_z / 2.f})) << sliver_z << ", " << x;
+      EXPECT_FALSE(maps.IsInside({x, 0.01f, sliver_z * 0.9f})) << sliver_z << ", " << x;
+    }
+    // A motion from the air onto the sphere stops on the sphere's surface facing it.
+    const float side = sliver_z > 0.f ? 1.f : -1.f;
+    const ContactQuery q = maps.Query({0.f, 0.f, sliver_z / 2.f}, {0.f, 0.f, 0.f});
+    ASSERT_TRUE(q.contact) << sliver_z;
+    EXPECT_NEAR(q.point.z, side * (kRadius + kEpsilon), 2e-3f) << sliver_z;
+    EXPECT_GT(q.normal.z * side, 0.9f) << sliver_z;
+  }
 }
 
 TEST(BodyMapRenderer, LoadsMapsTheEngineRendered) {

@@ -193,6 +193,35 @@ size_t StoreTexelGaps(const MapRasterInput& input, std::span<const Fragment> sor
   return stored;
 }
 
+// A part thinner than kMinBodyMapGap at either end of the texel's ray (its centre on the
+// silhouette of a part seen edge-on, whose two sides meet at one depth) is no body: layer 0 ends
+// at the air next to it instead of taking that air in, and that air is no gap. The back first,
+// as the renderer (air between two such parts leaves the front one). `dst` is layer 0's entry.
+void TrimSlivers(const MapRasterInput& input, std::span<const Fragment> sorted, uint32_t raster_i,
+                 uint32_t raster_j, float max_valid_depth, size_t dst, BodyMapPose* pose,
+                 std::vector<GapCandidate>* gaps) {
+  float normal[3];
+  if (!gaps->empty()) {
+    const Fragment& upper = sorted[gaps->back().upper];
+    if (sorted.back().depth - sorted[gaps->back().upper + 1].depth <= kMinBodyMapGap) {
+      const double back_depth = FragmentDepth(input, 1, upper.triangle, raster_i, raster_j);
+      WriteDepth(pose, 1, dst, std::clamp(static_cast<float>(back_depth), 0.f, max_valid_depth));
+      FragmentNormal(input, upper.triangle, raster_i, raster_j, -1.0, normal);
+      WriteNormal(pose, 1, dst, {normal[0], normal[1], normal[2]});
+      gaps->pop_back();
+    }
+  }
+  if (!gaps->empty()) {
+    const Fragment& lower = sorted[gaps->front().upper + 1];
+    if (sorted[gaps->front().upper].depth - sorted.front().depth <= kMinBodyMapGap) {
+      WriteDepth(pose, 0, dst, std::clamp(static_cast<float>(lower.depth), 0.f, max_valid_depth));
+      FragmentNormal(input, lower.triangle, raster_i, raster_j, 1.0, normal);
+      WriteNormal(pose, 0, dst, {normal[0], normal[1], normal[2]});
+      gaps->erase(gaps->begin());
+    }
+  }
+}
+
 }  // namespace
 
 Status BakeGapLayers(const MapRasterInput& input, std::span<const uint8_t> valid, uint32_t crop_i0,
@@ -236,9 +265,11 @@ Status BakeGapLayers(const MapRasterInput& input, std::span<const uint8_t> valid
         counts.dropped_gaps += gaps.size();
         continue;
       }
+      const size_t dst = static_cast<size_t>(j) * pose->width + i;  // dense: also layer 0's entry
+      TrimSlivers(input, sorted, raster_i, raster_j, max_valid_depth, dst, pose, &gaps);
+      if (gaps.empty()) continue;
       counts.dropped_gaps += gaps.size() > max_gaps ? gaps.size() - max_gaps : 0;
       KeepThickest(&gaps, max_gaps);
-      const size_t dst = static_cast<size_t>(j) * pose->width + i;  // dense: also layer 0's entry
       NestingDepths depths[2];  // [0] documented decoder, [1] float decoder
       for (int decoder = 0; decoder < 2; ++decoder) {
         depths[decoder].top = DecodedDepth(*pose, 0, dst, decoder == 1);

@@ -162,7 +162,7 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   Rasterize(window, maps);
   SetUpShading(window);
   if (options_.air_gaps > 0) {
-    FindGaps(window, *maps);
+    FindGaps(window, maps);
     PublishGaps(window, maps);
   }
   ShadeNormals(window, maps);

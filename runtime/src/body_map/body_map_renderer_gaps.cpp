@@ -9,7 +9,10 @@
 // candidate itself when another part still encloses it (one more raster pass over the texels
 // still searching), and so on. Surfaces enter where the drawn (offset) triangle runs
 // counter-clockwise in the window, as in the bake. Where the ray does not balance the texel
-// keeps what it has, the conservative answer (docs/ALGORITHMS.md §7.9).
+// keeps what it has, the conservative answer (docs/ALGORITHMS.md §7.9). A part thinner than
+// kMinGap at either end of the ray (a texel centre on the silhouette of a part seen edge-on,
+// whose two sides meet at one depth) is no body: the slab ends at the air next to it instead of
+// taking that air in.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -40,7 +43,7 @@ constexpr uint8_t kCrowded = 1, kEnteredAbove = 2;
 // texel; each later one only at the texels still searching (searching_): those that found a gap
 // and may hold more, and those whose candidate was not one because another part encloses it (an
 // arm sunk into the torso leaves the body below its exit) and whose ray has deeper surfaces.
-void BodyMapRenderer::FindGaps(const Window& window, const BodyMapCollider& maps) {
+void BodyMapRenderer::FindGaps(const Window& window, BodyMapCollider* maps) {
   found_.clear();
   searching_.clear();
   const size_t texels = static_cast<size_t>(window.width) * window.height;
@@ -52,7 +55,7 @@ void BodyMapRenderer::FindGaps(const Window& window, const BodyMapCollider& maps
   for (uint32_t pass = 0; pass < max_passes; ++pass) {
     const bool first = pass == 0;
     if (!first) FindUpperBoundariesBelow(window);
-    RasterizeGapSurfaces(window, maps, first);
+    RasterizeGapSurfaces(window, *maps, first);
     CollectGaps(maps);
     if (searching_.empty()) break;
   }
@@ -129,7 +132,10 @@ void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCo
           return;
         }
         if (once) ++winding_total_[k];
-        if (z > upper) {
+        // A candidate within kMinGap of the slab's front: what enters as close below it is the
+        // other side of the same sliver, above the air rather than crowding it.
+        const bool sliver_front = upper >= maps.slabs_[k].top - kMinGap;
+        if (z > upper || (sliver_front && z > upper - kMinGap)) {
           if (once) {
             ++winding_above_[k];
             gap_flags_[k] |= kEnteredAbove;
@@ -147,23 +153,33 @@ void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCo
 // (searching_, ascending): below a gap while the texel holds fewer than air_gaps, or below a
 // candidate that was no gap because the body continues under it (the surfaces above it do not
 // balance, or one lies within kMinGap below it) while the whole ray balances. The others lose
-// their exit face (out of the next pass).
-void BodyMapRenderer::CollectGaps(const BodyMapCollider& maps) {
+// their exit face (out of the next pass). Air whose only body above or below is thinner than
+// kMinGap (a sliver at the slab's top or bottom) moves that end of the slab instead.
+void BodyMapRenderer::CollectGaps(BodyMapCollider* maps) {
   next_searching_.clear();
   for (const uint32_t k : searching_) {
-    const BodyMapCollider::Slab slab = maps.slabs_[k];
+    BodyMapCollider::Slab& slab = maps->slabs_[k];
     const float upper = exit_z_[k], lower = entry_z_[k];
     const bool candidate = exit_face_[k] != kNoFace && winding_total_[k] == 0;
     const bool enclosed = winding_above_[k] != 0 || (gap_flags_[k] & kCrowded) != 0;
-    const bool air = candidate && !enclosed && entry_face_[k] != kNoFace &&
-                     (gap_flags_[k] & kEnteredAbove) != 0 && upper < slab.top - kMinGap &&
-                     lower > slab.bottom + kMinGap && upper - lower > kMinGap;
+    const bool bounded = candidate && !enclosed && entry_face_[k] != kNoFace &&
+                         (gap_flags_[k] & kEnteredAbove) != 0 && upper - lower > kMinGap;
+    const bool body_above = upper < slab.top - kMinGap;
+    const bool body_below = lower > slab.bottom + kMinGap;
     bool search_on = false;
-    if (air) {
+    if (bounded && body_above && body_below) {
       found_.push_back(
           {static_cast<uint32_t>(k), gap_count_[k]++, upper, lower, exit_face_[k], entry_face_[k]});
       below_z_[k] = lower;
       search_on = gap_count_[k] < options_.air_gaps;
+    } else if (bounded && !body_below) {
+      slab.bottom = upper;  // below the air only a sliver: the slab's back is the air's top
+      bottom_face_[k] = exit_face_[k];
+    } else if (bounded) {
+      slab.top = lower;  // above the air only a sliver: the slab's front is the air's bottom
+      top_face_[k] = entry_face_[k];
+      below_z_[k] = lower;
+      search_on = true;
     } else if (candidate && enclosed) {
       below_z_[k] = upper;  // the next exit below this one may open the gap
       search_on = true;

@@ -144,10 +144,10 @@ class BodyMapRenderer {
   Status PlaceWindow(const RenderRegion& region, Window* window) const;
   void Rasterize(const Window& window, BodyMapCollider* maps);
   // The gap passes (body_map_renderer_gaps.cpp).
-  void FindGaps(const Window& window, const BodyMapCollider& maps);
+  void FindGaps(const Window& window, BodyMapCollider* maps);
   void FindUpperBoundariesBelow(const Window& window);
   void RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps, bool all);
-  void CollectGaps(const BodyMapCollider& maps);
+  void CollectGaps(BodyMapCollider* maps);
   void PublishGaps(const Window& window, BodyMapCollider* maps);
   void SetUpShading(const Window& window);
   void ShadeNormals(const Window& window, BodyMapCollider* maps) const;
