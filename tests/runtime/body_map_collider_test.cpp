@@ -235,6 +235,56 @@ TEST(BodyMapCollider, StartInsidePushesOutToTheNearerSurface) {
   EXPECT_FALSE(c.Query({0.f, 0.f, 0.f}, {0.f, 0.f, 0.2f}).contact);
 }
 
+// Beside a side of the body, a point inside (a particle the body moved onto near its silhouette)
+// is a fraction of a texel from the side and the body's half thickness from either surface along
+// z: it leaves through the side, to just outside the nearest outside texel, with the push's
+// direction as the normal; the batch gives the same answer. Farther than 4 texels from any side,
+// or less than a texel deep along z, it still goes along z.
+TEST(BodyMapCollider, StartInsideBesideASideLeavesThroughTheSide) {
+  const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
+  const Float3 beside{24.5f * kTexel, 0.3f * kTexel, 0.f};  // the side: x = 25 texels
+  const ContactQuery q = c.Query(beside, beside);
+  ASSERT_TRUE(q.contact);
+  EXPECT_EQ(q.flags, kCollisionStartedInside | kCollisionSideWall);
+  EXPECT_NEAR(q.point.x, 25.f * kTexel, kWallTolerance);
+  EXPECT_GE(q.point.x, 25.f * kTexel);
+  EXPECT_NEAR(q.point.y, beside.y, 1e-6f);
+  EXPECT_FLOAT_EQ(q.point.z, beside.z);
+  EXPECT_NEAR(q.depth, 0.5f * kTexel, kWallTolerance);
+  EXPECT_LT(AngleDegrees(q.normal, {1.f, 0.f, 0.f}), 0.01);
+  EXPECT_FALSE(c.IsInside(q.point));
+  // Near a corner: the nearer of the two sides (y = -12 texels here).
+  const Float3 corner{-23.2f * kTexel, -11.6f * kTexel, 0.01f};
+  const ContactQuery qc = c.Query(corner, corner);
+  ASSERT_TRUE(qc.contact);
+  EXPECT_LT(AngleDegrees(qc.normal, {0.f, -1.f, 0.f}), 0.01);
+  EXPECT_NEAR(qc.depth, 0.4f * kTexel, kWallTolerance);
+  EXPECT_FALSE(c.IsInside(qc.point));
+  // Too far from a side, or near the front surface: along z.
+  const Float3 middle{19.5f * kTexel, 0.f, -0.01f};
+  EXPECT_FLOAT_EQ(c.Query(middle, middle).point.z, kBoxBottom);
+  const Float3 near_top{24.5f * kTexel, 0.f, kBoxTop - 0.5f * kTexel};
+  const ContactQuery qt = c.Query(near_top, near_top);
+  EXPECT_EQ(qt.flags, kCollisionStartedInside);
+  EXPECT_FLOAT_EQ(qt.point.z, kBoxTop);
+  // The batch: Query and the response, bit for bit, in every lane pack.
+  for (const InstructionSet set : kEveryLanes) {
+    BodyMapCollider lanes = c;
+    if (!UseLanes(&lanes, set)) continue;
+    std::vector<Float3> previous(16, beside), positions(16, beside), velocities(16);
+    std::vector<uint8_t> flags(16);
+    ResponseParams params;
+    params.separation = 1e-3f;
+    ASSERT_TRUE(lanes.CollideBatch(previous, positions, velocities, flags, params).ok());
+    Float3 want = beside, want_velocity{};
+    ApplyResponse(q, params, &want, &want_velocity);
+    for (int k = 0; k < 16; ++k) {
+      ExpectSameBits(positions[k], want, LanesName(set), k);
+      EXPECT_EQ(flags[k], kCollisionContact | q.flags) << LanesName(set);
+    }
+  }
+}
+
 // A particle inside the shell that leaves the body through its far side crossed it (a resting
 // particle the solver left within epsilon of a limb, pushed through it): it goes back out along
 // z to the surface it started nearer to, through z or the side walls alike, the batch agreeing

@@ -87,6 +87,49 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
 // ---------------------------------------------------------------------------------------------
 // Queries
 
+// A point inside at its texel's interval, *depth metres from the nearer surface along z: when
+// that is more than a texel, the nearest point (stepped 1e-3 texel into it) of a texel within
+// kSideExitTexels whose column holds p.z outside, if nearer. Beside a silhouette, a point just
+// inside the shell is millimetres from the side and up to the body's thickness from either
+// surface along z; pushing it along z threw it across the body. The candidate is tested with
+// IsInsideView itself, so the exit tests outside whatever the sampling and the gaps.
+bool BodyMapCollider::NearerSideExit(Float3 p, float* depth, Float3* exit) const {
+  if (!(*depth > texel_size_)) return false;
+  const float u = (p.x - origin_x_) * inv_texel_size_, v = (p.y - origin_y_) * inv_texel_size_;
+  const int i = static_cast<int>(u), j = static_cast<int>(v);  // p is inside: on the grid
+  const int radius =
+      std::min(kSideExitTexels, static_cast<int>(std::ceil(*depth * inv_texel_size_)));
+  constexpr float kInset = 1e-3f;  // texels: the exit belongs to the outside texel
+  bool found = false;
+  for (int dj = -radius; dj <= radius; ++dj) {
+    for (int di = -radius; di <= radius; ++di) {
+      if (di == 0 && dj == 0) continue;
+      const float ci = static_cast<float>(i + di), cj = static_cast<float>(j + dj);
+      const float eu = std::clamp(u, ci + kInset, ci + 1.f - kInset);
+      const float ev = std::clamp(v, cj + kInset, cj + 1.f - kInset);
+      const float du = (eu - u) * texel_size_, dv = (ev - v) * texel_size_;
+      const float distance = std::sqrt(du * du + dv * dv);
+      if (!(distance < *depth)) continue;
+      const Float3 candidate{origin_x_ + eu * texel_size_, origin_y_ + ev * texel_size_, p.z};
+      if (IsInsideView(candidate)) continue;
+      *depth = distance;
+      *exit = candidate;
+      found = true;
+    }
+  }
+  return found;
+}
+
+// The push-out through a texel's side: to the exit NearerSideExit found, with the horizontal
+// direction of the push as the normal (the wall's; a silhouette's surface faces about that way).
+void BodyMapCollider::PlaceOnSideExit(Float3 p, Float3 exit, ContactQuery* result) const {
+  const float dx = exit.x - p.x, dy = exit.y - p.y;
+  const float length = std::sqrt(dx * dx + dy * dy);
+  result->point = exit;
+  result->normal = length > 0.f ? Float3{dx / length, dy / length, 0.f} : result->normal;
+  result->flags = static_cast<uint8_t>(result->flags | kCollisionSideWall);
+}
+
 bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& t,
                                        ContactQuery* result) const {
   const float u0 = t.u0, v0 = t.v0, u1 = t.u1, v1 = t.v1;
@@ -115,15 +158,22 @@ bool BodyMapCollider::QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& 
   const bool inside_start = z0 <= slab.top && z0 >= slab.bottom;
   const bool inside_end = z1 <= slab.top && z1 >= slab.bottom;
   result->inside_end = inside_end;
-  if (inside_end) result->depth = std::min(slab.top - z1, z1 - slab.bottom);
+  Float3 side_exit{};
+  bool through_side = false;
+  if (inside_end) {
+    result->depth = std::min(slab.top - z1, z1 - slab.bottom);
+    through_side = NearerSideExit(p1, &result->depth, &side_exit);
+  }
   if (inside_start) {
     if (!inside_end) return false;  // left: whether it crossed the body is the walk's (§7.4)
-    const bool back = z1 - slab.bottom < slab.top - z1;  // never left: pushed out along z
+    // Never left: pushed out to the nearest exit, along z or through a texel's side.
+    const bool back = z1 - slab.bottom < slab.top - z1;
     result->contact = true;
     result->t = 0.f;
     result->flags = kCollisionStartedInside;
     result->point = Float3{p1.x, p1.y, back ? slab.bottom : slab.top};
     result->normal = TexelNormal(static_cast<uint32_t>(i), static_cast<uint32_t>(j), back);
+    if (through_side) PlaceOnSideExit(p1, side_exit, result);
     return true;
   }
   // Outside at the start: an entry only where the end values say a surface is crossed.
@@ -320,17 +370,21 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
     return SampleNormal(ci, cj, u, v, slot == kBackSlot);
   };
 
-  // Penetration of p1 along z (the start-inside push-out uses the same numbers).
+  // Penetration of p1: to the nearer surface along z, or through a texel's side when that is
+  // nearer (the start-inside push-out uses the same numbers).
   Interval p1_interval{0.f, 0.f, kFrontSlot, kBackSlot};
   int p1_ci = 0, p1_cj = 0;
   const float p1_u = (p1.x - origin_x_) * inv_texel_size_;
   const float p1_v = (p1.y - origin_y_) * inv_texel_size_;
+  Float3 side_exit{};
+  bool through_side = false;
   if (result.inside_end) {
     const float cells = sampling_ == DepthSampling::kNearest ? 1.f : 2.f;
     p1_ci = static_cast<int>(p1_u * cells);
     p1_cj = static_cast<int>(p1_v * cells);
     p1_interval = interval_at(p1_ci, p1_cj, p1_u, p1_v, p1.z);
     result.depth = std::min(p1_interval.top - p1.z, p1.z - p1_interval.bottom);
+    through_side = NearerSideExit(p1, &result.depth, &side_exit);
   }
 
   if (walk.hit) {
@@ -364,7 +418,8 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
   }
   if (result.inside_end) {
     // Started inside and never left (or, defensively, any inside end the walk did not explain):
-    // push p1 out along z to the nearer surface of its interval.
+    // push p1 out to its nearest exit, along z to the nearer surface of its interval or through
+    // a texel's side.
     const bool back = p1.z - p1_interval.bottom < p1_interval.top - p1.z;
     result.contact = true;
     result.t = 0.f;
@@ -372,6 +427,7 @@ void BodyMapCollider::WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const {
     result.point = Float3{p1.x, p1.y, back ? p1_interval.bottom : p1_interval.top};
     result.normal =
         normal_at(p1_ci, p1_cj, p1_u, p1_v, back ? p1_interval.bottom_slot : p1_interval.top_slot);
+    if (through_side) PlaceOnSideExit(p1, side_exit, &result);
   } else if (start_inside) {
     // Started inside and left with no entry. Leaving the body, it left through the surface it
     // started nearer to, or was inside for about the depth it started at; crossing it from inside

@@ -69,9 +69,11 @@ class BodyMapCollider {
   // Continuous test of the motion p0 -> p1 (a point query is p0 == p1), no response. The first
   // entry wins: through the front or back surface, or a texel's side wall
   // (kCollisionSideWall); t is its parameter, point is on the surface or wall. A motion that
-  // starts inside and never leaves is pushed out along the view axis to the nearer surface
-  // (t = 0, kCollisionStartedInside). depth: p1's penetration along the view axis. Non-finite
-  // input: no contact, kCollisionInvalidInput.
+  // starts inside and never leaves is pushed out to its nearest exit (t = 0,
+  // kCollisionStartedInside): along the view axis to the nearer surface, or, when that is more
+  // than a texel away, through the side of a texel within 4 texels if nearer (also
+  // kCollisionSideWall; the normal is the push's direction). depth: p1's penetration, the
+  // distance to that exit. Non-finite input: no contact, kCollisionInvalidInput.
   ContactQuery Query(Float3 p0, Float3 p1) const;
 
   // Query and the response (collision_types.h) for every particle moving previous[i] ->
@@ -211,6 +213,11 @@ class BodyMapCollider {
   ContactQuery QueryWalk(Float3 p0, Float3 p1) const;               // Query without its quick paths
   void WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const;
   bool QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& t, ContactQuery* result) const;
+  // A point inside more than a texel deep along z: its exit through a texel's side within this
+  // many texels, when nearer (body_map_query.cpp).
+  static constexpr int kSideExitTexels = 4;
+  bool NearerSideExit(Float3 p, float* depth, Float3* exit) const;
+  void PlaceOnSideExit(Float3 p, Float3 exit, ContactQuery* result) const;
   bool IsInsideBilinear(Float3 p) const;
   void InsideRange(const Float3* points, uint8_t* inside, size_t count) const;  // kNearest
   uint8_t CollideOne(Float3 from, Float3* position, Float3* velocity,

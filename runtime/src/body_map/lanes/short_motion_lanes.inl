@@ -184,10 +184,15 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
       AndNot(end_in_gap, And(LessEq(p1.z, slab_b_top), GreaterEq(p1.z, slab_b_bottom)));
   const F push_out = AndNot(Or(hit_a, hit_b), inside_end);
   const F contact = Or(Or(hit_a, hit_b), push_out);
-  const uint32_t contact_lanes = LaneBits(contact) & lanes;
+  // A push-out more than a texel along z may leave through a texel's side instead: Query's
+  // (NearerSideExit); those lanes are not answered here.
+  const F deep = And(
+      push_out, Greater(StdMin(Sub(end_top, p1.z), Sub(p1.z, end_bottom)), P::Splat(texel_size_)));
+  const uint32_t deep_lanes = LaneBits(deep) & lanes;
+  const uint32_t contact_lanes = LaneBits(contact) & lanes & ~deep_lanes;
   // Started inside and left with no entry: Query decides whether it crossed the body (§7.4).
   const uint32_t left_lanes = LaneBits(AndNot(contact, start_inside)) & lanes;
-  lanes &= ~left_lanes;
+  lanes &= ~(left_lanes | deep_lanes);
   if (contact_lanes == 0) return lanes | free_lanes;  // points and motions in air
 
   // The contact point: on the segment at the entry, stepped back across a side wall by 1e-3

@@ -317,9 +317,14 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   const F inside_end = AndNot(
       end_in_gap, And(p1_in_box, And(LessEq(p1.z, slab_b_top), GreaterEq(p1.z, slab_b_bottom))));
   const F push_out = AndNot(hit, inside_end);
-  const uint32_t contact_lanes = LaneBits(Or(hit, push_out)) & lanes;
+  // A push-out more than a texel along z may leave through a texel's side instead: Query's
+  // (NearerSideExit); those lanes are not answered here.
+  const F deep = And(push_out, Greater(StdMin(Sub(slab_b_top, p1.z), Sub(p1.z, slab_b_bottom)),
+                                       P::Splat(texel_size_)));
+  const uint32_t deep_lanes = LaneBits(deep) & lanes;
+  const uint32_t contact_lanes = LaneBits(Or(hit, push_out)) & lanes & ~deep_lanes;
   // Started inside and left with no entry: Query decides whether it crossed the body (§7.4).
-  lanes &= ~(LaneBits(AndNot(Or(hit, push_out), start_inside)) & lanes);
+  lanes &= ~((LaneBits(AndNot(Or(hit, push_out), start_inside)) & lanes) | deep_lanes);
   if (contact_lanes == 0) {  // through air (most long motions in free space)
     for (int lane = 0; lane < kLanes; ++lane) {
       if ((lanes >> lane) & 1u) flags[index[lane]] = kCollisionNone;
