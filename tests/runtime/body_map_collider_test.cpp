@@ -285,6 +285,42 @@ TEST(BodyMapCollider, StartInsideBesideASideLeavesThroughTheSide) {
   }
 }
 
+// The distance to the silhouette that spares the points far from one the side-exit search: on
+// the sphere's maps (a round silhouette, the grid's edge beyond it) every texel's value is the
+// brute-force Chebyshev distance to the nearest background texel, capped.
+TEST(BodyMapCollider, SilhouetteReachIsTheDistanceToTheNearestBackgroundTexel) {
+  const BodyMapCollider c = BuildOrDie(MakePose(SphereGrid(), Sphere));
+  const int cap = BodyMapColliderAccess::kSideExitTexels + 1;
+  const int w = static_cast<int>(c.width()), h = static_cast<int>(c.height());
+  const auto background = [&](int i, int j) {
+    float top = 0.f, bottom = 0.f;
+    return i < 0 || j < 0 || i >= w || j >= h ||
+           !BodyMapColliderAccess::TexelSlab(c, uint32_t(i), uint32_t(j), &top, &bottom);
+  };
+  size_t near = 0, far = 0;
+  for (int j = 0; j < h; ++j) {
+    for (int i = 0; i < w; ++i) {
+      int want = cap;
+      for (int d = 0; d < cap && want == cap; ++d) {
+        for (int dj = -d; dj <= d && want == cap; ++dj) {
+          for (int di = -d; di <= d; ++di) {
+            if (std::max(std::abs(di), std::abs(dj)) == d && background(i + di, j + dj)) {
+              want = d;
+              break;
+            }
+          }
+        }
+      }
+      ASSERT_EQ(BodyMapColliderAccess::SilhouetteReach(c, uint32_t(i), uint32_t(j)), uint32_t(want))
+          << i << ", " << j;
+      near += want > 0 && want < cap;
+      far += want == cap;
+    }
+  }
+  EXPECT_GT(near, 100u);
+  EXPECT_GT(far, 1000u);
+}
+
 // A particle inside the shell that leaves the body through its far side crossed it (a resting
 // particle the solver left within epsilon of a limb, pushed through it): it goes back out along
 // z to the surface it started nearer to, through z or the side walls alike, the batch agreeing
@@ -615,9 +651,9 @@ TEST(BodyMapCollider, SilhouetteDisagreementIsBackgroundAndCounted) {
   EXPECT_FALSE(c.IsInside({0.5f * kTexel, 0.5f * kTexel, 0.f}));
   EXPECT_TRUE(c.IsInside({1.5f * kTexel, 0.5f * kTexel, 0.f}));
   EXPECT_EQ(c.stats().valid_texels, 50u * 24u - 1u);
-  // 16 bytes per texel plus small change.
-  EXPECT_GE(c.memory_bytes(), 64u * 40u * 16u);
-  EXPECT_LT(c.memory_bytes(), 64u * 40u * 16u + 2048u);
+  // 17 bytes per texel plus small change.
+  EXPECT_GE(c.memory_bytes(), 64u * 40u * 17u);
+  EXPECT_LT(c.memory_bytes(), 64u * 40u * 17u + 2048u);
 }
 
 TEST(BodyMapCollider, QuickPathsAnswerBitForBitAsTheWalk) {

@@ -64,6 +64,7 @@ void BodyMapCollider::Clear() {
   gap_word_first_.clear();
   gaps_.clear();
   gap_normals_.clear();
+  silhouette_reach_.clear();
 }
 
 void BodyMapCollider::PackGaps(std::vector<GapTexel>* texels) {
@@ -104,6 +105,49 @@ void BodyMapCollider::Finish() {
   FinishBounds();
   FinishBilinearBlocks();
   FinishMinMaxBlocks();
+  FinishSilhouetteReach();
+}
+
+// Per texel, the Chebyshev distance in texels to the nearest background texel (beyond the grid
+// counts as background), capped at kSideExitTexels + 1: a point inside whose texel lies farther
+// from every silhouette has no side exit to look for (NearerSideExit). The distances along each
+// row first, then down each column over them, in place (the rows above a texel already hold
+// their final values, so their row distances wait in a small ring); no allocation once the
+// grid's size was seen.
+void BodyMapCollider::FinishSilhouetteReach() {
+  const int64_t w = width_, h = height_;
+  constexpr int kCap = kSideExitTexels + 1;
+  silhouette_reach_.resize(static_cast<size_t>(w * h));
+  uint8_t* reach = silhouette_reach_.data();
+  for (int64_t j = 0; j < h; ++j) {
+    uint8_t* row = reach + j * w;
+    const Slab* slab = slabs_.data() + j * w;
+    int run = 0;  // texels since the last background one (the grid's edge is one)
+    for (int64_t i = 0; i < w; ++i) {
+      run = slab[i].top >= slab[i].bottom ? std::min(run + 1, kCap) : 0;
+      row[i] = static_cast<uint8_t>(run);
+    }
+    run = 0;
+    for (int64_t i = w - 1; i >= 0; --i) {
+      run = row[i] == 0 ? 0 : std::min(run + 1, kCap);
+      row[i] = static_cast<uint8_t>(std::min<int>(row[i], run));
+    }
+  }
+  for (int64_t i = 0; i < w; ++i) {
+    uint8_t above[kCap] = {};  // row distances of the rows j - 1 .. j - kCap + 1, by j % kCap
+    for (int64_t j = 0; j < h; ++j) {
+      const uint8_t own = reach[j * w + i];
+      int best = kCap;
+      for (int d = 0; d < kCap; ++d) {  // d rows away, above and below
+        const int64_t up = j - d, down = j + d;
+        const int along_up = up < 0 ? 0 : d == 0 ? own : above[up % kCap];
+        const int along_down = down >= h ? 0 : d == 0 ? own : reach[down * w + i];
+        best = std::min({best, std::max(d, along_up), std::max(d, along_down)});
+      }
+      above[j % kCap] = own;
+      reach[j * w + i] = static_cast<uint8_t>(best);
+    }
+  }
 }
 
 // Marks the texels with gaps in their slabs' tops (WithGapFlag: the lanes read the flag from the
@@ -239,7 +283,8 @@ size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
          (gap_texel_bits_.capacity() + gap_word_first_.capacity()) * sizeof(uint32_t) +
-         bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds);
+         bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds) +
+         silhouette_reach_.capacity();
 }
 
 Float3 BodyMapCollider::TexelNormal(uint32_t i, uint32_t j, bool back) const {

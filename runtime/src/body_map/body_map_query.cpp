@@ -99,11 +99,18 @@ bool BodyMapCollider::NearerSideExit(Float3 p, float* depth, Float3* exit) const
   const int i = static_cast<int>(u), j = static_cast<int>(v);  // p is inside: on the grid
   const int radius =
       std::min(kSideExitTexels, static_cast<int>(std::ceil(*depth * inv_texel_size_)));
+  // Far from every silhouette (most of a body's texels): no side to leave through.
+  if (silhouette_reach_[static_cast<size_t>(j) * width_ + static_cast<size_t>(i)] > radius) {
+    return false;
+  }
   constexpr float kInset = 1e-3f;  // texels: the exit belongs to the outside texel
   bool found = false;
-  for (int dj = -radius; dj <= radius; ++dj) {
-    for (int di = -radius; di <= radius; ++di) {
-      if (di == 0 && dj == 0) continue;
+  // Ring by ring outwards: ring r lies at least r - 1 texels away.
+  for (int r = 1; r <= radius && static_cast<float>(r - 1) * texel_size_ < *depth; ++r) {
+    for (int k = 0; k < 8 * r; ++k) {  // the ring's cells, once each
+      const int side = k / (2 * r), step = k % (2 * r);
+      const int di = side == 0 ? -r + step : side == 1 ? r : side == 2 ? r - step : -r;
+      const int dj = side == 0 ? -r : side == 1 ? -r + step : side == 2 ? r : r - step;
       const float ci = static_cast<float>(i + di), cj = static_cast<float>(j + dj);
       const float eu = std::clamp(u, ci + kInset, ci + 1.f - kInset);
       const float ev = std::clamp(v, cj + kInset, cj + 1.f - kInset);

@@ -52,9 +52,10 @@ struct BodyMapStats {
 };
 
 // One pose's collider. Immutable after Build; queries are const, allocation-free and thread-safe.
-// Memory per texel of the pose's rectangle: 16 bytes (slab and oct16 normals), + 1 with
-// kBilinear, + 8 bytes per 8x8 block; with gap layers, 2 bits per texel and 16 bytes per gap layer
-// of each texel that has a gap. memory_bytes() reports the exact figure.
+// Memory per texel of the pose's rectangle: 17 bytes (slab, oct16 normals and the distance to the
+// silhouette), + 1 with kBilinear, + 8 bytes per 8x8 block; with gap layers, 2
+// bits per texel and 16 bytes per gap layer of each texel that has a gap. memory_bytes() reports
+// the exact figure.
 class BodyMapCollider {
  public:
   // Validates the untrusted pose and decodes it (allocates). A row-span pose is expanded into its
@@ -273,6 +274,7 @@ class BodyMapCollider {
   void FinishBounds();
   void FinishBilinearBlocks();
   void FinishMinMaxBlocks();
+  void FinishSilhouetteReach();
   void CountGapsBeforeWords();  // gap_word_first_ from gap_texel_bits_
   void Clear();
 
@@ -294,6 +296,7 @@ class BodyMapCollider {
   std::vector<TexelNormals> normals_;      // width*height
   std::vector<uint8_t> bilinear_ok_;       // width*height (kBilinear only)
   std::vector<BlockBounds> blocks_;        // blocks_w_ * blocks_h_
+  std::vector<uint8_t> silhouette_reach_;  // width*height: texels to background, <= 5
   uint32_t gap_layers_ = 0;                // BodyMapPose::layers - 1
   std::vector<uint32_t> gap_texel_bits_;   // one bit per texel: has gaps
   std::vector<uint32_t> gap_word_first_;   // per word of it, the gap texels before it

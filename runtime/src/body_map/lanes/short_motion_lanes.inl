@@ -188,7 +188,12 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   // (NearerSideExit); those lanes are not answered here.
   const F deep = And(
       push_out, Greater(StdMin(Sub(end_top, p1.z), Sub(p1.z, end_bottom)), P::Splat(texel_size_)));
-  const uint32_t deep_lanes = LaneBits(deep) & lanes;
+  uint32_t deep_lanes = LaneBits(deep) & lanes;
+  for (int lane = 0; deep_lanes != 0 && lane < kLanes; ++lane) {  // far from a silhouette: none
+    if (((deep_lanes >> lane) & 1u) && silhouette_reach_[texel_b[lane]] > kSideExitTexels) {
+      deep_lanes &= ~(1u << lane);
+    }
+  }
   const uint32_t contact_lanes = LaneBits(contact) & lanes & ~deep_lanes;
   // Started inside and left with no entry: Query decides whether it crossed the body (§7.4).
   const uint32_t left_lanes = LaneBits(AndNot(contact, start_inside)) & lanes;

@@ -321,7 +321,13 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   // (NearerSideExit); those lanes are not answered here.
   const F deep = And(push_out, Greater(StdMin(Sub(slab_b_top, p1.z), Sub(p1.z, slab_b_bottom)),
                                        P::Splat(texel_size_)));
-  const uint32_t deep_lanes = LaneBits(deep) & lanes;
+  uint32_t deep_lanes = LaneBits(deep) & lanes;
+  for (int lane = 0; deep_lanes != 0 && lane < kLanes; ++lane) {  // far from a silhouette: none
+    if (((deep_lanes >> lane) & 1u) &&
+        silhouette_reach_[static_cast<size_t>(texel_b[lane])] > kSideExitTexels) {
+      deep_lanes &= ~(1u << lane);
+    }
+  }
   const uint32_t contact_lanes = LaneBits(Or(hit, push_out)) & lanes & ~deep_lanes;
   // Started inside and left with no entry: Query decides whether it crossed the body (§7.4).
   lanes &= ~((LaneBits(AndNot(Or(hit, push_out), start_inside)) & lanes) | deep_lanes);
