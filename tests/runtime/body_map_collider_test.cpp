@@ -238,8 +238,8 @@ TEST(BodyMapCollider, StartInsidePushesOutToTheNearerSurface) {
 // Beside a side of the body, a point inside (a particle the body moved onto near its silhouette)
 // is a fraction of a texel from the side and the body's half thickness from either surface along
 // z: it leaves through the side, to just outside the nearest outside texel, with the push's
-// direction as the normal; the batch gives the same answer. Farther than 4 texels from any side,
-// or less than a texel deep along z, it still goes along z.
+// direction as the normal; the batch gives the same answer. Farther than kSideExitTexels from any
+// side, or less than a texel deep along z, it still goes along z.
 TEST(BodyMapCollider, StartInsideBesideASideLeavesThroughTheSide) {
   const BodyMapCollider c = BuildOrDie(MakePose(BoxGrid(), Box));
   const Float3 beside{24.5f * kTexel, 0.3f * kTexel, 0.f};  // the side: x = 25 texels

@@ -72,7 +72,7 @@ class BodyMapCollider {
   // (kCollisionSideWall); t is its parameter, point is on the surface or wall. A motion that
   // starts inside and never leaves is pushed out to its nearest exit (t = 0,
   // kCollisionStartedInside): along the view axis to the nearer surface, or, when that is more
-  // than a texel away, through the side of a texel within 4 texels if nearer (also
+  // than a texel away, beside a silhouette through a neighbouring texel's side if nearer (also
   // kCollisionSideWall; the normal is the push's direction). depth: p1's penetration, the
   // distance to that exit. Non-finite input: no contact, kCollisionInvalidInput.
   ContactQuery Query(Float3 p0, Float3 p1) const;
@@ -215,8 +215,9 @@ class BodyMapCollider {
   void WalkInto(Float3 p0, Float3 p1, ContactQuery* out) const;
   bool QuerySingleTexel(Float3 p0, Float3 p1, const TexelCoords& t, ContactQuery* result) const;
   // A point inside more than a texel deep along z: its exit through a texel's side within this
-  // many texels, when nearer (body_map_query.cpp).
-  static constexpr int kSideExitTexels = 4;
+  // many texels, when nearer (body_map_query.cpp). 4 cost 3.5x the maps' time per particle on
+  // the mannequin's motion sets (docs/ALGORITHMS.md §7.4).
+  static constexpr int kSideExitTexels = 1;
   bool NearerSideExit(Float3 p, float* depth, Float3* exit) const;
   void PlaceOnSideExit(Float3 p, Float3 exit, ContactQuery* result) const;
   bool IsInsideBilinear(Float3 p) const;
