@@ -91,7 +91,7 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
 // that is more than a texel, the nearest point (stepped 1e-3 texel into it) of a texel within
 // kSideExitTexels whose column holds p.z outside, if nearer. Beside a silhouette, a point just
 // inside the shell is millimetres from the side and up to the body's thickness from either
-// surface along z; pushing it along z threw it across the body. The candidate is tested with
+// surface along z; a push along z moves it that far across the body. The candidate is tested with
 // IsInsideView itself, so the exit tests outside whatever the sampling and the gaps.
 bool BodyMapCollider::NearerSideExit(Float3 p, float* depth, Float3* exit) const {
   if (!(*depth > texel_size_)) return false;
