@@ -88,29 +88,26 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
 // Queries
 
 // A point inside at its texel's interval, *depth metres from the nearer surface along z: when
-// that is more than a texel, the nearest point (stepped 1e-3 texel into it) of a texel within
-// kSideExitTexels whose column holds p.z outside, if nearer. Beside a silhouette, a point just
-// inside the shell is millimetres from the side and up to the body's thickness from either
-// surface along z; a push along z moves it that far across the body. The candidate is tested with
-// IsInsideView itself, so the exit tests outside whatever the sampling and the gaps.
+// that is more than a texel and the texel touches the background (a silhouette), the nearest
+// point (stepped 1e-3 texel into it) of a neighbouring texel whose column holds p.z outside, if
+// nearer. Beside a silhouette, a point just inside the shell is millimetres from the side and up
+// to the body's thickness from either surface along z; a push along z moves it that far across
+// the body. The candidate is tested with IsInsideView itself, so the exit tests outside whatever
+// the sampling and the gaps.
 bool BodyMapCollider::NearerSideExit(Float3 p, float* depth, Float3* exit) const {
   if (!(*depth > texel_size_)) return false;
   const float u = (p.x - origin_x_) * inv_texel_size_, v = (p.y - origin_y_) * inv_texel_size_;
   const int i = static_cast<int>(u), j = static_cast<int>(v);  // p is inside: on the grid
-  const int radius =
-      std::min(kSideExitTexels, static_cast<int>(std::ceil(*depth * inv_texel_size_)));
-  // Far from every silhouette (most of a body's texels): no side to leave through.
-  if (silhouette_reach_[static_cast<size_t>(j) * width_ + static_cast<size_t>(i)] > radius) {
+  // Away from every silhouette (most of a body's texels): no side to leave through.
+  if (silhouette_reach_[static_cast<size_t>(j) * width_ + static_cast<size_t>(i)] >
+      kSideExitTexels) {
     return false;
   }
   constexpr float kInset = 1e-3f;  // texels: the exit belongs to the outside texel
   bool found = false;
-  // Ring by ring outwards: ring r lies at least r - 1 texels away.
-  for (int r = 1; r <= radius && static_cast<float>(r - 1) * texel_size_ < *depth; ++r) {
-    for (int k = 0; k < 8 * r; ++k) {  // the ring's cells, once each
-      const int side = k / (2 * r), step = k % (2 * r);
-      const int di = side == 0 ? -r + step : side == 1 ? r : side == 2 ? r - step : -r;
-      const int dj = side == 0 ? -r : side == 1 ? -r + step : side == 2 ? r : r - step;
+  for (int dj = -kSideExitTexels; dj <= kSideExitTexels; ++dj) {
+    for (int di = -kSideExitTexels; di <= kSideExitTexels; ++di) {
+      if (di == 0 && dj == 0) continue;
       const float ci = static_cast<float>(i + di), cj = static_cast<float>(j + dj);
       const float eu = std::clamp(u, ci + kInset, ci + 1.f - kInset);
       const float ev = std::clamp(v, cj + kInset, cj + 1.f - kInset);
