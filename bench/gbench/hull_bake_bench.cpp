@@ -1,6 +1,6 @@
 // Bake cost of the per-bone convex collider (bake/include/drape/bake/hull_builder.h).
 //  BM_HullBake/<points>/<simplify mode>/<triangle budget>: one limb-like bone (points on a
-//    tapered capsule, 25 cm x 3.5 cm, like a forearm), delta 5 mm, max_growth 20 mm (50 mm for
+//    tapered capsule, 25 cm x 3.5 cm, like a forearm), delta 5 mm, max_growth 5 mm (50 mm for
 //    the budget sweep so that the budget, not the bound, stops it). Counters: growth_mm (surface
 //    beyond the inflated hull), tris/planes after, H0 tris, budget_reached.
 //    Modes: 0 = edge collapse (default), 1 = plane removal, 2 = none.

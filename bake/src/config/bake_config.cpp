@@ -162,7 +162,8 @@ const JsonSchema<BakeConfig>& HullsSection() {
                               "simplification stops at or below this",
                               [](BakeConfig& c) -> uint32_t& { return c.hull.max_triangles; })
           .Float("max_growth", "m", Closed(0, 1),
-                 "no collider vertex ends farther than this beyond the inflated hull",
+                 "no collider vertex ends farther than this beyond the inflated hull (what "
+                 "simplification may add to a collider's bloat)",
                  [](BakeConfig& c) -> float& { return c.hull.max_growth; })
           .Float("max_bloat", "m", OpenBelow(0, 1),
                  "a warning names every hull and joint sphere whose surface reaches farther than "
@@ -171,9 +172,10 @@ const JsonSchema<BakeConfig>& HullsSection() {
                  [](BakeConfig& c) -> float& { return c.max_bloat; })
           .Unsigned<uint32_t>("max_pieces", "count", 1, 64,
                               "a bone's region is cut into at most this many convex pieces, each "
-                              "its own hull, while its hull bulges beyond max_bloat (a body with "
-                              "one region, e.g. no skeleton: 4 times this); 1: one hull per bone "
-                              "(paper B)",
+                              "its own hull, while its hull bulges beyond max_bloat: its separate "
+                              "parts of the mesh (an eye, a fang) first, then plane cuts (a body "
+                              "with one region, e.g. no skeleton: 4 times this); 1: one hull per "
+                              "bone (paper B)",
                               [](BakeConfig& c) -> uint32_t& { return c.hull_max_pieces; })
           .Enum<ObbMode>(
               "obb",

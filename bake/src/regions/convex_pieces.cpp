@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include "drape/bake/mesh_reference.h"
 #include "hull/convex_hull.h"
@@ -21,6 +23,7 @@ struct WorkPiece {
   std::vector<std::vector<Vec3>> polygons;
   std::vector<Vec3> loose;
   double bloat = 0.0;
+  Vec3 worst;  // where its hull bulges farthest out of the body (with bloat > 0)
   bool splittable = true;
 };
 
@@ -57,9 +60,10 @@ double HullVolume(const std::vector<Vec3>& points) {
 }
 
 // How far the hull's faces reach out of the body: at each face's centroid and three points
-// towards its corners (the corners are body vertices). Stops once beyond `stop_above` (the
-// caller has a better choice already).
-double Bloat(const Context& c, const std::vector<Vec3>& points, double stop_above = INFINITY) {
+// towards its corners (the corners are body vertices); *worst_at (may be null) gets the farthest
+// sample. Stops once beyond `stop_above` (the caller has a better choice already).
+double Bloat(const Context& c, const std::vector<Vec3>& points, double stop_above = INFINITY,
+             Vec3* worst_at = nullptr) {
   Mesh hull;
   if (!HullOf(points, &hull)) return 0.0;
   constexpr double kWeights[4][3] = {
@@ -71,7 +75,10 @@ double Bloat(const Context& c, const std::vector<Vec3>& points, double stop_abov
       const double q[3] = {p.x, p.y, p.z};
       // The distance first: only a sample farther than the worst so far needs the winding number.
       const double distance = c.body.Distance(q);
-      if (distance > worst && !c.body.Inside(q)) worst = distance;
+      if (distance > worst && !c.body.Inside(q)) {
+        worst = distance;
+        if (worst_at != nullptr) *worst_at = p;
+      }
       if (worst > stop_above) return worst;
     }
   }
@@ -119,9 +126,6 @@ std::array<Vec3, 3> PrincipalAxes(const std::vector<Vec3>& points) {
   return axes;
 }
 
-// Candidate cuts per axis: at q / kQuantiles of the piece's extent along it, 0 < q < kQuantiles.
-constexpr uint32_t kQuantiles = 8;
-
 // The parts of `polygon` below and above the plane dot(x, axis) = cut (Sutherland-Hodgman); a
 // part with fewer than three corners is left empty.
 void ClipPolygon(const std::vector<Vec3>& polygon, Vec3 axis, double cut, std::vector<Vec3>* below,
@@ -155,14 +159,18 @@ void Cut(const WorkPiece& piece, Vec3 axis, double cut, WorkPiece* below, WorkPi
   for (const Vec3& p : piece.loose) (Dot(p, axis) < cut ? below : above)->loose.push_back(p);
 }
 
-// How many of the candidate cuts that leave the least hull volume have their bloat measured.
+// How many of the cuts through the middle that leave the least hull volume have their bloat
+// measured.
 constexpr size_t kBloatCandidates = 3;
 
-// Cuts the piece in two: of the candidate planes (three principal and three frame axes, seven
-// evenly spaced positions each), the few that leave the least hull volume are measured, and the one
-// whose worse side bloats least wins (ties: less volume). A cut between two parts removes the air a
-// hull bridging them holds; the volume alone can prefer a cut that leaves the deep bridge on
-// one side. False when no candidate puts a solid on both sides. Sets both sides' bloat.
+// Cuts the piece in two. Candidate planes: across its three principal axes and the frame's three
+// axes, through the middle of its extent and through the point where its hull bulges farthest.
+// The three through the middle that leave the least hull volume and every one through the bulge
+// are measured, and the one whose worse side bloats least wins (ties: less volume). A cut between
+// two parts removes the air a hull bridging them holds; a plane through the bulge reaches a bridge
+// that planes at fixed positions miss (seven evenly spaced per axis, ranked by volume alone, left
+// the deep bridge on one side: measured in docs/ALGORITHMS.md §2.3). False when no candidate puts
+// a solid on both sides. Sets both sides' bloat.
 bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece* right) {
   const std::vector<Vec3> points = PiecePoints(piece);
   const std::array<Vec3, 3> principal = PrincipalAxes(points);
@@ -171,38 +179,41 @@ bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece*
   struct Candidate {
     double volume;
     WorkPiece below, above;
+    bool through_bulge;  // always measured
   };
   std::vector<Candidate> candidates;
+  const auto add = [&](Vec3 axis, double cut, bool through_bulge) {
+    Candidate candidate{0.0, {}, {}, through_bulge};
+    Cut(piece, axis, cut, &candidate.below, &candidate.above);
+    // Each side must stay a solid (a hull needs four points).
+    const std::vector<Vec3> pa = PiecePoints(candidate.below);
+    const std::vector<Vec3> pb = PiecePoints(candidate.above);
+    if (pa.size() < 4 || pb.size() < 4) return;
+    candidate.volume = HullVolume(pa) + HullVolume(pb);
+    candidates.push_back(std::move(candidate));
+  };
   for (const Vec3& axis : axes) {
-    // Evenly spaced over the piece's extent: quantiles of its elements would crowd where
-    // earlier cuts left many small fragments and slice slivers off there.
     double lo = INFINITY, hi = -INFINITY;
     for (const Vec3& p : points) {
       lo = std::min(lo, Dot(p, axis));
       hi = std::max(hi, Dot(p, axis));
     }
-    for (uint32_t q = 1; q < kQuantiles; ++q) {
-      const double cut = lo + (hi - lo) * q / kQuantiles;
-      Candidate candidate;
-      Cut(piece, axis, cut, &candidate.below, &candidate.above);
-      // Each side must stay a solid (a hull needs four points).
-      const std::vector<Vec3> pa = PiecePoints(candidate.below);
-      const std::vector<Vec3> pb = PiecePoints(candidate.above);
-      if (pa.size() < 4 || pb.size() < 4) continue;
-      candidate.volume = HullVolume(pa) + HullVolume(pb);
-      candidates.push_back(std::move(candidate));
-    }
+    add(axis, 0.5 * (lo + hi), false);
+    if (const double cut = Dot(piece.worst, axis); cut > lo && cut < hi) add(axis, cut, true);
   }
   if (candidates.empty()) return false;
   // Stable: equal volumes keep the axis and position order (deterministic).
   std::stable_sort(candidates.begin(), candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.volume < b.volume; });
   double best_bloat = INFINITY;
-  for (size_t i = 0; i < std::min(kBloatCandidates, candidates.size()); ++i) {
-    Candidate& candidate = candidates[i];
-    candidate.below.bloat = Bloat(c, PiecePoints(candidate.below), best_bloat);
+  size_t through_middle = 0;
+  for (Candidate& candidate : candidates) {
+    if (!candidate.through_bulge && through_middle++ >= kBloatCandidates) continue;
+    candidate.below.bloat =
+        Bloat(c, PiecePoints(candidate.below), best_bloat, &candidate.below.worst);
     if (candidate.below.bloat >= best_bloat) continue;
-    candidate.above.bloat = Bloat(c, PiecePoints(candidate.above), best_bloat);
+    candidate.above.bloat =
+        Bloat(c, PiecePoints(candidate.above), best_bloat, &candidate.above.worst);
     const double bloat = std::max(candidate.below.bloat, candidate.above.bloat);
     if (bloat < best_bloat) {
       best_bloat = bloat;
@@ -213,6 +224,308 @@ bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece*
   return true;
 }
 
+// ---- Connected parts ---------------------------------------------------------------------------
+
+struct Box {
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  void Add(Vec3 p) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  void Add(const Box& b) {
+    Add(b.lo);
+    Add(b.hi);
+  }
+  double Volume() const {
+    return std::max(hi.x - lo.x, 0.0) * std::max(hi.y - lo.y, 0.0) * std::max(hi.z - lo.z, 0.0);
+  }
+  double Distance(Vec3 p) const {  // 0 inside
+    const Vec3 d{std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+                 std::max({lo.z - p.z, 0.0, p.z - hi.z})};
+    return Norm(d);
+  }
+  double Gap(const Box& b) const {  // 0 when they overlap
+    const Vec3 d{std::max({lo.x - b.hi.x, 0.0, b.lo.x - hi.x}),
+                 std::max({lo.y - b.hi.y, 0.0, b.lo.y - hi.y}),
+                 std::max({lo.z - b.hi.z, 0.0, b.lo.z - hi.z})};
+    return Norm(d);
+  }
+};
+
+Box BoxOf(const WorkPiece& piece) {
+  Box box;
+  for (const Vec3& p : piece.loose) box.Add(p);
+  for (const std::vector<Vec3>& polygon : piece.polygons)
+    for (const Vec3& p : polygon) box.Add(p);
+  return box;
+}
+
+void Absorb(WorkPiece* into, WorkPiece&& from) {
+  for (std::vector<Vec3>& polygon : from.polygons) into->polygons.push_back(std::move(polygon));
+  into->loose.insert(into->loose.end(), from.loose.begin(), from.loose.end());
+}
+
+size_t NearestBox(const std::vector<Box>& boxes, Vec3 p, size_t skip) {
+  size_t best = boxes.size();
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (i != skip && (best == boxes.size() || boxes[i].Distance(p) < boxes[best].Distance(p))) {
+      best = i;
+    }
+  }
+  return best;
+}
+
+// The region's whole triangles grouped into the connected parts of the mesh they belong to
+// (triangles sharing a vertex; the mesh is welded by position): an eye, a fang, a plate of armour
+// modelled as a shell of its own is a piece before any cut, which no plane could cut out of the
+// part it sits in. Loose points (region vertices in no whole triangle, points inside the body) go
+// with the part of the body triangle nearest them, else the part whose box is nearest. A part too
+// small for a hull joins the part whose box is nearest. Parts in order of their first triangle.
+std::vector<WorkPiece> ConnectedParts(std::span<const Float3> rest_positions,
+                                      std::span<const uint32_t> triangles,
+                                      std::span<const uint32_t> vertices,
+                                      std::span<const Float3> interior, const MeshReference& body) {
+  std::vector<uint8_t> in_region(rest_positions.size(), 0), in_triangle(rest_positions.size(), 0);
+  for (uint32_t v : vertices) in_region[v] = 1;
+  std::vector<uint32_t> root(rest_positions.size());
+  for (uint32_t v = 0; v < root.size(); ++v) root[v] = v;
+  const auto find = [&](uint32_t v) {
+    while (root[v] != v) v = root[v] = root[root[v]];
+    return v;
+  };
+  std::vector<uint32_t> whole;  // first index of each region triangle
+  for (uint32_t t = 0; t + 2 < triangles.size(); t += 3) {
+    if (!in_region[triangles[t]] || !in_region[triangles[t + 1]] || !in_region[triangles[t + 2]])
+      continue;
+    whole.push_back(t);
+    for (uint32_t k = 0; k < 3; ++k) in_triangle[triangles[t + k]] = 1;
+    const uint32_t a = find(triangles[t]), b = find(triangles[t + 1]), d = find(triangles[t + 2]);
+    root[b] = a;
+    root[find(d)] = a;
+  }
+  std::vector<int32_t> part_of_root(rest_positions.size(), -1);
+  std::vector<int32_t> triangle_part(triangles.size() / 3, -1);
+  std::vector<WorkPiece> parts;
+  for (uint32_t t : whole) {
+    int32_t& part = part_of_root[find(triangles[t])];
+    if (part < 0) {
+      part = static_cast<int32_t>(parts.size());
+      parts.emplace_back();
+    }
+    triangle_part[t / 3] = part;
+    parts[static_cast<size_t>(part)].polygons.push_back({ToVec3(rest_positions[triangles[t]]),
+                                                         ToVec3(rest_positions[triangles[t + 1]]),
+                                                         ToVec3(rest_positions[triangles[t + 2]])});
+  }
+  std::vector<Vec3> loose;
+  for (uint32_t v : vertices) {
+    if (!in_triangle[v]) loose.push_back(ToVec3(rest_positions[v]));
+  }
+  for (const Float3& p : interior) loose.push_back(ToVec3(p));
+  detail::SortUnique(&loose);
+  if (parts.empty()) parts.emplace_back();
+  std::vector<Box> boxes;
+  for (const WorkPiece& part : parts) boxes.push_back(BoxOf(part));
+  for (const Vec3& p : loose) {
+    const double q[3] = {p.x, p.y, p.z};
+    uint32_t triangle = kNoTriangle;
+    body.ClosestPoint(q, nullptr, &triangle, nullptr);
+    const int32_t part = triangle < triangle_part.size() ? triangle_part[triangle] : -1;
+    const size_t to = part >= 0 ? static_cast<size_t>(part) : NearestBox(boxes, p, boxes.size());
+    parts[to].loose.push_back(p);
+  }
+  // A part too flat or small for a hull (a card of hair, a lone triangle) joins the solid part
+  // whose box is nearest; with no solid part, the region is one piece.
+  std::vector<WorkPiece> solids, flats;
+  std::vector<Box> solid_boxes, flat_boxes;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const std::vector<Vec3> points = PiecePoints(parts[i]);
+    const bool solid = points.size() >= 4 && HullVolume(points) > 0.0;
+    (solid ? solids : flats).push_back(std::move(parts[i]));
+    (solid ? solid_boxes : flat_boxes).push_back(boxes[i]);
+  }
+  if (solids.empty()) {
+    WorkPiece one;
+    for (WorkPiece& flat : flats) Absorb(&one, std::move(flat));
+    return {std::move(one)};
+  }
+  for (size_t i = 0; i < flats.size(); ++i) {
+    const Vec3 centre = (flat_boxes[i].lo + flat_boxes[i].hi) * 0.5;
+    Absorb(&solids[NearestBox(solid_boxes, centre, solid_boxes.size())], std::move(flats[i]));
+  }
+  return solids;
+}
+
+// More parts than the joining below can weigh pair by pair (a mesh of many small shells: chain
+// mail, scales) become kMaxParts groups of parts consecutive along the longest side of their
+// boxes, a cost linear in the parts.
+constexpr size_t kMaxParts = 64;
+
+void GroupAlongTheLongestSide(std::vector<WorkPiece>* parts) {
+  if (parts->size() <= kMaxParts) return;
+  Box all;
+  std::vector<Box> boxes;
+  for (const WorkPiece& part : *parts) {
+    boxes.push_back(BoxOf(part));
+    all.Add(boxes.back());
+  }
+  const Vec3 size = all.hi - all.lo;
+  const int axis = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
+  const auto centre = [&](size_t i) {
+    const Vec3 c = (boxes[i].lo + boxes[i].hi) * 0.5;
+    return axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
+  };
+  std::vector<size_t> order(parts->size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return centre(a) < centre(b); });
+  std::vector<WorkPiece> groups(kMaxParts);
+  for (size_t k = 0; k < order.size(); ++k)
+    Absorb(&groups[k * kMaxParts / order.size()], std::move((*parts)[order[k]]));
+  *parts = std::move(groups);
+}
+
+// The pieces of one region while they are joined and cut to fit the body within the budget.
+// Joining costs are cached by the pieces' ids (a piece that changes gets a new id).
+class PieceSet {
+ public:
+  // `parts`: with their bloat measured.
+  PieceSet(const Context& c, const ConvexPieceOptions& options, std::vector<WorkPiece> parts)
+      : c_(c), max_bloat_(options.max_bloat), budget_(std::max<uint32_t>(options.max_pieces, 1)) {
+    for (WorkPiece& part : parts) Add(std::move(part));
+  }
+
+  // The two pieces whose joint hull bloats least join (of those whose boxes lie within max_bloat
+  // of each other) while that hull fits the body (a tooth in its gum, an eye the head's hull
+  // holds) or the pieces are more than the budget; beyond the budget with no such pair, the two
+  // whose joint box grows least.
+  void JoinWhileTheyFit() {
+    for (;;) {
+      const bool over = pieces_.size() > budget_;
+      size_t a = 0, b = 0;
+      const double fits = std::nextafter(max_bloat_, INFINITY);
+      if (CheapestJoin(over ? INFINITY : fits, pieces_.size(), &a, &b) == INFINITY) {
+        if (!over) return;
+        LeastBoxGrowth(&a, &b);
+      }
+      Join(a, b);
+    }
+  }
+
+  // The piece that bloats most beyond max_bloat is cut in two (Split) while the budget allows;
+  // once it is spent, a cut is still made when two other pieces can join for it and both the
+  // join and the cut's sides bloat less than that piece (the worst piece only gets better).
+  void CutWhileTheyBloat() {
+    for (size_t round = 0; round < 4 * budget_; ++round) {
+      const size_t worst = Worst();
+      if (worst == pieces_.size()) return;
+      const double bloat = pieces_[worst].bloat;
+      size_t a = 0, b = 0;
+      const bool full = pieces_.size() >= budget_;
+      if (full && CheapestJoin(bloat, worst, &a, &b) >= bloat) return;
+      WorkPiece left, right;
+      if (!Split(c_, pieces_[worst], &left, &right) ||
+          (full && std::max(left.bloat, right.bloat) >= bloat)) {
+        pieces_[worst].splittable = false;
+        continue;
+      }
+      Replace(worst, std::move(left));
+      Add(std::move(right));
+      if (full) Join(a, b);
+    }
+  }
+
+  std::vector<WorkPiece> Take() { return std::move(pieces_); }
+
+ private:
+  void Add(WorkPiece piece) {
+    ids_.push_back(next_id_++);
+    boxes_.push_back(BoxOf(piece));
+    pieces_.push_back(std::move(piece));
+  }
+  void Replace(size_t i, WorkPiece piece) {
+    ids_[i] = next_id_++;
+    boxes_[i] = BoxOf(piece);
+    pieces_[i] = std::move(piece);
+  }
+  void Join(size_t a, size_t b) {
+    if (a > b) std::swap(a, b);
+    WorkPiece joined = pieces_[a];
+    Absorb(&joined, std::move(pieces_[b]));
+    joined.bloat = Bloat(c_, PiecePoints(joined), INFINITY, &joined.worst);
+    pieces_.erase(pieces_.begin() + static_cast<std::ptrdiff_t>(b));
+    ids_.erase(ids_.begin() + static_cast<std::ptrdiff_t>(b));
+    boxes_.erase(boxes_.begin() + static_cast<std::ptrdiff_t>(b));
+    Replace(a, std::move(joined));
+  }
+
+  // The splittable piece that bloats most beyond max_bloat, or pieces_.size().
+  size_t Worst() const {
+    size_t worst = pieces_.size();
+    for (size_t i = 0; i < pieces_.size(); ++i) {
+      const WorkPiece& piece = pieces_[i];
+      if (piece.splittable && piece.bloat > max_bloat_ &&
+          (worst == pieces_.size() || piece.bloat > pieces_[worst].bloat)) {
+        worst = i;
+      }
+    }
+    return worst;
+  }
+
+  // The least bloat of the joint hull of two pieces other than `skip` whose boxes lie within
+  // max_bloat of each other, if below `below` (else `below` or more); sets *a < *b.
+  double CheapestJoin(double below, size_t skip, size_t* a, size_t* b) {
+    double best = INFINITY;
+    for (size_t i = 0; i < pieces_.size(); ++i) {
+      for (size_t j = i + 1; j < pieces_.size(); ++j) {
+        if (i == skip || j == skip || boxes_[i].Gap(boxes_[j]) > max_bloat_) continue;
+        const double cost = JoinCost(i, j, std::min(best, below));
+        if (cost < best && cost < below) best = cost, *a = i, *b = j;
+      }
+    }
+    return best;
+  }
+
+  // The bloat of the joint hull of pieces i and j, or a bound beyond `above` when it is farther.
+  // Cached: a bound is reused while it is beyond what the caller asks about.
+  double JoinCost(size_t i, size_t j, double above) {
+    const std::pair<uint32_t, uint32_t> key{ids_[i], ids_[j]};
+    const auto found = join_cost_.find(key);
+    if (found != join_cost_.end() && (found->second.exact || found->second.bloat > above))
+      return found->second.bloat;
+    WorkPiece joined = pieces_[i];
+    Absorb(&joined, WorkPiece(pieces_[j]));
+    const double bloat = Bloat(c_, PiecePoints(joined), above);
+    join_cost_[key] = {bloat, bloat <= above};
+    return bloat;
+  }
+
+  void LeastBoxGrowth(size_t* a, size_t* b) const {
+    double best = INFINITY;
+    for (size_t i = 0; i < pieces_.size(); ++i) {
+      for (size_t j = i + 1; j < pieces_.size(); ++j) {
+        Box joint = boxes_[i];
+        joint.Add(boxes_[j]);
+        const double growth = joint.Volume() - boxes_[i].Volume() - boxes_[j].Volume();
+        if (growth < best) best = growth, *a = i, *b = j;
+      }
+    }
+  }
+
+  const Context& c_;
+  const double max_bloat_;
+  const size_t budget_;
+  std::vector<WorkPiece> pieces_;
+  std::vector<uint32_t> ids_;
+  std::vector<Box> boxes_;
+  uint32_t next_id_ = 0;
+  struct Cost {
+    double bloat;
+    bool exact;  // else a bound: the joint hull bloats at least this much
+  };
+  std::map<std::pair<uint32_t, uint32_t>, Cost> join_cost_;
+};
+
 }  // namespace
 
 std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_positions,
@@ -222,41 +535,26 @@ std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_posi
                                                const MeshReference& body,
                                                const ConvexPieceOptions& options) {
   const Context c{body};
-  // The region's whole triangles, and its vertices in none of them.
-  std::vector<uint8_t> in_region(rest_positions.size(), 0), in_triangle(rest_positions.size(), 0);
-  for (uint32_t v : vertices) in_region[v] = 1;
+  std::vector<WorkPiece> pieces =
+      ConnectedParts(rest_positions, triangles, vertices, interior, body);
+  // The region as one piece first: parts whose one hull fits stay one.
   WorkPiece whole;
-  for (uint32_t t = 0; t + 2 < triangles.size(); t += 3) {
-    if (in_region[triangles[t]] && in_region[triangles[t + 1]] && in_region[triangles[t + 2]]) {
-      whole.polygons.push_back({ToVec3(rest_positions[triangles[t]]),
-                                ToVec3(rest_positions[triangles[t + 1]]),
-                                ToVec3(rest_positions[triangles[t + 2]])});
-      for (uint32_t k = 0; k < 3; ++k) in_triangle[triangles[t + k]] = 1;
+  for (const WorkPiece& part : pieces) Absorb(&whole, WorkPiece(part));
+  whole.bloat = Bloat(c, PiecePoints(whole), INFINITY, &whole.worst);
+  if (whole.bloat <= options.max_bloat || options.max_pieces <= 1) {
+    pieces = {std::move(whole)};
+  } else {
+    if (pieces.size() == 1) {
+      pieces = {std::move(whole)};
+    } else {
+      GroupAlongTheLongestSide(&pieces);
+      for (WorkPiece& part : pieces)
+        part.bloat = Bloat(c, PiecePoints(part), INFINITY, &part.worst);
     }
-  }
-  for (uint32_t v : vertices) {
-    if (!in_triangle[v]) whole.loose.push_back(ToVec3(rest_positions[v]));
-  }
-  for (const Float3& p : interior) whole.loose.push_back(ToVec3(p));
-  detail::SortUnique(&whole.loose);
-  whole.bloat = Bloat(c, PiecePoints(whole));
-  std::vector<WorkPiece> pieces{std::move(whole)};
-  while (pieces.size() < std::max<uint32_t>(options.max_pieces, 1)) {
-    size_t worst = pieces.size();
-    for (size_t i = 0; i < pieces.size(); ++i) {
-      if (pieces[i].splittable && pieces[i].bloat > options.max_bloat &&
-          (worst == pieces.size() || pieces[i].bloat > pieces[worst].bloat)) {
-        worst = i;
-      }
-    }
-    if (worst == pieces.size()) break;
-    WorkPiece left, right;
-    if (!Split(c, pieces[worst], &left, &right)) {
-      pieces[worst].splittable = false;
-      continue;
-    }
-    pieces[worst] = std::move(left);
-    pieces.push_back(std::move(right));
+    PieceSet set(c, options, std::move(pieces));
+    set.JoinWhileTheyFit();
+    set.CutWhileTheyBloat();
+    pieces = set.Take();
   }
   std::vector<ConvexPiece> out;
   for (const WorkPiece& p : pieces) {

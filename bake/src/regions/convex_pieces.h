@@ -29,10 +29,12 @@ struct ConvexPiece {
 // triangles (those with all three corners in the region are clipped by the cuts, so the pieces'
 // hulls together hold every such triangle). `interior`: rest-pose points inside the body the
 // pieces' hulls hold too (along the bone), each going with the side of every cut it lies on.
-// `body`: the rest-pose body. The worst piece is cut in two while it bloats beyond max_bloat and
-// the budget allows: of the planes across its three principal axes and the frame's three axes at
-// seven evenly spaced positions, the three that leave the least hull volume are measured, and
-// the one whose worse side bloats least wins. Deterministic.
+// `body`: the rest-pose body. When the region's hull bloats beyond max_bloat: its connected parts
+// of the mesh (an eye, a fang, a plate: shells no plane cuts out of the part they sit on) are the
+// first pieces, those whose joint hull fits joining (and the nearest beyond the budget); then the
+// worst piece is cut in two by a plane while it bloats beyond max_bloat and the budget allows,
+// and once the budget is spent, a cut is still made when two other pieces can join for it with
+// less bloat. Deterministic.
 std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_positions,
                                                std::span<const uint32_t> triangles,
                                                std::span<const uint32_t> vertices,

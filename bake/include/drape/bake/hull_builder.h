@@ -38,7 +38,7 @@ struct HullOptions {
   InflationMode inflation = InflationMode::kMinkowskiIcosahedron;
   SimplifyMode simplify = SimplifyMode::kEdgeCollapse;
   uint32_t max_triangles = 100;  // stop simplifying at or below this many triangles, >= 4
-  float max_growth = 0.02f;      // metres, >= 0: no vertex may end farther than this beyond H0
+  float max_growth = 0.005f;     // metres, >= 0: no vertex may end farther than this beyond H0
   ObbMode obb = ObbMode::kCovariance;
   uint32_t obb_seed = 42;   // random seed of CGAL's OBB optimiser (kCgalOptimal)
   uint32_t min_points = 4;  // >= 1: fewer distinct input points -> skip with a reason
