@@ -288,7 +288,7 @@ TEST(BodyMapCollider, StartInsideBesideASideLeavesThroughTheSide) {
 // The distance to the silhouette that spares the points far from one the side-exit search: on
 // the sphere's maps (a round silhouette, the grid's edge beyond it) every texel's value is the
 // brute-force Chebyshev distance to the nearest background texel, capped.
-TEST(BodyMapCollider, SilhouetteReachIsTheDistanceToTheNearestBackgroundTexel) {
+TEST(BodyMapCollider, AirReachIsTheDistanceToTheNearestBackgroundTexel) {
   const BodyMapCollider c = BuildOrDie(MakePose(SphereGrid(), Sphere));
   const int cap = BodyMapColliderAccess::kSideExitTexels + 1;
   const int w = static_cast<int>(c.width()), h = static_cast<int>(c.height());
@@ -311,7 +311,7 @@ TEST(BodyMapCollider, SilhouetteReachIsTheDistanceToTheNearestBackgroundTexel) {
           }
         }
       }
-      ASSERT_EQ(BodyMapColliderAccess::SilhouetteReach(c, uint32_t(i), uint32_t(j)), uint32_t(want))
+      ASSERT_EQ(BodyMapColliderAccess::AirReach(c, uint32_t(i), uint32_t(j)), uint32_t(want))
           << i << ", " << j;
       near += want > 0 && want < cap;
       far += want == cap;

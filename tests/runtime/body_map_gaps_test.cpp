@@ -414,5 +414,44 @@ TEST(BodyMapGaps, SlabTopsCarryTheGapFlagWithinOneUlp) {
 // same texels, so the answers are the same bits. (Without 7497812, 190 of the sphere's 40 000
 // differ.)
 
+// Beside a gap that closes (the air between an arm and the torso, shut a texel further on by a
+// wall of body), a point inside the wall at the gap's height is a fraction of a texel from the
+// air and far from either surface along z: it leaves sideways into the gap, whatever its distance
+// to the silhouette; the batch gives the same answer in every lane pack.
+TEST(BodyMapGaps, StartInsideBesideAGapLeavesThroughIt) {
+  // The stack's block and plate, and a wall from the block's bottom to the plate's top beside
+  // the plate (the boxes stay disjoint: the block is cut around the wall).
+  constexpr ZBox kBlockLeft{-30 * kTexel, 20 * kTexel, -30 * kTexel, 30 * kTexel, -0.10f, 0.05f};
+  constexpr ZBox kBlockRight{22 * kTexel, 30 * kTexel, -30 * kTexel, 30 * kTexel, -0.10f, 0.05f};
+  constexpr ZBox kWall{20 * kTexel, 22 * kTexel, -20 * kTexel, 20 * kTexel, -0.10f, 0.12f};
+  const BodyMapCollider c = BuildOrDie(LayeredPose(3, {kBlockLeft, kBlockRight, kPlate, kWall}));
+  const Float3 in_wall{20.3f * kTexel, 0.5f * kTexel, 0.075f};  // 10 texels from the background
+  ASSERT_TRUE(c.IsInside(in_wall));
+  ASSERT_FALSE(c.IsInside({19.5f * kTexel, in_wall.y, in_wall.z})) << "the gap's air";
+  const ContactQuery q = c.Query(in_wall, in_wall);
+  ASSERT_TRUE(q.contact);
+  EXPECT_EQ(q.flags, kCollisionStartedInside | kCollisionSideWall);
+  EXPECT_NEAR(q.point.x, 20.f * kTexel, kWallTolerance);
+  EXPECT_LE(q.point.x, 20.f * kTexel);
+  EXPECT_NEAR(q.depth, 0.3f * kTexel, kWallTolerance);
+  EXPECT_LT(AngleDegrees(q.normal, {-1.f, 0.f, 0.f}), 0.01);
+  EXPECT_FALSE(c.IsInside(q.point));
+  for (const InstructionSet set : kEveryLanes) {
+    BodyMapCollider lanes = c;
+    if (!UseLanes(&lanes, set)) continue;
+    std::vector<Float3> previous(16, in_wall), positions(16, in_wall), velocities(16);
+    std::vector<uint8_t> flags(16);
+    ResponseParams params;
+    params.separation = 1e-3f;
+    ASSERT_TRUE(lanes.CollideBatch(previous, positions, velocities, flags, params).ok());
+    Float3 want = in_wall, want_velocity{};
+    ApplyResponse(q, params, &want, &want_velocity);
+    for (int k = 0; k < 16; ++k) {
+      ExpectSameBits(positions[k], want, LanesName(set), k);
+      EXPECT_EQ(flags[k], kCollisionContact | q.flags) << LanesName(set);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace drape

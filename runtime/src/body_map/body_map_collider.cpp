@@ -64,7 +64,7 @@ void BodyMapCollider::Clear() {
   gap_word_first_.clear();
   gaps_.clear();
   gap_normals_.clear();
-  silhouette_reach_.clear();
+  air_reach_.clear();
 }
 
 void BodyMapCollider::PackGaps(std::vector<GapTexel>* texels) {
@@ -105,26 +105,32 @@ void BodyMapCollider::Finish() {
   FinishBounds();
   FinishBilinearBlocks();
   FinishMinMaxBlocks();
-  FinishSilhouetteReach();
+  FinishAirReach();
 }
 
-// Per texel, the Chebyshev distance in texels to the nearest background texel (beyond the grid
-// counts as background), capped at kSideExitTexels + 1: a point inside whose texel lies farther
-// from every silhouette has no side exit to look for (NearerSideExit). The distances along each
+// Per texel, the Chebyshev distance in texels to the nearest texel with air inside the grid's
+// box: background (beyond the grid counts as background) or a texel with air gaps in its slab
+// (the narrow air between an arm and the torso, which closes a texel further on), capped at
+// kSideExitTexels + 1: a point inside whose texel lies farther from all air has no side exit to
+// look for (NearerSideExit). The distances along each
 // row first, then down each column over them, in place (the rows above a texel already hold
 // their final values, so their row distances wait in a small ring); no allocation once the
 // grid's size was seen.
-void BodyMapCollider::FinishSilhouetteReach() {
+void BodyMapCollider::FinishAirReach() {
   const int64_t w = width_, h = height_;
   constexpr int kCap = kSideExitTexels + 1;
-  silhouette_reach_.resize(static_cast<size_t>(w * h));
-  uint8_t* reach = silhouette_reach_.data();
+  air_reach_.resize(static_cast<size_t>(w * h));
+  uint8_t* reach = air_reach_.data();
+  const auto solid = [&](int64_t k) {  // valid, without gaps
+    return slabs_[static_cast<size_t>(k)].top >= slabs_[static_cast<size_t>(k)].bottom &&
+           (gap_layers_ == 0 ||
+            ((gap_texel_bits_[static_cast<size_t>(k) >> 5] >> (k & 31)) & 1u) == 0);
+  };
   for (int64_t j = 0; j < h; ++j) {
     uint8_t* row = reach + j * w;
-    const Slab* slab = slabs_.data() + j * w;
-    int run = 0;  // texels since the last background one (the grid's edge is one)
+    int run = 0;  // texels since the last one with air (the grid's edge is one)
     for (int64_t i = 0; i < w; ++i) {
-      run = slab[i].top >= slab[i].bottom ? std::min(run + 1, kCap) : 0;
+      run = solid(j * w + i) ? std::min(run + 1, kCap) : 0;
       row[i] = static_cast<uint8_t>(run);
     }
     run = 0;
@@ -283,8 +289,7 @@ size_t BodyMapCollider::memory_bytes() const {
   return sizeof(*this) + (slabs_.capacity() + gaps_.capacity()) * sizeof(Slab) +
          (normals_.capacity() + gap_normals_.capacity()) * sizeof(TexelNormals) +
          (gap_texel_bits_.capacity() + gap_word_first_.capacity()) * sizeof(uint32_t) +
-         bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds) +
-         silhouette_reach_.capacity();
+         bilinear_ok_.capacity() + blocks_.capacity() * sizeof(BlockBounds) + air_reach_.capacity();
 }
 
 Float3 BodyMapCollider::TexelNormal(uint32_t i, uint32_t j, bool back) const {

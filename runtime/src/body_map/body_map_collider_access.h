@@ -38,10 +38,10 @@ struct BodyMapColliderAccess {
     }
     return count;
   }
-  // Texels from (i, j) to the nearest background texel (Chebyshev; beyond the grid counts),
-  // capped at kSideExitTexels + 1.
-  static uint32_t SilhouetteReach(const BodyMapCollider& c, uint32_t i, uint32_t j) {
-    return c.silhouette_reach_[static_cast<size_t>(j) * c.width_ + i];
+  // Texels from (i, j) to the nearest texel with air: background (beyond the grid counts) or
+  // gaps in its slab (Chebyshev), capped at kSideExitTexels + 1.
+  static uint32_t AirReach(const BodyMapCollider& c, uint32_t i, uint32_t j) {
+    return c.air_reach_[static_cast<size_t>(j) * c.width_ + i];
   }
   static constexpr int kSideExitTexels = BodyMapCollider::kSideExitTexels;
   // Query without its quick paths: clip, walk, answer. Query gives the same bits.

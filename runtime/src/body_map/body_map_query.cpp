@@ -88,9 +88,10 @@ bool BodyMapCollider::IsInsideBilinear(Float3 p) const {
 // Queries
 
 // A point inside at its texel's interval, *depth metres from the nearer surface along z: when
-// that is more than a texel and the texel touches the background (a silhouette), the nearest
-// point (stepped 1e-3 texel into it) of a neighbouring texel whose column holds p.z outside, if
-// nearer. Beside a silhouette, a point just inside the shell is millimetres from the side and up
+// that is more than a texel and the texel touches air (a background texel: a silhouette; or a
+// texel with gaps: air between two parts that closes here), the nearest point (stepped 1e-3
+// texel into it) of a neighbouring texel whose column holds p.z outside, if nearer. Beside a
+// silhouette or a closing gap, a point just inside the shell is millimetres from the side and up
 // to the body's thickness from either surface along z; a push along z moves it that far across
 // the body. The candidate is tested with IsInsideView itself, so the exit tests outside whatever
 // the sampling and the gaps.
@@ -98,9 +99,8 @@ bool BodyMapCollider::NearerSideExit(Float3 p, float* depth, Float3* exit) const
   if (!(*depth > texel_size_)) return false;
   const float u = (p.x - origin_x_) * inv_texel_size_, v = (p.y - origin_y_) * inv_texel_size_;
   const int i = static_cast<int>(u), j = static_cast<int>(v);  // p is inside: on the grid
-  // Away from every silhouette (most of a body's texels): no side to leave through.
-  if (silhouette_reach_[static_cast<size_t>(j) * width_ + static_cast<size_t>(i)] >
-      kSideExitTexels) {
+  // Away from all air (most of a body's texels): no side to leave through.
+  if (air_reach_[static_cast<size_t>(j) * width_ + static_cast<size_t>(i)] > kSideExitTexels) {
     return false;
   }
   constexpr float kInset = 1e-3f;  // texels: the exit belongs to the outside texel

@@ -314,7 +314,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   // The collider's grid and everything Finish derives from it, for the largest window so far.
   maps->slabs_.reserve(reserved_texels_);
   maps->normals_.reserve(reserved_texels_);
-  maps->silhouette_reach_.reserve(reserved_texels_);
+  maps->air_reach_.reserve(reserved_texels_);
   maps->blocks_.reserve(reserved_texels_ / 64 + options_.max_side / 4 + 1);  // 8x8 blocks
   if (options_.sampling == DepthSampling::kBilinear) maps->bilinear_ok_.reserve(reserved_texels_);
   if (options_.air_gaps > 0) {

@@ -275,7 +275,7 @@ class BodyMapCollider {
   void FinishBounds();
   void FinishBilinearBlocks();
   void FinishMinMaxBlocks();
-  void FinishSilhouetteReach();
+  void FinishAirReach();
   void CountGapsBeforeWords();  // gap_word_first_ from gap_texel_bits_
   void Clear();
 
@@ -297,7 +297,7 @@ class BodyMapCollider {
   std::vector<TexelNormals> normals_;      // width*height
   std::vector<uint8_t> bilinear_ok_;       // width*height (kBilinear only)
   std::vector<BlockBounds> blocks_;        // blocks_w_ * blocks_h_
-  std::vector<uint8_t> silhouette_reach_;  // width*height: texels to background, <= 5
+  std::vector<uint8_t> air_reach_;         // width*height: texels to air (background or gaps), <= 2
   uint32_t gap_layers_ = 0;                // BodyMapPose::layers - 1
   std::vector<uint32_t> gap_texel_bits_;   // one bit per texel: has gaps
   std::vector<uint32_t> gap_word_first_;   // per word of it, the gap texels before it

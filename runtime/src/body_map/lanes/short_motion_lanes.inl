@@ -189,8 +189,8 @@ uint32_t BodyMapCollider::CollideShortLanes(const Float3* previous, Float3* posi
   const F deep = And(
       push_out, Greater(StdMin(Sub(end_top, p1.z), Sub(p1.z, end_bottom)), P::Splat(texel_size_)));
   uint32_t deep_lanes = LaneBits(deep) & lanes;
-  for (int lane = 0; deep_lanes != 0 && lane < kLanes; ++lane) {  // far from a silhouette: none
-    if (((deep_lanes >> lane) & 1u) && silhouette_reach_[texel_b[lane]] > kSideExitTexels) {
+  for (int lane = 0; deep_lanes != 0 && lane < kLanes; ++lane) {  // far from all air: none
+    if (((deep_lanes >> lane) & 1u) && air_reach_[texel_b[lane]] > kSideExitTexels) {
       deep_lanes &= ~(1u << lane);
     }
   }

@@ -322,9 +322,9 @@ uint32_t BodyMapCollider::CollideWalkLanes(const uint32_t* index, uint32_t lanes
   const F deep = And(push_out, Greater(StdMin(Sub(slab_b_top, p1.z), Sub(p1.z, slab_b_bottom)),
                                        P::Splat(texel_size_)));
   uint32_t deep_lanes = LaneBits(deep) & lanes;
-  for (int lane = 0; deep_lanes != 0 && lane < kLanes; ++lane) {  // far from a silhouette: none
+  for (int lane = 0; deep_lanes != 0 && lane < kLanes; ++lane) {  // far from all air: none
     if (((deep_lanes >> lane) & 1u) &&
-        silhouette_reach_[static_cast<size_t>(texel_b[lane])] > kSideExitTexels) {
+        air_reach_[static_cast<size_t>(texel_b[lane])] > kSideExitTexels) {
       deep_lanes &= ~(1u << lane);
     }
   }
