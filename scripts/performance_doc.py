@@ -339,7 +339,7 @@ def speed_vs_error(doc, rows, sections):
                     f"{ratio(fcl, h)} |")
         doc.source("speed against error")
 
-    proxy_targets(doc, read_proxy_rows(doc.out))
+    proxy_targets(doc, read_proxy_rows(doc.out), read_fits(doc.out))
     doc.add("### Charts", "",
             "x: ns per particle at one thread (log); y: p99 penetration after response and the "
             "missed rate; one marker per setting, the line is the Pareto front, dashed lines the "
@@ -417,16 +417,29 @@ def key_rows(rs):
     return sorted(tags.values(), key=lambda t: t[0]["ns_per_particle_1t"] or 0)
 
 
-def proxy_targets(doc, proxies):
+def read_fits(out):
+    """{character: row of fit.csv}: the default bake's bloat and coverage."""
+    path = os.path.join(out, "fit.csv")
+    if not os.path.exists(path):
+        return {}
+    with open(path, newline="", encoding="utf-8") as f:
+        return {r["character"]: r for r in csv.DictReader(f)}
+
+
+def proxy_targets(doc, proxies, fits):
     if not proxies:
         return
     doc.add("### Proxy colliders (hulls + joint colliders, defaults, rest pose)", "",
             "Targets: motions that start clear of the body (thin crossings, fast segments) missed "
             "≤ 0.5 %; penetration after the response p99 ≤ 5 mm, max ≤ 20 mm; ≤ 150 ns per "
-            "particle on people. Bold: not met. The bake report's `fit` gives each collider's "
-            "bloat and the body's coverage.", "",
-            "| character | colliders | missed % thin / fast | p99 / max mm thin + fast | ns 1t |",
-            "|---|---|---|---|---|")
+            "particle on people; the colliders' bloat (how far their surface reaches outside the "
+            "body beyond delta, from the bake report's `fit`) p99 ≤ 10 mm, max ≤ 30 mm, and "
+            "coverage ≥ 99 %. A person whose file makes them taller than a person is rescaled "
+            "to 1.75 m; the others are as their files give them (the Spider 5.9 m long). Bold: "
+            "not met.", "",
+            "| character | colliders | bloat p99 / max mm | coverage % | missed % thin / fast "
+            "| p99 / max mm thin + fast | ns 1t |",
+            "|---|---|---|---|---|---|---|")
     for c, sets in proxies.items():
         thin, fast, every = sets.get("thin_crossing"), sets.get("fast"), sets.get("all")
         if not (thin and fast and every):
@@ -437,7 +450,16 @@ def proxy_targets(doc, proxies):
         speed = float(every["ns_per_particle_1t"])
         bold = lambda text, bad: f"**{text}**" if bad else text  # noqa: E731
         counts = every["setting"].rsplit("(", 1)[-1].rstrip(")")
-        doc.add(f"| {c} | {counts} | "
+        fit = fits.get(c)
+        if fit:
+            bloat = [float(fit["bloat_p99_mm"]), float(fit["bloat_max_mm"])]
+            coverage = float(fit["coverage"]) * 100
+            too_far = bloat[0] > 10 or bloat[1] > 30
+            fit_cells = (f"{bold(f'{bloat[0]:.1f} / {bloat[1]:.1f}', too_far)}"
+                         f" | {bold(f'{coverage:.2f}', coverage < 99)}")
+        else:
+            fit_cells = "- | -"
+        doc.add(f"| {c} | {counts} | {fit_cells} | "
                 f"{bold(f'{missed[0]:.2f} / {missed[1]:.2f}', max(missed) > 0.5)} | "
                 f"{bold(f'{p99:.1f} / {worst:.1f}', p99 > 5 or worst > 20)} | "
                 f"{bold(ns(speed), every['human'] == '1' and speed > 150)} |")

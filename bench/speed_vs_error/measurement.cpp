@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -55,6 +56,14 @@ std::string PerBoneTable(const nlohmann::json& report) {
         "triangles | planes | growth mm | bloat p99 mm | bloat max mm | bytes |\n"
         "|---|---:|---:|---:|---:|---:|---:|\n";
   if (!report.contains("hulls") || !report["hulls"].contains("colliders")) return "";
+  if (const nlohmann::json& fit = report["fit"]; fit.is_object()) {
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "Every collider together: bloat p99 %.1f mm, max %.1f mm; coverage %.2f %%.\n\n",
+                  fit.value("bloat_p99_mm", 0.0), fit.value("bloat_max_mm", 0.0),
+                  100.0 * fit.value("coverage", 0.0));
+    md << line;
+  }
   for (const auto& c : report["hulls"]["colliders"]) {
     char line[256];
     std::snprintf(line, sizeof(line), "| %s | %d | %d | %.1f | %.1f | %.1f | %d |\n",
@@ -178,6 +187,10 @@ Measurement::HullAssets Measurement::MeasureRestHulls(const Context& context,
     }
     if (!is_default) continue;
     per_bone = PerBoneTable(result.report);
+    if (const nlohmann::json& fit = result.report["fit"]; fit.is_object()) {
+      fits_.push_back({spec.label, fit.value("bloat_p99_mm", 0.0), fit.value("bloat_max_mm", 0.0),
+                       fit.value("coverage", 0.0), a.hulls.size()});
+    }
     MeasureDefaultHullVariants(context, a, rest_skinning, bytes, hb.label, std::move(default_maps));
   }
   if (!per_bone.empty()) sections_.push_back({spec.label + ": hulls per bone", per_bone});
@@ -327,6 +340,16 @@ void Measurement::Finish() {
   const std::string dir = options_.out_dir;
   if (!WriteCsv(dir + "/speed_vs_error.csv", rows_))
     Fail(dir + "/speed_vs_error.csv: cannot write");
+  if (std::ofstream fit(dir + "/fit.csv"); fit) {
+    fit << "character,bloat_p99_mm,bloat_max_mm,coverage,hulls\n";
+    for (const Fit& f : fits_) {
+      fit << f.character << ',' << f.bloat_p99_mm << ',' << f.bloat_max_mm << ',' << f.coverage
+          << ',' << f.hulls << '\n';
+    }
+    if (!fit) Fail(dir + "/fit.csv: cannot write");
+  } else {
+    Fail(dir + "/fit.csv: cannot write");
+  }
   const std::vector<std::string> charts = WriteCharts(dir, rows_);
   std::ostringstream header;
   header << "# Speed against error\n\nWritten by `drape-speed-vs-error` ("

@@ -89,6 +89,13 @@ class Measurement {
   std::vector<std::string> set_violations_;
   std::vector<Section> sections_;
   std::vector<std::string> notes_;
+  // The default bake's fit per character at rest (the report's "fit"), written to fit.csv.
+  struct Fit {
+    std::string character;
+    double bloat_p99_mm, bloat_max_mm, coverage;
+    size_t hulls;
+  };
+  std::vector<Fit> fits_;
 };
 
 }  // namespace drape::bench
