@@ -56,14 +56,7 @@ std::string PerBoneTable(const nlohmann::json& report) {
         "triangles | planes | growth mm | bloat p99 mm | bloat max mm | bytes |\n"
         "|---|---:|---:|---:|---:|---:|---:|\n";
   if (!report.contains("hulls") || !report["hulls"].contains("colliders")) return "";
-  if (const nlohmann::json& fit = report["fit"]; fit.is_object()) {
-    char line[256];
-    std::snprintf(line, sizeof(line),
-                  "Every collider together: bloat p99 %.1f mm, max %.1f mm; coverage %.2f %%.\n\n",
-                  fit.value("bloat_p99_mm", 0.0), fit.value("bloat_max_mm", 0.0),
-                  100.0 * fit.value("coverage", 0.0));
-    md << line;
-  }
+
   for (const auto& c : report["hulls"]["colliders"]) {
     char line[256];
     std::snprintf(line, sizeof(line), "| %s | %d | %d | %.1f | %.1f | %.1f | %d |\n",
@@ -188,8 +181,15 @@ Measurement::HullAssets Measurement::MeasureRestHulls(const Context& context,
     if (!is_default) continue;
     per_bone = PerBoneTable(result.report);
     if (const nlohmann::json& fit = result.report["fit"]; fit.is_object()) {
-      fits_.push_back({spec.label, fit.value("bloat_p99_mm", 0.0), fit.value("bloat_max_mm", 0.0),
-                       fit.value("coverage", 0.0), a.hulls.size()});
+      const Fit f{spec.label, fit.value("bloat_p99_mm", 0.0), fit.value("bloat_max_mm", 0.0),
+                  fit.value("coverage", 0.0), a.hulls.size()};
+      char line[256];
+      std::snprintf(
+          line, sizeof(line),
+          "Every collider together: bloat p99 %.1f mm, max %.1f mm; coverage %.2f %%.\n\n",
+          f.bloat_p99_mm, f.bloat_max_mm, 100.0 * f.coverage);
+      per_bone = line + per_bone;
+      fits_.push_back(f);
     }
     MeasureDefaultHullVariants(context, a, rest_skinning, bytes, hb.label, std::move(default_maps));
   }

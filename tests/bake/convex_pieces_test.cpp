@@ -122,7 +122,7 @@ TEST(ConvexPieces, BeyondTheBudgetTheNearestPartsJoin) {
               (pieces[0].balls == right && pieces[1].balls == left));
 }
 
-TEST(ConvexPieces, ManySmallShellsStayWithinTheBudgetQuickly) {
+TEST(ConvexPieces, ManySmallShellsStayWithinTheBudget) {
   // 400 small shells over a metre (chain mail, scales): grouped along the longest side, then
   // joined within the budget (pair by pair, 400 parts would weigh 80 000 joins).
   Shells body;

@@ -268,21 +268,7 @@ TEST(BodyMapCollider, StartInsideBesideASideLeavesThroughTheSide) {
   EXPECT_EQ(qt.flags, kCollisionStartedInside);
   EXPECT_FLOAT_EQ(qt.point.z, kBoxTop);
   // The batch: Query and the response, bit for bit, in every lane pack.
-  for (const InstructionSet set : kEveryLanes) {
-    BodyMapCollider lanes = c;
-    if (!UseLanes(&lanes, set)) continue;
-    std::vector<Float3> previous(16, beside), positions(16, beside), velocities(16);
-    std::vector<uint8_t> flags(16);
-    ResponseParams params;
-    params.separation = 1e-3f;
-    ASSERT_TRUE(lanes.CollideBatch(previous, positions, velocities, flags, params).ok());
-    Float3 want = beside, want_velocity{};
-    ApplyResponse(q, params, &want, &want_velocity);
-    for (int k = 0; k < 16; ++k) {
-      ExpectSameBits(positions[k], want, LanesName(set), k);
-      EXPECT_EQ(flags[k], kCollisionContact | q.flags) << LanesName(set);
-    }
-  }
+  ExpectEveryLanePackAnswersAsQuery(c, beside);
 }
 
 // The distance to the silhouette that spares the points far from one the side-exit search: on

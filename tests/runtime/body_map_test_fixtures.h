@@ -358,6 +358,26 @@ inline OneByOne QueryOneByOne(const BodyMapCollider& c, const std::vector<Float3
   return want;
 }
 
+// A particle resting at `p` (16 of them, one lane pack's worth and more): CollideBatch in every
+// lane pack moves them as Query and ApplyResponse do, bit for bit, with the same flags.
+inline void ExpectEveryLanePackAnswersAsQuery(const BodyMapCollider& c, Float3 p) {
+  const std::vector<Float3> previous(16, p), velocities(16);
+  ResponseParams params;
+  params.separation = 1e-3f;
+  const OneByOne want = QueryOneByOne(c, previous, previous, velocities, params);
+  for (const InstructionSet set : kEveryLanes) {
+    BodyMapCollider lanes = c;
+    if (!UseLanes(&lanes, set)) continue;
+    std::vector<Float3> positions = previous, got_velocities = velocities;
+    std::vector<uint8_t> flags(16);
+    ASSERT_TRUE(lanes.CollideBatch(previous, positions, got_velocities, flags, params).ok());
+    for (int k = 0; k < 16; ++k) {
+      ExpectSameBits(positions[k], want.positions[k], LanesName(set), k);
+      EXPECT_EQ(flags[k], want.flags[k]) << LanesName(set);
+    }
+  }
+}
+
 // Every field of two answers, bit for bit (query k).
 inline void ExpectSameAnswer(const ContactQuery& a, const ContactQuery& b, int k) {
   EXPECT_EQ(a.inside_end, b.inside_end) << k;

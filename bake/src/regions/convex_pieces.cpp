@@ -541,16 +541,14 @@ std::vector<ConvexPiece> SplitIntoConvexPieces(std::span<const Float3> rest_posi
   WorkPiece whole;
   for (const WorkPiece& part : pieces) Absorb(&whole, WorkPiece(part));
   whole.bloat = Bloat(c, PiecePoints(whole), INFINITY, &whole.worst);
-  if (whole.bloat <= options.max_bloat || options.max_pieces <= 1) {
+  const bool fits = whole.bloat <= options.max_bloat || options.max_pieces <= 1;
+  if (fits || pieces.size() == 1) {
     pieces = {std::move(whole)};
   } else {
-    if (pieces.size() == 1) {
-      pieces = {std::move(whole)};
-    } else {
-      GroupAlongTheLongestSide(&pieces);
-      for (WorkPiece& part : pieces)
-        part.bloat = Bloat(c, PiecePoints(part), INFINITY, &part.worst);
-    }
+    GroupAlongTheLongestSide(&pieces);
+    for (WorkPiece& part : pieces) part.bloat = Bloat(c, PiecePoints(part), INFINITY, &part.worst);
+  }
+  if (!fits) {
     PieceSet set(c, options, std::move(pieces));
     set.JoinWhileTheyFit();
     set.CutWhileTheyBloat();

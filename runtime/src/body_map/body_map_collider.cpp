@@ -112,25 +112,22 @@ void BodyMapCollider::Finish() {
 // box: background (beyond the grid counts as background) or a texel with air gaps in its slab
 // (the narrow air between an arm and the torso, which closes a texel further on), capped at
 // kSideExitTexels + 1: a point inside whose texel lies farther from all air has no side exit to
-// look for (NearerSideExit). The distances along each
-// row first, then down each column over them, in place (the rows above a texel already hold
-// their final values, so their row distances wait in a small ring); no allocation once the
-// grid's size was seen.
+// look for (NearerSideExit). The distances along each row first, then down each column over
+// them, in place (the rows above a texel already hold their final values, so their row
+// distances wait in a small ring); no allocation once the grid's size was seen.
 void BodyMapCollider::FinishAirReach() {
   const int64_t w = width_, h = height_;
   constexpr int kCap = kSideExitTexels + 1;
   air_reach_.resize(static_cast<size_t>(w * h));
   uint8_t* reach = air_reach_.data();
-  const auto solid = [&](int64_t k) {  // valid, without gaps
-    return slabs_[static_cast<size_t>(k)].top >= slabs_[static_cast<size_t>(k)].bottom &&
-           (gap_layers_ == 0 ||
-            ((gap_texel_bits_[static_cast<size_t>(k) >> 5] >> (k & 31)) & 1u) == 0);
-  };
   for (int64_t j = 0; j < h; ++j) {
     uint8_t* row = reach + j * w;
+    const Slab* slab = slabs_.data() + j * w;
     int run = 0;  // texels since the last one with air (the grid's edge is one)
     for (int64_t i = 0; i < w; ++i) {
-      run = solid(j * w + i) ? std::min(run + 1, kCap) : 0;
+      const bool solid =
+          slab[i].top >= slab[i].bottom && !TexelHasGaps(static_cast<size_t>(j * w + i));
+      run = solid ? std::min(run + 1, kCap) : 0;
       row[i] = static_cast<uint8_t>(run);
     }
     run = 0;
@@ -167,10 +164,7 @@ void BodyMapCollider::FinishBounds() {
     for (size_t i = 0; i < w; ++i) {
       Slab& s = slabs_[j * w + i];
       if (!(s.top >= s.bottom)) continue;  // background: top -inf, no gaps, its low bit clear
-      if (gap_layers_ != 0) {
-        const size_t k = j * w + i;
-        s.top = WithGapFlag(s.top, (gap_texel_bits_[k >> 5] >> (k & 31u)) & 1u);
-      }
+      if (gap_layers_ != 0) s.top = WithGapFlag(s.top, TexelHasGaps(j * w + i) ? 1u : 0u);
       ++valid;
       i_lo = std::min(i_lo, i);
       i_hi = std::max(i_hi, i + 1);

@@ -163,6 +163,9 @@ class BodyMapCollider {
            gap_layers_;
   }
   int64_t GapBase(uint32_t i, uint32_t j) const { return GapBaseAt(j * width_ + i); }
+  bool TexelHasGaps(size_t texel) const {
+    return gap_layers_ != 0 && ((gap_texel_bits_[texel >> 5] >> (texel & 31u)) & 1u) != 0;
+  }
   bool InGap(int64_t base, float z) const {
     if (base < 0) return false;
     const Slab* g = gaps_.data() + base;

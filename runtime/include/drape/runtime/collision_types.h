@@ -57,7 +57,7 @@ enum CollisionFlags : uint8_t {
   kCollisionContact = 1 << 0,        // a contact was found and the response applied
   kCollisionStartedInside = 1 << 1,  // the segment started inside: pushed out, not swept
   kCollisionSideWall = 1 << 2,       // body maps: through a texel side wall (staircase), on entry
-                                     // or on a push-out beside a silhouette (with StartedInside)
+                                     // or on a push-out beside air (with StartedInside)
   kCollisionFallback = 1 << 3,       // hulls: the map-table ray missed; the push-out was used
   kCollisionInvalidInput = 1 << 7,   // a NaN or infinite position; the particle was left untouched
 };
