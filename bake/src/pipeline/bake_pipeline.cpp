@@ -162,40 +162,59 @@ std::vector<BoneHull> BuildBoneHulls(const BakeConfig& config, const std::vector
   return built;
 }
 
-// A hull's faces that lie inside the body (a convex piece's cuts from the bone's other pieces, a
-// bone's end buried in its neighbour): the runtime's push-out leaves through the nearest other
-// face. A face is inside when a point just off its centroid is inside the body and farther than
-// delta + 2 mm from its surface. Flagging buried ends too (not only cuts) left fewer particles
-// inside the body after a static push-out on CesiumMan and Fox, at rest and posed (uniform
-// set p99 60 -> 25 mm, 49 -> 17 mm posed on CesiumMan; no set worse). Faces of
-// one geometric plane (a cut's face can be stored as several planes a rounding apart) are judged
-// together, by their joint centroid: judged alone, the parts along the cut's rim stayed outer,
-// and the push-out, taking the first of the equal planes, left through the cut.
-void MarkInternalPlanes(const Mat34& collider_to_asset, const MeshReference& body, float delta,
-                        HullColliderData* hull) {
-  const size_t planes = hull->planes.size();
+// Whether `p` (collider frame) is inside `hull` with every plane at least `depth` metres away.
+bool DeeperThan(const HullColliderData& hull, Float3 p, float depth) {
+  return std::ranges::all_of(hull.planes, [&](const Plane& plane) {
+    return Dot(plane.normal, p) - plane.offset <= -depth;
+  });
+}
+
+// Per plane, the lowest index of the planes of its geometric plane (a face can be stored as
+// several planes a rounding apart). Union-find over the pairs within tolerance (closeness is not
+// transitive).
+std::vector<size_t> GroupEqualPlanes(std::span<const Plane> planes) {
   constexpr float kSameNormal = 0.99999f;  // cosine: 0.26 degrees
   constexpr float kSameOffset = 1e-4f;     // metres
-  // Union-find over the pairs within tolerance (closeness is not transitive); each group is
-  // named by its lowest plane index.
-  std::vector<size_t> group(planes);
-  for (size_t p = 0; p < planes; ++p) group[p] = p;
+  std::vector<size_t> group(planes.size());
+  for (size_t p = 0; p < planes.size(); ++p) group[p] = p;
   const auto root = [&](size_t p) {
     while (group[p] != p) p = group[p] = group[group[p]];
     return p;
   };
-  for (size_t p = 0; p < planes; ++p) {
+  for (size_t p = 0; p < planes.size(); ++p) {
     for (size_t q = 0; q < p; ++q) {
-      const Plane& a = hull->planes[p];
-      const Plane& b = hull->planes[q];
+      const Plane& a = planes[p];
+      const Plane& b = planes[q];
       if (Dot(a.normal, b.normal) > kSameNormal && std::fabs(a.offset - b.offset) < kSameOffset) {
         const size_t ra = root(p), rb = root(q);
         group[std::max(ra, rb)] = std::min(ra, rb);
       }
     }
   }
-  for (size_t p = 0; p < planes; ++p) group[p] = root(p);
-  std::vector<double> area(planes, 0.0);
+  for (size_t p = 0; p < planes.size(); ++p) group[p] = root(p);
+  return group;
+}
+
+// A hull's faces that lie inside the body (a convex piece's cuts from the bone's other pieces, a
+// bone's end buried in its neighbour): the runtime's push-out leaves through the nearest other
+// face. A face is inside when a point 2 mm off its centroid is inside the body and farther than
+// delta + 2 mm from its surface. Flagging buried ends too (not only cuts) left fewer particles
+// inside the body after a static push-out on CesiumMan and Fox, at rest and posed (uniform
+// set p99 60 -> 25 mm, 49 -> 17 mm posed on CesiumMan; no set worse). Faces of one geometric
+// plane are judged together, by their joint centroid: judged alone, the parts along the cut's
+// rim stayed outer, and the push-out, taking the first of the equal planes, left through the
+// cut. A face is inside too when its centroid's outside, or that of most of its area, is inside
+// another piece of the same bone (they move as one): the sliver faces the inflation leaves along a
+// cut's rim, nearly parallel to it, sit just outside the body but lead into the next piece, and a
+// particle pushed out through one was pushed straight back (Animated_Human's chin: a fast
+// particle left 68 mm inside the body).
+void MarkInternalPlanes(const Mat34& collider_to_asset, const MeshReference& body, float delta,
+                        std::span<const HullColliderData* const> same_bone,
+                        HullColliderData* hull) {
+  constexpr float kOff = 0.002f;  // metres off the face where its outside is judged
+  const size_t planes = hull->planes.size();
+  const std::vector<size_t> group = GroupEqualPlanes(hull->planes);
+  std::vector<double> area(planes, 0.0), area_into_sibling(planes, 0.0);
   std::vector<Float3> centroid(planes, Float3{0.f, 0.f, 0.f});
   for (size_t t = 0; t < hull->triangle_planes.size(); ++t) {
     const Float3 a = hull->vertices[hull->triangles[3 * t]];
@@ -203,17 +222,27 @@ void MarkInternalPlanes(const Mat34& collider_to_asset, const MeshReference& bod
     const Float3 c = hull->vertices[hull->triangles[3 * t + 2]];
     const float w = 0.5f * Length(Cross(b - a, c - a));
     const size_t g = group[hull->triangle_planes[t]];
+    const Float3 outside = (a + b + c) * (1.f / 3.f) + hull->planes[g].normal * kOff;
+    const bool into_sibling = std::ranges::any_of(same_bone, [&](const HullColliderData* other) {
+      return DeeperThan(*other, outside, kOff);
+    });
     area[g] += w;
+    area_into_sibling[g] += into_sibling ? w : 0.0;
     centroid[g] = centroid[g] + (a + b + c) * (w / 3.f);
   }
   hull->plane_internal.assign(planes, 0);
   for (size_t g = 0; g < planes; ++g) {
     if (group[g] != g || !(area[g] > 0.0)) continue;
     const Float3 local =
-        centroid[g] * static_cast<float>(1.0 / area[g]) + hull->planes[g].normal * 0.002f;
+        centroid[g] * static_cast<float>(1.0 / area[g]) + hull->planes[g].normal * kOff;
     const Float3 at = TransformPoint(collider_to_asset, local);
     const double q[3] = {at.x, at.y, at.z};
-    if (body.Distance(q) > delta + 0.002 && body.Inside(q)) hull->plane_internal[g] = 1;
+    const bool centroid_into_sibling = std::ranges::any_of(
+        same_bone,
+        [&](const HullColliderData* other) { return DeeperThan(*other, local, kOff / 2.f); });
+    const bool inside = centroid_into_sibling || 2.0 * area_into_sibling[g] > area[g] ||
+                        (body.Distance(q) > delta + kOff && body.Inside(q));
+    hull->plane_internal[g] = inside ? 1 : 0;
   }
   size_t internal = 0;
   for (size_t p = 0; p < planes; ++p) {
@@ -282,6 +311,21 @@ void ReportVertexFractions(const Regions& regions, json* report) {
   (*report)["hull_vertex_fraction"] = static_cast<double>(rigid + shaping) / vertices;
 }
 
+// Every hull's internal faces, judged against the body and the other pieces of its bone (all of
+// a bone's pieces share its collider frame).
+void MarkAllInternalPlanes(const Regions& regions, const MeshReference& body, float delta,
+                           std::vector<HullColliderData>* hulls) {
+  std::vector<const HullColliderData*> same_bone;
+  for (HullColliderData& hull : *hulls) {
+    same_bone.clear();
+    for (const HullColliderData& other : *hulls) {
+      if (&other != &hull && other.joint == hull.joint) same_bone.push_back(&other);
+    }
+    const uint32_t j = static_cast<uint32_t>(hull.joint);
+    MarkInternalPlanes(regions.collider_frames[j], body, delta, same_bone, &hull);
+  }
+}
+
 Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& character,
                  CharacterAsset* asset, json* report) {
   const SkeletonData& skeleton = character.skeleton;
@@ -314,7 +358,6 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
       continue;
     }
     hull.bind_frame = Multiply(rest_to_bind, regions.collider_frames[j]);
-    MarkInternalPlanes(regions.collider_frames[j], body, config.hull.delta, &hull);
     json entry = HullReport(bone, regions, j, built[i]);
     entry["piece"] = jobs[i].piece;
     entry["pieces"] = jobs[i].pieces;
@@ -324,6 +367,7 @@ Status BakeHulls(const BakeConfig& config, Regions& regions, const Character& ch
     colliders.push_back(std::move(entry));
     asset->hulls.push_back(std::move(hull));
   }
+  MarkAllInternalPlanes(regions, body, config.hull.delta, &asset->hulls);
   (*report)["colliders"] = colliders;
   (*report)["left_out"] = left_out;
   ReportVertexFractions(regions, report);
