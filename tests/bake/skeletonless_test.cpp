@@ -64,9 +64,9 @@ TEST_P(SkeletonRemoved, ConvexPiecesFitTheBody) {
   const Status s = bake::BakeCharacter(obj, config, &result);
   ASSERT_TRUE(s.ok()) << s.message();
   ASSERT_EQ(result.asset.skeleton.joint_count(), 1u) << "the copy has no skeleton";
-  // One region, cut: more than one hull, within the single-region budget (4 x max_pieces).
+  // One region, cut: more than one hull, within the budget of one bone.
   EXPECT_GT(result.asset.hulls.size(), 1u);
-  EXPECT_LE(result.asset.hulls.size(), 4u * config.hull_max_pieces);
+  EXPECT_LE(result.asset.hulls.size(), config.hull_max_pieces);
   // The capsules need bones: the whole body gets one, which the report measures.
   EXPECT_EQ(result.asset.capsules.size(), 1u);
   EXPECT_TRUE(result.report.contains("fit_capsules"));

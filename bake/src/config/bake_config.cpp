@@ -174,8 +174,7 @@ const JsonSchema<BakeConfig>& HullsSection() {
                               "a bone's region is cut into at most this many convex pieces, each "
                               "its own hull, while its hull bulges beyond max_bloat: its separate "
                               "parts of the mesh (an eye, a fang) first, then plane cuts (a body "
-                              "with one region, e.g. no skeleton: 4 times this); 1: one hull per "
-                              "bone (paper B)",
+                              "without a skeleton is one region); 1: one hull per bone (paper B)",
                               [](BakeConfig& c) -> uint32_t& { return c.hull_max_pieces; })
           .Enum<ObbMode>(
               "obb",

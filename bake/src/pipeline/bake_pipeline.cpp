@@ -53,11 +53,6 @@ size_t HullBytes(const HullColliderData& h) {
          h.map.cell_offsets.size() * 4 + h.map.cell_triangles.size() * 4;
 }
 
-// A character whose body is one region (no skeleton) may cut it into this many times
-// hulls.max_pieces: a standing human needs about 32 convex pieces to stay within 30 mm of its
-// skin (a skeleton-less CesiumMan: 104 mm at 8 pieces, 25 mm at 32).
-constexpr uint32_t kSingleRegionPieceFactor = 4;
-
 // One collider to build: a bone's region, or a convex piece of it (regions/convex_pieces.h).
 struct HullJob {
   uint32_t joint = 0;
@@ -91,14 +86,7 @@ std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
     ConvexPieceOptions options;
     options.max_bloat = config.max_bloat;
     options.max_pieces = config.hull_max_pieces;
-    // A body without a skeleton (or with one bone) is one region: the whole budget is its own.
-    uint32_t regions_with_points = 0;
-    for (uint32_t j = 0; j < joints; ++j) {
-      regions_with_points +=
-          !regions.rigid_vertices[j].empty() || !regions.shaping_vertices[j].empty();
-    }
-    if (regions_with_points == 1) options.max_pieces *= kSingleRegionPieceFactor;
-      // One bone per iteration, results in per-bone slots: identical at any thread count.
+    // One bone per iteration, results in per-bone slots: identical at any thread count.
 #pragma omp parallel for schedule(dynamic, 1)
     for (int64_t j = 0; j < static_cast<int64_t>(joints); ++j) {
       const std::vector<uint32_t> region = region_of(static_cast<size_t>(j));

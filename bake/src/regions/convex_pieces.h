@@ -16,7 +16,7 @@ class MeshReference;
 
 struct ConvexPieceOptions {
   double max_bloat = 0.015;  // metres: a piece whose hull bulges farther out of the body splits
-  uint32_t max_pieces = 8;   // per bone, >= 1
+  uint32_t max_pieces = 32;  // per bone, >= 1
 };
 
 struct ConvexPiece {

@@ -76,7 +76,9 @@ struct BakeConfig {
   float max_bloat = 0.015f;
   // >= 1: a bone's region whose convex hull bulges beyond max_bloat is cut into at most this many
   // convex pieces, each its own hull (regions/convex_pieces.h); 1: one hull per bone (paper B).
-  uint32_t hull_max_pieces = 8;
+  // Cuts stop once every piece fits max_bloat, so a person's bones use few of them; a 6 m
+  // creature's head of eyes and fangs needs about 30 to stay within 30 mm of the body.
+  uint32_t hull_max_pieces = 32;
   KirkpatrickOptions kirkpatrick;
   MapTableOptions map_table;
 
