@@ -48,6 +48,12 @@ class BakeEveryCharacter : public ::testing::TestWithParam<CharacterCase> {
   std::string Path() const {
     return *GetParam().path ? test::CharacterPath(GetParam().path) : test::MannequinPath();
   }
+  // The default bake without body maps: the colliders alone.
+  void BakeColliders(BakeResult* result) const {
+    BakeConfig config;
+    config.maps_enabled = false;
+    ASSERT_TRUE(BakeCharacter(Path(), config, result).ok());
+  }
 };
 
 // Every rigid vertex, and its delta-ball, is inside the hull of its bone; every hull is convex.
@@ -124,12 +130,9 @@ TEST_P(BakeEveryCharacter, HullsContainTheirRigidVerticesAndAreConvex) {
 // planes, leaves through the unflagged copy (static points inside CesiumMan were left up to
 // 75 mm deep at the body's midline).
 TEST_P(BakeEveryCharacter, PlanesOfOneFaceShareTheirInsideFlag) {
-  const std::string path = Path();
-  DRAPE_REQUIRE_FILE(path);
-  BakeConfig config;
-  config.maps_enabled = false;
+  DRAPE_REQUIRE_FILE(Path());
   BakeResult result;
-  ASSERT_TRUE(BakeCharacter(path, config, &result).ok());
+  ASSERT_NO_FATAL_FAILURE(BakeColliders(&result));
   size_t flagged = 0;
   for (const HullColliderData& hull : result.asset.hulls) {
     if (hull.plane_internal.empty()) continue;
@@ -155,12 +158,9 @@ TEST_P(BakeEveryCharacter, PlanesOfOneFaceShareTheirInsideFlag) {
 // chin: a fast particle left 68 mm inside the body). Faces of one geometric plane (stored as
 // several planes a rounding apart) are judged together.
 TEST_P(BakeEveryCharacter, NoOuterFaceLeadsIntoAnotherPieceOfItsBone) {
-  const std::string path = Path();
-  DRAPE_REQUIRE_FILE(path);
-  BakeConfig config;
-  config.maps_enabled = false;
+  DRAPE_REQUIRE_FILE(Path());
   BakeResult result;
-  ASSERT_TRUE(BakeCharacter(path, config, &result).ok());
+  ASSERT_NO_FATAL_FAILURE(BakeColliders(&result));
   const std::vector<HullColliderData>& hulls = result.asset.hulls;
   const auto deep_in = [](const HullColliderData& hull, Float3 p) {
     for (const Plane& plane : hull.planes) {
