@@ -191,11 +191,11 @@ std::vector<size_t> GroupEqualPlanes(std::span<const Plane> planes) {
 // set p99 60 -> 25 mm, 49 -> 17 mm posed on CesiumMan; no set worse). Faces of one geometric
 // plane are judged together, by their joint centroid: judged alone, the parts along the cut's
 // rim stayed outer, and the push-out, taking the first of the equal planes, left through the
-// cut. A face is inside too when its centroid's outside, or that of most of its area, is inside
-// another piece of the same bone (they move as one): the sliver faces the inflation leaves along a
-// cut's rim, nearly parallel to it, sit just outside the body but lead into the next piece, and a
-// particle pushed out through one was pushed straight back (Animated_Human's chin: a fast
-// particle left 68 mm inside the body).
+// cut. A face is inside too when the point 2 mm off its centroid is 1 mm deep in another piece of
+// the same bone, or those off most of its area are 2 mm deep (the pieces move as one): the sliver
+// faces the inflation leaves along a cut's rim, nearly parallel to it, sit just outside the body
+// but lead into the next piece, and a particle pushed out through one was pushed straight back
+// (Animated_Human's chin: a fast particle left 68 mm inside the body).
 void MarkInternalPlanes(const Mat34& collider_to_asset, const MeshReference& body, float delta,
                         std::span<const HullColliderData* const> same_bone,
                         HullColliderData* hull) {
