@@ -168,7 +168,7 @@ TEST_P(BakeEveryCharacter, NoOuterFaceLeadsIntoAnotherPieceOfItsBone) {
     }
     return true;
   };
-  size_t faces_between_pieces = 0;
+  size_t faces_checked = 0;
   for (const HullColliderData& hull : hulls) {
     const size_t planes = hull.planes.size();
     // The lowest plane of each plane's geometric plane: planes within tolerance of each other,
@@ -207,17 +207,17 @@ TEST_P(BakeEveryCharacter, NoOuterFaceLeadsIntoAnotherPieceOfItsBone) {
     }
     for (size_t p = 0; p < planes; ++p) {
       if (face[p] != p || !(into_sibling[p] > 0.6 * area[p])) continue;
-      ++faces_between_pieces;
       // A piece whose every face leads inward (buried in its siblings and the body) keeps none
       // flagged: the push-out needs a face to leave through.
       if (hull.plane_internal.empty()) continue;
+      ++faces_checked;
       EXPECT_EQ(hull.plane_internal[p], 1)
           << result.asset.skeleton.joint_names[hull.joint] << " plane " << p << ": "
           << 100.0 * into_sibling[p] / area[p] << " % of it leads into another piece of the bone";
     }
   }
   if (!*GetParam().path) {
-    EXPECT_GT(faces_between_pieces, 0u) << "the mannequin's torso is cut: the test tests nothing";
+    EXPECT_GT(faces_checked, 0u) << "the mannequin's torso is cut: the test tests nothing";
   }
 }
 
