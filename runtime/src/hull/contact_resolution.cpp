@@ -228,6 +228,70 @@ uint32_t HullColliderSet::ParticleContacts(Float3 p0, Float3 p1, float s0, float
   return count;
 }
 
+// The response bound of one ResolveParticle call. Per collider hit, in its frame: an entry
+// response leaves the particle within its motion relative to the collider (the chord) of where p0
+// sits on the collider at the end of the substep, which the collider carried away from p0 (a bone
+// turning into a particle at rest pushes it as far as its surface travels). Responses to several
+// moving colliders compose: their carries add up. Most responses stay within the floor, the
+// world chord plus the depths, which needs no transform: the whole bound is computed the first
+// time a response reaches beyond it (the same decisions, bit for bit: the floor's sum has fewer,
+// smaller non-negative terms, and rounding is monotonic).
+class HullColliderSet::ResponseBound {
+ public:
+  // From the first pass's contacts. `keep_frames`: the hits' frames outlive the pass (the
+  // selected substep's); otherwise the bound is computed now.
+  void Set(Float3 p0, Float3 p1, const ContactFrames& c, float separation, bool keep_frames) {
+    p0_ = p0;
+    p1_ = p1;
+    separation_ = separation;
+    depth_ = 0.0;
+    hits_ = c.hits;
+    const ContactQuery* contacts = c.contacts();
+    for (uint32_t h = 0; h < c.hits; ++h) {
+      frames_[h] = c.frames[c.order[h]];
+      depth_ += contacts[c.order[h]].depth;
+    }
+    const double floor = std::sqrt(DistanceSquared(p0, p1)) + kUnionDepthFactor * depth_ +
+                         static_cast<double>(separation);
+    floor_squared_ = floor * floor;
+    full_squared_ = -1.0;
+    if (!keep_frames) Full();
+  }
+  // Whether x lies farther from p0 than the bound.
+  bool Exceeded(Float3 x) {
+    const double d2 = DistanceSquared(x, p0_);
+    return d2 > floor_squared_ && d2 > Full();
+  }
+  double Distance() { return std::sqrt(Full()); }
+
+ private:
+  double Full() {
+    if (full_squared_ >= 0.0) return full_squared_;
+    double chord = std::sqrt(DistanceSquared(p0_, p1_)), carry = 0.0;
+    for (uint32_t h = 0; h < hits_; ++h) {
+      const Float3 a = TransformPoint(frames_[h]->to_local_start, p0_);
+      const Float3 b = TransformPoint(frames_[h]->to_local_end, p1_);
+      const Float3 carried = TransformPoint(frames_[h]->to_world_end, a);
+      chord = std::max(chord, std::sqrt(DistanceSquared(a, b)));
+      carry += std::sqrt(DistanceSquared(carried, p0_));
+    }
+    // Rounding of the float response: relative to the coordinates' size.
+    const double scale = std::max(
+        {std::fabs(double(p1_.x)), std::fabs(double(p1_.y)), std::fabs(double(p1_.z)), 1.0});
+    const double bound = chord + carry + kUnionDepthFactor * depth_ +
+                         static_cast<double>(separation_) + 1e-6 * scale;
+    full_squared_ = bound * bound;
+    return full_squared_;
+  }
+
+  Float3 p0_, p1_;
+  float separation_ = 0.f;
+  double depth_ = 0.0;                                // metres, the hits' depths summed
+  double floor_squared_ = 0.0, full_squared_ = -1.0;  // -1: not computed yet
+  uint32_t hits_ = 0;
+  const ActiveFrames* frames_[kMaxCandidates];
+};
+
 template <bool kActive>
 void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, uint8_t* flags,
                                       const ResponseParams& params, float s0, float s1,
@@ -243,7 +307,7 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
   // depth; inside overlapping colliders the nearest exit of their union can be deeper than any
   // one of them (HullColliderSet::kUnionDepthFactor). A response beyond it (contact planes of two
   // colliders meeting far from the body) is undone.
-  double budget_squared = 0.0;
+  ResponseBound bound;
   // The best iterate so far (Gauss-Seidel passes can make a pinched particle worse).
   Float3 best_position = position, best_velocity = vel;
   IterateScore best_score{UINT32_MAX, INFINITY};  // worse than any iterate
@@ -281,7 +345,7 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
     }
     const ContactQuery* contacts = pass_contacts.contacts();
     uint32_t* order = pass_contacts.order;
-    if (pass == 0) budget_squared = Budget(p0, position, pass_contacts, params.separation);
+    if (pass == 0) bound.Set(p0, position, pass_contacts, params.separation, kActive);
     // Deepest first; ties keep collider order (insertion sort is stable).
     for (uint32_t i = 1; i < hits; ++i) {
       const uint32_t key = order[i];
@@ -308,8 +372,8 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
       if (planes.count() > 1) planes.Enforce(&position);
       // Beyond the budget: this response alone (the contact planes meet too far away), else
       // none (the passes go on from the last iterate within it).
-      if (DistanceSquared(position, p0) > budget_squared) position = responded;
-      if (DistanceSquared(position, p0) > budget_squared) {
+      if (bound.Exceeded(position)) position = responded;
+      if (bound.Exceeded(position)) {
         position = before_position;
         vel = before_velocity;
         planes = before_planes;
@@ -334,8 +398,7 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
       for (uint32_t h = 0; h < pass_contacts.hits; ++h)
         started_inside |= (contacts[pass_contacts.order[h]].flags & kCollisionStartedInside) != 0;
       ContactQuery exit;
-      if (started_inside &&
-          NearestUnionExit(p0, *p1, pass_contacts, std::sqrt(budget_squared), &exit)) {
+      if (started_inside && NearestUnionExit(p0, *p1, pass_contacts, bound.Distance(), &exit)) {
         position = *p1;
         vel = *velocity;
         ApplyResponse(exit, params, &position, &vel);
@@ -345,30 +408,6 @@ void HullColliderSet::ResolveParticle(Float3 p0, Float3* p1, Float3* velocity, u
   *p1 = position;
   *velocity = vel;
   *flags = result;
-}
-
-double HullColliderSet::Budget(Float3 p0, Float3 p1, const ContactFrames& c, float separation) {
-  // Per collider hit, in its frame: an entry response leaves the particle within its motion
-  // relative to the collider (the chord) of where p0 sits on the collider at the end of the
-  // substep, which the collider carried away from p0 (a bone turning into a particle at rest
-  // pushes it as far as its surface travels). Responses to several moving colliders compose:
-  // their carries add up.
-  double chord = std::sqrt(DistanceSquared(p0, p1)), carry = 0.0, depth = 0.0;
-  const ContactQuery* contacts = c.contacts();
-  for (uint32_t h = 0; h < c.hits; ++h) {
-    const uint32_t i = c.order[h];
-    const Float3 a = TransformPoint(c.frames[i]->to_local_start, p0);
-    const Float3 b = TransformPoint(c.frames[i]->to_local_end, p1);
-    const Float3 carried = TransformPoint(c.frames[i]->to_world_end, a);
-    chord = std::max(chord, std::sqrt(DistanceSquared(a, b)));
-    carry += std::sqrt(DistanceSquared(carried, p0));
-    depth += contacts[i].depth;
-  }
-  // Rounding of the float response: relative to the coordinates' size.
-  const double scale =
-      std::max({std::fabs(double(p1.x)), std::fabs(double(p1.y)), std::fabs(double(p1.z)), 1.0});
-  const double budget = chord + carry + kUnionDepthFactor * depth + separation + 1e-6 * scale;
-  return budget * budget;
 }
 
 template void HullColliderSet::ResolveParticle<true>(Float3, Float3*, Float3*, uint8_t*,

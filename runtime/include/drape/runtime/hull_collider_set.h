@@ -274,8 +274,10 @@ class HullColliderSet {
   bool NearestUnionExit(Float3 p0, Float3 x, const ContactFrames& candidates, double max_distance,
                         ContactQuery* exit) const;
   bool InsideAnyCandidate(Float3 x, const ContactFrames& candidates) const;
-  // The squared distance from p0 a response may leave the particle at (kUnionDepthFactor).
-  static double Budget(Float3 p0, Float3 p1, const ContactFrames& contacts, float separation);
+  // The distance from p0 a response may leave the particle at (kUnionDepthFactor), from the
+  // first pass's contacts; computed when a response first reaches beyond its floor
+  // (contact_resolution.cpp).
+  class ResponseBound;
   // Query's helpers: whether collider k is of a kind in `kinds`; the point just outside the
   // surface a contact resolves to; whether x is inside any collider of `kinds`; the nearest exit
   // of the union of the colliders p1 is inside (replaces *best when one is found).
