@@ -146,17 +146,63 @@ void ClipPolygon(const std::vector<Vec3>& polygon, Vec3 axis, double cut, std::v
   if (above->size() < 3) above->clear();
 }
 
+// Metres a cut may leave a polygon reaching across it (what the hull of the side holding it may
+// gain beyond the plane).
+constexpr double kCutSnap = 1e-3;
+
 // The two sides of the plane dot(x, axis) = cut: polygons across it are clipped, so the two
 // hulls together still hold every triangle of the piece (a low-poly body's triangles can span a
 // whole limb; kept whole, they would make each side's hull bridge the cut).
 void Cut(const WorkPiece& piece, Vec3 axis, double cut, WorkPiece* below, WorkPiece* above) {
   for (const std::vector<Vec3>& polygon : piece.polygons) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Vec3& p : polygon) {
+      lo = std::min(lo, Dot(p, axis) - cut);
+      hi = std::max(hi, Dot(p, axis) - cut);
+    }
+    // A polygon reaching across by less than kCutSnap goes whole to the side that holds the
+    // rest of it: clipped, its corner would be a sliver of a triangle that no later cut can
+    // separate from the far parts of its piece (a side needs four points), so the piece's hull
+    // would keep bridging them.
+    if (lo < 0.0 && hi >= 0.0 && std::min(hi, -lo) <= kCutSnap) {
+      (hi <= -lo ? below : above)->polygons.push_back(polygon);
+      continue;
+    }
     std::vector<Vec3> a, b;
     ClipPolygon(polygon, axis, cut, &a, &b);
     if (!a.empty()) below->polygons.push_back(std::move(a));
     if (!b.empty()) above->polygons.push_back(std::move(b));
   }
   for (const Vec3& p : piece.loose) (Dot(p, axis) < cut ? below : above)->loose.push_back(p);
+}
+
+// Metres under a lone polygon the point that makes it a solid lies.
+constexpr double kSolidDepth = 1e-3;
+
+// A piece of fewer than four points (a cut's sliver of one triangle, which no later cut could
+// separate from the far parts of a piece) gets a point kSolidDepth under its largest polygon,
+// inside the body (polygons wind counter-clockwise seen from outside), so that it can be a piece
+// of its own. False when it has no polygon with an area.
+bool MakeSolid(WorkPiece* piece) {
+  if (PiecePoints(*piece).size() >= 4) return true;
+  Vec3 normal{0, 0, 0}, centre{0, 0, 0};
+  double largest = 0.0;
+  for (const std::vector<Vec3>& polygon : piece->polygons) {
+    Vec3 area{0, 0, 0}, sum{0, 0, 0};
+    for (size_t i = 0; i < polygon.size(); ++i) {
+      area = area + Cross(polygon[i], polygon[(i + 1) % polygon.size()]);
+      sum = sum + polygon[i];
+    }
+    const double length = std::sqrt(Dot(area, area));
+    if (length > largest) {
+      largest = length;
+      normal = area * (1.0 / length);
+      centre = sum * (1.0 / static_cast<double>(polygon.size()));
+    }
+  }
+  if (!(largest > 0.0)) return false;
+  piece->loose.push_back(centre - normal * kSolidDepth);
+  return PiecePoints(*piece).size() >= 4;
 }
 
 // How many of the cuts through the middle that leave the least hull volume have their bloat
@@ -185,10 +231,11 @@ bool Split(const Context& c, const WorkPiece& piece, WorkPiece* left, WorkPiece*
   const auto add = [&](Vec3 axis, double cut, bool through_bulge) {
     Candidate candidate{0.0, {}, {}, through_bulge};
     Cut(piece, axis, cut, &candidate.below, &candidate.above);
-    // Each side must stay a solid (a hull needs four points).
+    // Each side must stay a solid (a hull needs four points): a side that is one sliver of a
+    // triangle gets a point under it.
+    if (!MakeSolid(&candidate.below) || !MakeSolid(&candidate.above)) return;
     const std::vector<Vec3> pa = PiecePoints(candidate.below);
     const std::vector<Vec3> pb = PiecePoints(candidate.above);
-    if (pa.size() < 4 || pb.size() < 4) return;
     candidate.volume = HullVolume(pa) + HullVolume(pb);
     candidates.push_back(std::move(candidate));
   };
