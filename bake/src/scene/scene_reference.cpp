@@ -32,7 +32,8 @@ constexpr SampleScene kSampleScenes[] = {
      "(`garments/mannequin_dress.glb`, written by `drape-sim --export-garments`), its max distance "
      "painted per vertex (`_MAX_DISTANCE`: 0 at the waist to 8 cm at the hem), on a floor"},
     {"robot_expressive_cape.json", "`RobotExpressive.glb` (shared assets)",
-     "a cape on a rigid-part robot (4.4 m tall as authored), 18 hulls"},
+     "a cape on a rigid-part robot (4.4 m tall as authored), hulls: at its size in metres the "
+     "bake cuts its parts into many convex pieces"},
     {"fox_blanket.json", "`Fox.glb` (shared assets)",
      "a blanket dropped on a quadruped's back while it looks around, body maps rendered per frame "
      "and seen from above (the bake's least-air view axis), on a floor"},
