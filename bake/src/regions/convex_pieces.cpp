@@ -201,8 +201,9 @@ bool MakeSolid(WorkPiece* piece) {
     }
   }
   if (!(largest > 0.0)) return false;
+  // Off the plane of three points that span an area: a fourth.
   piece->loose.push_back(centre - normal * kSolidDepth);
-  return PiecePoints(*piece).size() >= 4;
+  return true;
 }
 
 // How many of the cuts through the middle that leave the least hull volume have their bloat
