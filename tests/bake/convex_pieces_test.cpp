@@ -152,6 +152,12 @@ TEST(ConvexPieces, AFlatPartJoinsASolidOrIsCutAwayAsOne) {
     EXPECT_GE(p.piece.points.size(), 4u);
     EXPECT_LE(p.piece.bloat, kMaxBloat);
   }
+  // Each ball whole and the card alone (a cut could not take the card while a side needed four
+  // points: the large ball went into six pieces around it, one 14 mm out of the body).
+  ASSERT_EQ(pieces.size(), 3u);
+  size_t cards = 0;
+  for (const ConvexPieceResult& p : pieces) cards += p.balls == std::set<size_t>{2};
+  EXPECT_EQ(cards, 1u);
   EXPECT_TRUE(EveryVertexIsInAPiece(body, pieces));
 }
 
