@@ -71,14 +71,35 @@ struct AxisResult {
   double mean_tests = 0.0;
 };
 
+// Directions tried when no OBB axis gives valid sides, each OBB axis tilted by this angle
+// (radians) towards +-each other axis: 12 directions.
+constexpr double kTilt = 0.2;
+constexpr int kTiltedDirections = 12;
+
+// The projection frame of direction `index`: 0-2 the OBB axes, 3 + k the k-th tilted direction.
+void ProjectionFrame(const Obb& obb, int index, Float3* axis, Float3* u, Float3* v) {
+  if (index < 3) {
+    *axis = obb.axes[index];
+    *u = obb.axes[(index + 1) % 3];
+    *v = obb.axes[(index + 2) % 3];
+  } else {
+    const int k = (index - 3) / 4, towards = (k + 1 + ((index - 3) / 2) % 2) % 3;
+    const float sign = (index - 3) % 2 == 0 ? 1.f : -1.f;
+    const Float3 a = obb.axes[k], b = obb.axes[towards] * sign;
+    *axis = NormalizeOr(
+        a * static_cast<float>(std::cos(kTilt)) + b * static_cast<float>(std::sin(kTilt)), a);
+    const Float3 other = obb.axes[3 - k - towards];
+    *u = NormalizeOr(other - *axis * Dot(other, *axis), other);
+    *v = Cross(*axis, *u);
+  }
+  if (Dot(Cross(*u, *v), *axis) < 0.f) *v = -*v;
+}
+
 AxisResult BuildForAxis(const HullColliderData& hull, int axis_index,
                         const KirkpatrickOptions& options) {
   AxisResult r;
   const Obb& obb = hull.obb;
-  r.axis = obb.axes[axis_index];
-  r.u = obb.axes[(axis_index + 1) % 3];
-  r.v = obb.axes[(axis_index + 2) % 3];
-  if (Dot(Cross(r.u, r.v), r.axis) < 0.f) r.v = -r.v;
+  ProjectionFrame(obb, axis_index, &r.axis, &r.u, &r.v);
   std::vector<float> uv(2 * hull.vertices.size());
   std::vector<Point> points(hull.vertices.size());
   for (size_t i = 0; i < hull.vertices.size(); ++i) {
@@ -227,12 +248,21 @@ Status BuildKirkpatrick(HullColliderData* hull, const KirkpatrickOptions& option
         chosen = k;
     }
   }
+  // Triangles a few nanometres wide (a simplified hull keeps some where no collapse was
+  // admissible) can wind the wrong way once their corners are rounded to float (u, v), and the
+  // shadow folds; another direction rounds them differently.
+  AxisResult tilted;
+  for (int k = 0; chosen < 0 && k < kTiltedDirections; ++k) {
+    tilted = BuildForAxis(*hull, 3 + k, options);
+    if (tilted.ok) chosen = 3 + k;
+  }
   if (chosen < 0) {
     std::string reasons;
     for (int k = 0; k < 3; ++k) reasons += (k ? "; " : "") + results[k].error;
-    return Fail("no OBB axis gives a valid projection: " + reasons);
+    return Fail("no OBB axis gives a valid projection, nor " + std::to_string(kTiltedDirections) +
+                " tilted directions: " + reasons);
   }
-  AxisResult& r = results[chosen];
+  AxisResult& r = chosen < 3 ? results[chosen] : tilted;
   hull->projection_axis = r.axis;
   hull->projection_u = r.u;
   hull->projection_v = r.v;

@@ -38,7 +38,9 @@ struct KirkpatrickSideStats {
 };
 
 struct KirkpatrickStats {
-  int32_t axis_index = -1;         // the OBB axis used (0..2)
+  // The OBB axis used (0..2), or 3 + k: the k-th of 12 OBB axes tilted by 0.2 rad, tried when
+  // no OBB axis gives valid sides.
+  int32_t axis_index = -1;
   bool axis_fallback = false;      // the requested longest/shortest axis failed; another was used
   float vertical_tolerance = 0.f;  // tau actually used
   KirkpatrickSideStats upper, lower;
