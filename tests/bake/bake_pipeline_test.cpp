@@ -324,7 +324,8 @@ INSTANTIATE_TEST_SUITE_P(
                       CharacterCase{"Fox/Fox.glb", 0.005, "y"},
                       CharacterCase{"RobotExpressive/RobotExpressive.glb", 0.002, "z"},
                       CharacterCase{"QuaterniusAnimatedHuman/Animated_Human.fbx", 0.002, "z"},
-                      CharacterCase{"QuaterniusSpider/Spider.fbx", 0.005, "y"}));
+                      CharacterCase{"QuaterniusSpider/Spider.fbx", 0.005, "y"}),
+    [](const auto& param_info) { return test::CharacterTestName(param_info.param.path); });
 
 // The same input and config give byte-identical files at 1 and 2 threads and across runs.
 TEST(BakePipeline, BytesDoNotDependOnThreadCount) {

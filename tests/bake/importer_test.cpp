@@ -231,7 +231,8 @@ INSTANTIATE_TEST_SUITE_P(
                       CharacterCase{"Fox/Fox.glb", 24},
                       CharacterCase{"RobotExpressive/RobotExpressive.glb", 43},
                       CharacterCase{"QuaterniusAnimatedHuman/Animated_Human.fbx", 41},
-                      CharacterCase{"QuaterniusSpider/Spider.fbx", 39}));
+                      CharacterCase{"QuaterniusSpider/Spider.fbx", 39}),
+    [](const auto& param_info) { return test::CharacterTestName(param_info.param.path); });
 
 TEST(Importer, UnitsAndUpAxisDetected) {
   const std::string fox = test::CharacterPath("Fox/Fox.glb");

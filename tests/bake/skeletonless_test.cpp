@@ -80,11 +80,11 @@ TEST_P(SkeletonRemoved, ConvexPiecesFitTheBody) {
   RecordProperty("hulls", std::to_string(result.asset.hulls.size()));
 }
 
-INSTANTIATE_TEST_SUITE_P(HumanCopies, SkeletonRemoved,
-                         ::testing::Values(StaticCase{"", 0.5f},
-                                           StaticCase{"CesiumMan/CesiumMan.glb", 0.f},
-                                           StaticCase{"QuaterniusAnimatedHuman/Animated_Human.fbx",
-                                                      0.f, 1.75 / 5.2594}));
+INSTANTIATE_TEST_SUITE_P(
+    HumanCopies, SkeletonRemoved,
+    ::testing::Values(StaticCase{"", 0.5f}, StaticCase{"CesiumMan/CesiumMan.glb", 0.f},
+                      StaticCase{"QuaterniusAnimatedHuman/Animated_Human.fbx", 0.f, 1.75 / 5.2594}),
+    [](const auto& param_info) { return test::CharacterTestName(param_info.param.path); });
 
 }  // namespace
 }  // namespace drape

@@ -14,6 +14,17 @@ inline std::string CharacterPath(const std::string& relative) {
   return SharedDir() + "/assets/characters/" + relative;
 }
 inline std::string MannequinPath() { return SourceDir() + "/samples/mannequin/mannequin.gltf"; }
+// A parameterised test's name for a character path under shared/assets/characters ("" is the
+// mannequin): its file name without extension, so test names stay the same from build to build.
+inline std::string CharacterTestName(const std::string& relative) {
+  if (relative.empty()) return "mannequin";
+  std::string name = std::filesystem::path(relative).stem().string();
+  for (char& c : name) {
+    const bool alnum = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+    if (!alnum) c = '_';
+  }
+  return name;
+}
 
 }  // namespace drape::test
 
