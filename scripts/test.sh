@@ -45,11 +45,19 @@ check() {  # name, command...: one pass/fail step of this script
   fi
 }
 
+# Each stage's wall time, printed when the next one starts: where the command's minutes go.
+stage_start=$SECONDS
+stage() {
+  echo "(previous stage: $((SECONDS - stage_start)) s)"
+  stage_start=$SECONDS
+  echo "== $1"
+}
+
 echo "== 1. full build"
 cmake --preset test >/dev/null && cmake --build build -j "$jobs" || { echo "tests: 0 passed, 1 failed"; exit 1; }
 run_ctest build
 
-echo "== 2. runtime alone (-DDRAPE_BUILD_BAKE=OFF)"
+stage "2. runtime alone (-DDRAPE_BUILD_BAKE=OFF)"
 cmake --preset runtime-only >/dev/null &&
   cmake --build build-runtime -j "$jobs" --target drape_formats drape_runtime drape-inspect \
     drape-query ||
@@ -66,7 +74,7 @@ no_bake_in_link_lines() {
 }
 check "runtime link lines name no assimp, CGAL or OSMesa" no_bake_in_link_lines
 
-echo "== 3. install and find_package(drape) from a consumer"
+stage "3. install and find_package(drape) from a consumer"
 install_consumer() {
   local prefix consumer
   prefix=$(mktemp -d) consumer=$(mktemp -d)
@@ -81,7 +89,7 @@ install_consumer() {
 }
 check "installed drape::runtime links into a C++ and a C consumer" install_consumer
 
-echo "== 4. formats + runtime tests under ASan + UBSan, without OpenMP"
+stage "4. formats + runtime tests under ASan + UBSan, without OpenMP"
 if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     LSAN_OPTIONS=suppressions=$root/tests/tools/lsan_suppressions.txt run_ctest build-sanitize
@@ -91,10 +99,11 @@ else
   check "sanitizer build" false
 fi
 
-echo "== 5. fuzzing"
+stage "5. fuzzing"
 fuzz_runs=${DRAPE_FUZZ_RUNS:-100000}
 check "fuzz targets run clean (fixed seed, $fuzz_runs inputs each)" \
   env DRAPE_FUZZ_RUNS="$fuzz_runs" scripts/fuzz.sh "${DRAPE_FUZZ_SECONDS:-60}"
 
+echo "(previous stage: $((SECONDS - stage_start)) s; all stages: $SECONDS s)"
 echo "tests: $total_passed passed, $total_failed failed"
 [ "$total_failed" -eq 0 ]
