@@ -40,24 +40,33 @@ struct VariationCase {
   const char* name;
 };
 
+// The four heaviest of (weight, joint) influences (ties to the lower joint), renormalised: what
+// a glTF vertex holds.
+std::vector<std::pair<float, uint16_t>> FourHeaviest(
+    std::vector<std::pair<float, uint16_t>> influences) {
+  std::sort(influences.begin(), influences.end(), [](const auto& a, const auto& b) {
+    return a.first > b.first || (a.first == b.first && a.second < b.second);
+  });
+  influences.resize(std::min<size_t>(influences.size(), 4));
+  float sum = 0.f;
+  for (const auto& k : influences) sum += k.first;
+  for (auto& k : influences) k.first /= sum;
+  return influences;
+}
+
 // The mesh's influences as four per vertex, smoothed by the garments' weight smoothing (each
 // pass: half its own weights, half its neighbours' mean, the four heaviest kept), and back.
 void SmoothWeights(uint32_t passes, MeshData* mesh) {
   const uint32_t n = mesh->vertex_count();
   std::vector<ClothSkinWeights> weights(n);
   for (uint32_t v = 0; v < n; ++v) {
-    std::vector<std::pair<float, uint16_t>> kept;
+    std::vector<std::pair<float, uint16_t>> influences;
     for (uint32_t i = mesh->influence_offsets[v]; i < mesh->influence_offsets[v + 1]; ++i)
-      kept.push_back({mesh->influence_weights[i], mesh->influence_joints[i]});
-    std::sort(kept.begin(), kept.end(), [](const auto& a, const auto& b) {
-      return a.first > b.first || (a.first == b.first && a.second < b.second);
-    });
-    kept.resize(std::min<size_t>(kept.size(), 4));
-    float sum = 0.f;
-    for (const auto& k : kept) sum += k.first;
+      influences.push_back({mesh->influence_weights[i], mesh->influence_joints[i]});
+    const std::vector<std::pair<float, uint16_t>> kept = FourHeaviest(std::move(influences));
     for (size_t k = 0; k < kept.size(); ++k) {
       weights[v].joints[k] = kept[k].second;
-      weights[v].weights[k] = kept[k].first / sum;
+      weights[v].weights[k] = kept[k].first;
     }
   }
   bake::detail::SmoothSkinWeights(mesh->triangles, passes, &weights);
@@ -104,17 +113,11 @@ void Subdivide(MeshData* mesh) {
       for (uint32_t i = mesh->influence_offsets[end]; i < mesh->influence_offsets[end + 1]; ++i)
         blend[mesh->influence_joints[i]] += 0.5f * mesh->influence_weights[i];
     }
-    std::vector<std::pair<float, uint16_t>> kept;  // the four heaviest, as a glTF vertex holds
-    for (const auto& [joint, weight] : blend) kept.push_back({weight, joint});
-    std::sort(kept.begin(), kept.end(), [](const auto& x, const auto& y) {
-      return x.first > y.first || (x.first == y.first && x.second < y.second);
-    });
-    kept.resize(std::min<size_t>(kept.size(), 4));
-    float sum = 0.f;
-    for (const auto& k : kept) sum += k.first;
-    for (const auto& [weight, joint] : kept) {
+    std::vector<std::pair<float, uint16_t>> influences;
+    for (const auto& [joint, weight] : blend) influences.push_back({weight, joint});
+    for (const auto& [weight, joint] : FourHeaviest(std::move(influences))) {
       mesh->influence_joints.push_back(joint);
-      mesh->influence_weights.push_back(weight / sum);
+      mesh->influence_weights.push_back(weight);
     }
     mesh->influence_offsets.push_back(static_cast<uint32_t>(mesh->influence_joints.size()));
     midpoints.emplace(key, v);

@@ -83,8 +83,10 @@ void ProjectionFrame(const Obb& obb, int index, Float3* axis, Float3* u, Float3*
     *u = obb.axes[(index + 1) % 3];
     *v = obb.axes[(index + 2) % 3];
   } else {
-    const int k = (index - 3) / 4, towards = (k + 1 + ((index - 3) / 2) % 2) % 3;
-    const float sign = (index - 3) % 2 == 0 ? 1.f : -1.f;
+    const int tilted = index - 3;                        // 0-11
+    const int k = tilted / 4;                            // the axis tilted
+    const int towards = (k + 1 + (tilted / 2) % 2) % 3;  // one of the two others
+    const float sign = tilted % 2 == 0 ? 1.f : -1.f;     // towards its + or - side
     const Float3 a = obb.axes[k], b = obb.axes[towards] * sign;
     *axis = NormalizeOr(
         a * static_cast<float>(std::cos(kTilt)) + b * static_cast<float>(std::sin(kTilt)), a);
