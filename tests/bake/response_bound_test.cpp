@@ -168,13 +168,13 @@ TEST_P(ResponseBound, NoParticleMovesBeyondItsMotionPlusDepth) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryCharacter, ResponseBound,
-                         ::testing::Values("", "CesiumMan/CesiumMan.glb",
-                                           "RiggedFigure/RiggedFigure.glb",
-                                           "RiggedSimple/RiggedSimple.gltf",
-                                           "RobotExpressive/RobotExpressive.glb",
-                                           "QuaterniusAnimatedHuman/Animated_Human.fbx",
-                                           "Fox/Fox.glb", "QuaterniusSpider/Spider.fbx"));
+INSTANTIATE_TEST_SUITE_P(
+    EveryCharacter, ResponseBound,
+    ::testing::Values("", "CesiumMan/CesiumMan.glb", "RiggedFigure/RiggedFigure.glb",
+                      "RiggedSimple/RiggedSimple.gltf", "RobotExpressive/RobotExpressive.glb",
+                      "QuaterniusAnimatedHuman/Animated_Human.fbx", "Fox/Fox.glb",
+                      "QuaterniusSpider/Spider.fbx"),
+    [](const auto& param_info) { return test::CharacterTestName(param_info.param); });
 
 }  // namespace
 }  // namespace drape

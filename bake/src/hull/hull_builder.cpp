@@ -148,8 +148,10 @@ Status Simplify(const Mesh& h0, const std::vector<uint32_t>& h0_groups, uint32_t
   return Status::Ok();
 }
 
-// 4. Self-verification (exact): a closed convex mesh; counts the input delta-balls it does not
-// contain and measures its growth beyond H0.
+// 4. Self-verification (exact): a closed convex mesh; counts the delta-balls of `inputs` it does
+// not contain and measures its growth beyond H0. A convex collider that contains the balls of the
+// input hull's vertices contains every input's ball (each input is a convex combination of those
+// vertices, and so is its ball of the vertices' balls), so the caller may pass only those.
 Status Verify(const Mesh& result, const std::vector<Vec3>& inputs, double delta,
               const GrowthReference& reference, HullStats* stats) {
   const auto verify_start = Clock::now();
@@ -242,6 +244,12 @@ Status BuildHullGeometry(std::span<const Float3> points, const HullOptions& opti
         "input not full-dimensional: vertex normals undefined, used the Minkowski inflation";
   }
   const std::vector<Vec3>& base = full_dimensional ? input_hull.points : inputs;
+  // The points whose delta-balls the verification tests: the input hull's vertices suffice for
+  // the Minkowski inflation (see Verify; on a 4 541-point bone of a 75k-triangle character the
+  // exact test of every input took 3 of the bake's 10 s). The paper's vertex-normal offset reports
+  // how many inputs poke out, so it tests them all.
+  const std::vector<Vec3>& containment_points =
+      inflation == InflationMode::kMinkowskiIcosahedron ? base : inputs;
   double max_abs = 0.0;
   for (const Vec3& p : base) max_abs = std::max(max_abs, MaxAbs(p));
 
@@ -276,7 +284,9 @@ Status BuildHullGeometry(std::span<const Float3> points, const HullOptions& opti
     stats->simplify_ms += MillisecondsSince(simplify_start);
 
     // 4. Self-verification (exact).
-    if (Status s = Verify(simplified.mesh, inputs, delta, reference, stats); !s.ok()) return s;
+    if (Status s = Verify(simplified.mesh, containment_points, delta, reference, stats); !s.ok()) {
+      return s;
+    }
     if (inflation == InflationMode::kMinkowskiIcosahedron && stats->uncovered_points != 0) {
       continue;  // larger margin
     }
