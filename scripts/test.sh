@@ -6,7 +6,9 @@
 #     in 4 in a -DDRAPE_BUILD_BAKE=OFF build under sanitizers);
 #  3. cmake --install of that build, and a tiny consumer that find_package(drape)s it;
 #  4. formats + runtime tests again (what an engine links and feeds untrusted .drape files),
-#     under AddressSanitizer + UndefinedBehaviorSanitizer, built without OpenMP
+#     under AddressSanitizer + UndefinedBehaviorSanitizer, built with clang (stage 1 builds with
+#     the system's gcc, so both compilers build the runtime with warnings as errors, and clang's
+#     UBSan also checks float-to-integer casts) and without OpenMP
 #     (-DDRAPE_OPENMP=OFF: an engine that links no libgomp; the loops run on the calling thread)
 #     and checked to link no libgomp; the bad-model corpus through drape-bake runs in stage 1
 #     (the model reader runs in a child process there);
@@ -91,7 +93,8 @@ check "installed drape::runtime links into a C++ and a C consumer" install_consu
 
 stage "4. formats + runtime tests under ASan + UBSan, without OpenMP"
 if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
-  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+    UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$root/tests/tools/ubsan_suppressions.txt \
     LSAN_OPTIONS=suppressions=$root/tests/tools/lsan_suppressions.txt run_ctest build-sanitize
   check "the runtime built without OpenMP links no libgomp" \
     bash -c '! ldd build-sanitize/bin/drape-inspect | grep -q libgomp'

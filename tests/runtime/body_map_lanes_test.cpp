@@ -220,7 +220,10 @@ TEST(BodyMapBatch, AnswersAsQueryAndResponseBitForBit) {
       // a texel's slab for its gaps there.
       const float u = (p0.x - c.origin_x()) / texel, v = (p0.y - c.origin_y()) / texel;
       float upper[kMaxBodyMapLayers], lower[kMaxBodyMapLayers], top = 0.f, bottom = 0.f;
-      if (u >= 0.f && v >= 0.f && IsFinite(p1) &&
+      // On the grid before the casts (p0 may be infinite: a float-to-integer cast of it is
+      // undefined).
+      if (u >= 0.f && v >= 0.f && u < static_cast<float>(c.width()) &&
+          v < static_cast<float>(c.height()) && IsFinite(p1) &&
           BodyMapColliderAccess::TexelSlab(c, static_cast<uint32_t>(u), static_cast<uint32_t>(v),
                                            &top, &bottom)) {
         const uint32_t gaps = BodyMapColliderAccess::TexelGaps(

@@ -3,7 +3,6 @@
 // §7.5); and the bilinear depth the walk samples (§7.3).
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "body_map/body_map_walk.h"
 #include "drape/runtime/body_map_collider.h"
@@ -12,7 +11,6 @@
 namespace drape {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
 using detail::BodyMapWalk;
 using detail::FloorToInt;
 using detail::kEntryBack;
