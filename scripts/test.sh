@@ -91,7 +91,7 @@ install_consumer() {
 }
 check "installed drape::runtime links into a C++ and a C consumer" install_consumer
 
-stage "4. formats + runtime tests under ASan + UBSan, without OpenMP"
+stage "4. formats + runtime tests under ASan + UBSan, built with clang, without OpenMP"
 if cmake --preset sanitize >/dev/null && cmake --build build-sanitize -j "$jobs"; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$root/tests/tools/ubsan_suppressions.txt \

@@ -21,9 +21,11 @@ struct HullColliderSetAccess {
   static bool ObbMayContainLocal(const HullColliderSet& set, uint32_t hull, Float3 p) {
     const HullColliderSet::HullRecord& h = set.hulls_[hull];
     const Float3 d = p - h.obb_center;
-    return (std::fabs(Dot(d, h.obb_axes[0])) <= h.obb_half.x) &
-           (std::fabs(Dot(d, h.obb_axes[1])) <= h.obb_half.y) &
-           (std::fabs(Dot(d, h.obb_axes[2])) <= h.obb_half.z);
+    // The three compares first, then & (no short circuit, no branch per axis).
+    const bool in_x = std::fabs(Dot(d, h.obb_axes[0])) <= h.obb_half.x;
+    const bool in_y = std::fabs(Dot(d, h.obb_axes[1])) <= h.obb_half.y;
+    const bool in_z = std::fabs(Dot(d, h.obb_axes[2])) <= h.obb_half.z;
+    return in_x & in_y & in_z;
   }
   // The whole narrow phase of the collider-frame segment a -> b with the set's options.
   static ContactQuery QueryHullLocal(const HullColliderSet& set, uint32_t hull, Float3 a, Float3 b);

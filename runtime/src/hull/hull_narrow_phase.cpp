@@ -130,8 +130,8 @@ ContactQuery HullColliderSet::ColliderContact(uint32_t collider, const ActiveFra
     const Float3 bo = TransformPoint(f.to_obb_end, p1);
     const Float3 ao = TransformPoint(f.to_obb_start, p0);
     const Float3 half = h.obb_half;
-    const bool end_in =
-        (std::fabs(bo.x) <= half.x) & (std::fabs(bo.y) <= half.y) & (std::fabs(bo.z) <= half.z);
+    const Float3 bo_abs{std::fabs(bo.x), std::fabs(bo.y), std::fabs(bo.z)};
+    const bool end_in = (bo_abs.x <= half.x) & (bo_abs.y <= half.y) & (bo_abs.z <= half.z);
     const bool beyond_one_face =
         ((ao.x > half.x) & (bo.x > half.x)) | ((ao.x < -half.x) & (bo.x < -half.x)) |
         ((ao.y > half.y) & (bo.y > half.y)) | ((ao.y < -half.y) & (bo.y < -half.y)) |
