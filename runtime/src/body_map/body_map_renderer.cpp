@@ -77,6 +77,11 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
     return Invalid("the mesh has " + std::to_string(mesh.triangles.size()) +
                    " triangle indices (a positive multiple of 3 is needed)");
   }
+  if (mesh.triangle_count() >= detail::kMaxRasterTriangles) {
+    return Invalid("the mesh has " + std::to_string(mesh.triangle_count()) +
+                   " triangles (fewer than " + std::to_string(detail::kMaxRasterTriangles) +
+                   " are supported)");
+  }
   for (size_t k = 0; k < mesh.triangles.size(); ++k) {
     if (mesh.triangles[k] >= vertices) {
       return Invalid("triangle index " + std::to_string(k) + " names vertex " +
@@ -119,8 +124,9 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   face_normals_.resize(triangles);
   shading_.resize(triangles);
   drawn_.reserve(triangles);
+  if (o.air_gaps > 0) gap_triangles_.reserve(triangles);
   raster_.reserve(triangles);
-  raster_rows_.reserve(triangles);
+  raster_boxes_.reserve(triangles);
 
   // The bind pose's window, grown: most poses then render without allocating.
   Float3 lo{kInf, kInf, kInf}, hi{-kInf, -kInf, -kInf};
@@ -147,6 +153,9 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   stats_.width = stats_.height = stats_.triangles_drawn = stats_.valid_texels = 0;
   stats_.gap_texels = 0;
   if (mesh_ == nullptr) return Invalid("not initialised (Init failed or was not called)");
+  // A render that enlarged any buffer is counted once, whichever stages grew.
+  const uint32_t grew_before = stats_.grew;
+  const size_t bytes = memory_bytes();
   RenderRegion box;  // everywhere, or the region in the view frame
   if (region != nullptr) {
     if (Status s = CheckRegion(*region); !s.ok()) return s;
@@ -169,6 +178,8 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   maps->Finish();
   stats_.valid_texels = maps->stats().valid_texels;
   stats_.gap_texels = maps->stats().gap_texels;
+  if (memory_bytes() != bytes) ++stats_.grew;  // more gap texels or surfaces than reserved
+  stats_.grew = std::min(stats_.grew, grew_before + 1);
   return Status::Ok();
 }
 
@@ -332,13 +343,8 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   if (options_.air_gaps > 0) {
     exit_z_.assign(texels, -kInf);
     exit_face_.assign(texels, kNoFace);
-    // Set by the gap passes at the texels they look at (FindGaps).
-    for (std::vector<float>* v : {&entry_z_, &below_z_}) v->resize(texels);
-    gap_count_.resize(texels);
-    entry_face_.resize(texels);
-    winding_above_.resize(texels);
-    winding_total_.resize(texels);
-    gap_flags_.resize(texels);
+    fragment_count_.assign(texels, 0u);
+    fragment_cursor_.resize(texels);  // set by FindGaps
   }
   maps->width_ = window.width;
   maps->height_ = window.height;
@@ -358,15 +364,18 @@ void BodyMapRenderer::Reserve(size_t texels) {
   top_face_.reserve(texels);
   bottom_face_.reserve(texels);
   if (options_.air_gaps == 0) return;
-  for (std::vector<float>* v : {&exit_z_, &entry_z_, &below_z_}) v->reserve(texels);
-  found_.reserve(texels / 8 * options_.air_gaps);  // as the collider's gaps
-  gap_count_.reserve(texels);
-  searching_.reserve(texels);  // a pass may search on every texel
-  next_searching_.reserve(texels);
-  for (std::vector<uint32_t>* v : {&exit_face_, &entry_face_}) v->reserve(texels);
-  winding_above_.reserve(texels);
-  winding_total_.reserve(texels);
-  gap_flags_.reserve(texels);
+  exit_z_.reserve(texels);
+  for (std::vector<uint32_t>* v : {&exit_face_, &fragment_count_, &fragment_cursor_})
+    v->reserve(texels);
+  // Gap texels (rays crossing more than one part) on up to an eighth of the window, with four
+  // surfaces each on average: a human has them on a few percent.
+  const size_t gap_texels = texels / 8 + 1;
+  gap_texels_.reserve(gap_texels);
+  fragment_offsets_.reserve(gap_texels + 1);
+  fragments_.reserve(4 * gap_texels);
+  gaps_per_texel_.reserve(gap_texels);
+  texel_gaps_.reserve(gap_texels * options_.air_gaps);
+  found_.reserve(gap_texels * options_.air_gaps);               // as the collider's gaps
   gap_tiles_.reserve(texels / 64 + options_.max_side / 4 + 1);  // 8 x 8 tiles
 }
 
@@ -378,10 +387,11 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   const bool gaps = options_.air_gaps > 0;
   const detail::RasterWindow w = RasterWindowOf(window);
   raster_.resize(drawn_.size());  // reserved for every triangle at Init
-  raster_rows_.resize(drawn_.size());
-  detail::SetUpTriangles(offset_.data(), mesh_->triangles.data(), drawn_, w, raster_, raster_rows_);
+  raster_boxes_.resize(drawn_.size());
+  detail::SetUpTriangles(offset_.data(), mesh_->triangles.data(), drawn_, w, raster_,
+                         raster_boxes_);
   detail::RasterizeInBands(
-      drawn_, raster_, raster_rows_, w, nullptr,
+      drawn_, raster_, raster_boxes_, w, nullptr,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
         const float z = r.Depth(px, py);
         BodyMapCollider::Slab& s = slabs[k];
@@ -393,8 +403,10 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
           s.bottom = z;
           bottom_face_[k] = t;
         }
+        if (!gaps) return;
+        ++fragment_count_[k];
         // A surface leaving the body going along -z: a gap's upper boundary candidate.
-        if (gaps && !r.entering && z > exit_z_[k]) {
+        if (!r.entering && z > exit_z_[k]) {
           exit_z_[k] = z;
           exit_face_[k] = t;
         }
@@ -496,19 +508,18 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
 size_t BodyMapRenderer::memory_bytes() const {
   return sizeof(*this) +
          (vertex_triangle_offsets_.capacity() + vertex_triangles_.capacity() + drawn_.capacity() +
-          top_face_.capacity() + bottom_face_.capacity() + exit_face_.capacity() +
-          entry_face_.capacity()) *
+          gap_triangles_.capacity() + top_face_.capacity() + bottom_face_.capacity() +
+          exit_face_.capacity() + fragment_count_.capacity() + fragment_cursor_.capacity() +
+          gap_texels_.capacity() + fragment_offsets_.capacity()) *
              sizeof(uint32_t) +
-         (exit_z_.capacity() + entry_z_.capacity() + below_z_.capacity()) * sizeof(float) +
-         found_.capacity() * sizeof(FoundGap) + gap_count_.capacity() +
-         (searching_.capacity() + next_searching_.capacity()) * sizeof(uint32_t) +
-         (winding_above_.capacity() + winding_total_.capacity()) * sizeof(int16_t) +
-         gap_flags_.capacity() +
+         exit_z_.capacity() * sizeof(float) + fragments_.capacity() * sizeof(GapFragment) +
+         (texel_gaps_.capacity() + found_.capacity()) * sizeof(FoundGap) +
+         gaps_per_texel_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *
              sizeof(Float3) +
          shading_.capacity() * sizeof(detail::TriangleShading) +
          raster_.capacity() * sizeof(detail::RasterTriangle) +
-         raster_rows_.capacity() * sizeof(detail::RasterRows) + gap_tiles_.capacity();
+         raster_boxes_.capacity() * sizeof(detail::RasterBox) + gap_tiles_.capacity();
 }
 
 }  // namespace drape

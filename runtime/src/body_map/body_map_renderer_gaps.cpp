@@ -1,18 +1,19 @@
 // BodyMapRenderer's air gaps (options.air_gaps): the air below each texel's front surface, gap
-// by gap going down. The first raster pass found the highest surface leaving the body going
-// along -z (the first candidate upper boundary); a gap pass counts the surfaces above it, each
-// texel centre on a shared edge counted once, and finds the highest surface entering the body
-// below it (the lower boundary). The range between them is air when as many surfaces enter as
-// leave above the upper boundary (the winding count is 0 just below it) and along the whole ray
-// (the count ends at 0, as the bake's sweep requires), and none lies within kMinGap below it.
-// The next candidate is the highest surface leaving below that lower boundary, or below the
-// candidate itself when another part still encloses it (one more raster pass over the texels
-// still searching), and so on. Surfaces enter where the drawn (offset) triangle runs
-// counter-clockwise in the window, as in the bake. Where the ray does not balance the texel
-// keeps what it has, the conservative answer (docs/ALGORITHMS.md §7.9). A part thinner than
-// kMinGap at either end of the ray (a texel centre on the silhouette of a part seen edge-on,
-// whose two sides meet at one depth) is no body: the slab ends at the air next to it instead of
-// taking that air in.
+// by gap going down. The raster pass found the highest surface leaving the body going along -z
+// (the first candidate upper boundary) and counted the surfaces on each ray. Where that surface
+// lies above the back one a gap may lie: one more raster pass collects every surface on those
+// texels' rays, in draw order, and the search then walks each texel's list. It counts the
+// surfaces above the candidate, each texel centre on a shared edge counted once, and finds the
+// highest surface entering the body below it (the lower boundary). The range between them is air
+// when as many surfaces enter as leave above the upper boundary (the winding count is 0 just
+// below it) and along the whole ray (the count ends at 0, as the bake's sweep requires), and none
+// lies within kMinGap below it. The next candidate is the highest surface leaving below that
+// lower boundary, or below the candidate itself when another part still encloses it, and so on.
+// Surfaces enter where the drawn (offset) triangle runs counter-clockwise in the window, as in
+// the bake. Where the ray does not balance the texel keeps what it has, the conservative answer
+// (docs/ALGORITHMS.md §7.9). A part thinner than kMinGap at either end of the ray (a texel centre
+// on the silhouette of a part seen edge-on, whose two sides meet at one depth) is no body: the
+// slab ends at the air next to it instead of taking that air in.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -33,165 +34,163 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // Gaps thinner than this (metres) are not kept, as the bake's (kMinBodyMapGap): touching parts
 // and folded offset slivers, far below epsilon and a texel.
 constexpr float kMinGap = 1e-4f;
-// gap_flags_ bits: a surface lies within kMinGap below the candidate; one enters above it (a
-// seam texel can leave the counts balanced with nothing counted above).
-constexpr uint8_t kCrowded = 1, kEnteredAbove = 2;
+// GapFragment::face_flags: the triangle below kMaxRasterTriangles, and two flags above it.
+constexpr uint32_t kEnteringBit = 1u << 31, kCountsOnceBit = 1u << 30;
+constexpr uint32_t kFaceMask = kCountsOnceBit - 1u;
+// Gap texels per chunk of the search.
+constexpr int64_t kGapTexelGrain = 256;
 
 }  // namespace
 
-// Stage 4b: the air gaps into found_, pass by pass going down. The first pass looks at every
-// texel; each later one only at the texels still searching (searching_): those that found a gap
-// and may hold more, and those whose candidate was not one because another part encloses it (an
-// arm sunk into the torso leaves the body below its exit) and whose ray has deeper surfaces.
+// Stage 4b: the air gaps into found_, by texel, then level.
 void BodyMapRenderer::FindGaps(const Window& window, BodyMapCollider* maps) {
+  SelectGapTexels(*maps, static_cast<size_t>(window.width) * window.height);
+  CollectGapFragments(window);
+  const uint32_t slots = options_.air_gaps;
+  const int64_t count = static_cast<int64_t>(gap_texels_.size());
+  gaps_per_texel_.resize(gap_texels_.size());
+  texel_gaps_.resize(gap_texels_.size() * slots);
+  detail::ParallelFor(count, kGapTexelGrain, [&](int64_t c) {
+    const uint32_t n = static_cast<uint32_t>(c);
+    gaps_per_texel_[n] =
+        static_cast<uint8_t>(SearchTexelGaps(n, maps, &texel_gaps_[size_t{n} * slots]));
+  });
   found_.clear();
-  searching_.clear();
-  const size_t texels = static_cast<size_t>(window.width) * window.height;
-  std::fill(below_z_.begin(), below_z_.begin() + static_cast<std::ptrdiff_t>(texels), -kInf);
-  std::fill(gap_count_.begin(), gap_count_.begin() + static_cast<std::ptrdiff_t>(texels), 0);
-  // Each pass rasterizes the searching texels' tiles twice; a ray with more nested parts than
-  // this keeps what the passes found.
-  const uint32_t max_passes = 2 * options_.air_gaps;
-  for (uint32_t pass = 0; pass < max_passes; ++pass) {
-    const bool first = pass == 0;
-    if (!first) FindUpperBoundariesBelow(window);
-    RasterizeGapSurfaces(window, *maps, first);
-    CollectGaps(maps);
-    if (searching_.empty()) break;
+  for (size_t c = 0; c < gap_texels_.size(); ++c) {
+    for (uint32_t g = 0; g < gaps_per_texel_[c]; ++g) found_.push_back(texel_gaps_[c * slots + g]);
   }
 }
 
-// The next candidate upper boundaries: per searching texel, the highest surface leaving the body
-// below below_z_ (its last gap's lower boundary, or the candidate that failed).
-void BodyMapRenderer::FindUpperBoundariesBelow(const Window& window) {
-  const int64_t width = window.width;
-  gap_tiles_.assign(detail::TileMask::TileCount(window.width, window.height), 0);
-  detail::TileMask tiles{(width + 7) >> detail::TileMask::kShift, gap_tiles_};
-  for (const uint32_t k : searching_) {
-    exit_z_[k] = -kInf;
-    exit_face_[k] = kNoFace;
-    tiles.Mark(int64_t{k} % width, int64_t{k} / width);
+// The texels where a gap may lie (the first candidate lies above the back surface, with room for
+// a gap of kMinGap and its two boundaries), ascending, and where each one's surfaces go. The
+// other texels collect nothing (their count drops to 0).
+void BodyMapRenderer::SelectGapTexels(const BodyMapCollider& maps, size_t texels) {
+  gap_texels_.clear();
+  fragment_offsets_.clear();
+  uint32_t total = 0;
+  for (size_t k = 0; k < texels; ++k) {
+    const bool room =
+        exit_face_[k] != kNoFace && exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap;
+    if (!room) {
+      fragment_count_[k] = 0;
+      continue;
+    }
+    gap_texels_.push_back(static_cast<uint32_t>(k));
+    fragment_offsets_.push_back(total);
+    fragment_cursor_[k] = total;
+    total += fragment_count_[k];  // at most 2^30 triangles per texel
   }
-  detail::RasterizeInBands(
-      drawn_, raster_, raster_rows_, RasterWindowOf(window), &tiles,
-      [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
-        if (r.entering) return;  // below_z_ is -inf but where searching
-        const float z = r.Depth(px, py);
-        if (z < below_z_[k] - kMinGap && z > exit_z_[k]) {
-          exit_z_[k] = z;
-          exit_face_[k] = t;
-        }
-      });
+  fragment_offsets_.push_back(total);
+  fragments_.resize(total);
 }
 
-// At the pass's texels, where a gap may lie below the candidate upper boundary in exit_z_ (it
-// lies above the back surface); then the entering and leaving surfaces around it. Texels out of
-// the pass have no exit face (CollectGaps clears it), so the pass leaves them alone.
-void BodyMapRenderer::RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps,
-                                           bool all) {
+// One raster pass over the tiles that hold gap texels: every surface on their rays, in draw
+// order (a texel's triangles are drawn in `drawn` order by one row band).
+void BodyMapRenderer::CollectGapFragments(const Window& window) {
   const int64_t width = window.width;
-  const size_t texels = static_cast<size_t>(window.width) * window.height;
   gap_tiles_.assign(detail::TileMask::TileCount(window.width, window.height), 0);
   detail::TileMask tiles{(width + 7) >> detail::TileMask::kShift, gap_tiles_};
-  // The candidates, ascending: on the first pass every texel with one, later the searching
-  // texels that still have one. Only they are reset, drawn and collected.
-  const auto keep = [&](size_t k) {
-    // No room for a gap of kMinGap and its two boundaries above the back surface.
-    if (exit_face_[k] != kNoFace && !(exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap)) {
-      exit_face_[k] = kNoFace;
-    }
-    if (exit_face_[k] == kNoFace) return false;
-    entry_z_[k] = -kInf;
-    entry_face_[k] = kNoFace;
-    winding_above_[k] = winding_total_[k] = 0;
-    gap_flags_[k] = 0;
-    tiles.Mark(static_cast<int64_t>(k) % width, static_cast<int64_t>(k) / width);
-    return true;
-  };
-  if (all) {
-    searching_.clear();
-    for (size_t k = 0; k < texels; ++k) {
-      if (keep(k)) searching_.push_back(static_cast<uint32_t>(k));  // reserved for every texel
-    }
-  } else {
-    searching_.erase(std::remove_if(searching_.begin(), searching_.end(),
-                                    [&](uint32_t k) { return !keep(size_t{k}); }),
-                     searching_.end());
-  }
+  for (const uint32_t k : gap_texels_) tiles.Mark(int64_t{k} % width, int64_t{k} / width);
+  if (gap_texels_.empty()) return;
+  const detail::RasterWindow w = RasterWindowOf(window);
+  detail::TrianglesOnTiles(raster_boxes_, w, tiles, &gap_triangles_);
   detail::RasterizeInBands(
-      drawn_, raster_, raster_rows_, RasterWindowOf(window), &tiles,
+      drawn_, raster_, raster_boxes_, w, &gap_triangles_,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool once) {
-        if (exit_face_[k] == kNoFace) return;  // no gap to bound here
-        // Counted once per shared edge; searched for the lower boundary inclusively, so that a
-        // texel centre on a seam (vertices split at the same position, whose edge values are
-        // not exactly negated) can only spoil the count, which keeps the slab.
-        const float z = r.Depth(px, py), upper = exit_z_[k];
-        if (!r.entering) {  // the drawn triangle's winding, as the bake's sweep
-          if (once) --winding_total_[k];
-          if (z >= upper && once) --winding_above_[k];
-          return;
-        }
-        if (once) ++winding_total_[k];
-        // A candidate within kMinGap of the slab's front: what enters as close below it is the
-        // other side of the same sliver, above the air rather than crowding it.
-        const bool sliver_front = upper >= maps.slabs_[k].top - kMinGap;
-        if (z > upper || (sliver_front && z > upper - kMinGap)) {
-          if (once) {
-            ++winding_above_[k];
-            gap_flags_[k] |= kEnteredAbove;
-          }
-        } else if (z > upper - kMinGap) {
-          gap_flags_[k] |= kCrowded;
-        } else if (z > entry_z_[k]) {
-          entry_z_[k] = z;
-          entry_face_[k] = t;
-        }
+        uint32_t& left = fragment_count_[k];  // the same coverage as the raster pass counted
+        if (left == 0) return;
+        --left;
+        const uint32_t flags = (r.entering ? kEnteringBit : 0u) | (once ? kCountsOnceBit : 0u);
+        fragments_[fragment_cursor_[k]++] = {r.Depth(px, py), t | flags};
       });
 }
 
-// The pass's gaps that pass the tests, appended to found_, and the texels to search on
-// (searching_, ascending): below a gap while the texel holds fewer than air_gaps, or below a
-// candidate that was no gap because the body continues under it (the surfaces above it do not
-// balance, or one lies within kMinGap below it) while the whole ray balances. The others lose
-// their exit face (out of the next pass). Air whose only body above or below is thinner than
-// kMinGap (a sliver at the slab's top or bottom) moves that end of the slab instead.
-void BodyMapRenderer::CollectGaps(BodyMapCollider* maps) {
-  next_searching_.clear();
-  for (const uint32_t k : searching_) {
-    BodyMapCollider::Slab& slab = maps->slabs_[k];
-    const float upper = exit_z_[k], lower = entry_z_[k];
-    const bool candidate = exit_face_[k] != kNoFace && winding_total_[k] == 0;
-    const bool enclosed = winding_above_[k] != 0 || (gap_flags_[k] & kCrowded) != 0;
-    const bool bounded = candidate && !enclosed && entry_face_[k] != kNoFace &&
-                         (gap_flags_[k] & kEnteredAbove) != 0 && upper - lower > kMinGap;
+// The search down one gap texel's ray (gap_texels_[candidate]): up to air_gaps gaps into found
+// (level order), and the slab's ends moved past slivers. Returns the gaps found. Each step looks
+// at the candidate upper boundary: where it bounds air, the next candidate is the highest leaving
+// surface below the air; where another part encloses it, the highest leaving surface below it.
+uint32_t BodyMapRenderer::SearchTexelGaps(uint32_t candidate, BodyMapCollider* maps,
+                                          FoundGap* found) {
+  const uint32_t k = gap_texels_[candidate];
+  const GapFragment* begin = fragments_.data() + fragment_offsets_[candidate];
+  const GapFragment* end = fragments_.data() + fragment_offsets_[candidate + 1];
+  BodyMapCollider::Slab& slab = maps->slabs_[k];
+  float upper = exit_z_[k];
+  uint32_t upper_face = exit_face_[k];
+  uint32_t gaps = 0;
+  for (uint32_t step = 0; step < 2 * options_.air_gaps; ++step) {
+    // No room for a gap of kMinGap and its two boundaries above the back surface.
+    if (upper_face == kNoFace || !(upper > slab.bottom + 2.f * kMinGap)) break;
+    // The surfaces around the candidate. Counted once per shared edge; searched for the lower
+    // boundary inclusively, so that a texel centre on a seam (vertices split at the same
+    // position, whose edge values are not exactly negated) can only spoil the count, which
+    // keeps the slab.
+    float lower = -kInf;
+    uint32_t lower_face = kNoFace;
+    int32_t winding_above = 0, winding_total = 0;
+    bool crowded = false, entered_above = false;
+    // A candidate within kMinGap of the slab's front: what enters as close below it is the
+    // other side of the same sliver, above the air rather than crowding it.
+    const bool sliver_front = upper >= slab.top - kMinGap;
+    for (const GapFragment* f = begin; f != end; ++f) {
+      const float z = f->z;
+      const bool once = (f->face_flags & kCountsOnceBit) != 0;
+      if ((f->face_flags & kEnteringBit) == 0) {  // the drawn triangle's winding, as the bake's
+        if (once) --winding_total;
+        if (z >= upper && once) --winding_above;
+        continue;
+      }
+      if (once) ++winding_total;
+      if (z > upper || (sliver_front && z > upper - kMinGap)) {
+        if (once) {
+          ++winding_above;
+          entered_above = true;
+        }
+      } else if (z > upper - kMinGap) {
+        crowded = true;
+      } else if (z > lower) {
+        lower = z;
+        lower_face = f->face_flags & kFaceMask;
+      }
+    }
+    // Air when the counts balance above it and along the ray and it is thick enough; a sliver at
+    // the slab's top or bottom moves that end of the slab instead.
+    const bool balanced = winding_total == 0;
+    const bool enclosed = winding_above != 0 || crowded;
+    const bool bounded =
+        balanced && !enclosed && lower_face != kNoFace && entered_above && upper - lower > kMinGap;
     const bool body_above = upper < slab.top - kMinGap;
     const bool body_below = lower > slab.bottom + kMinGap;
-    bool search_on = false;
+    float below;  // where the next candidate is searched
     if (bounded && body_above && body_below) {
-      found_.push_back(
-          {static_cast<uint32_t>(k), gap_count_[k]++, upper, lower, exit_face_[k], entry_face_[k]});
-      below_z_[k] = lower;
-      search_on = gap_count_[k] < options_.air_gaps;
+      found[gaps] = {k, gaps, upper, lower, upper_face, lower_face};
+      if (++gaps == options_.air_gaps) break;
+      below = lower;
     } else if (bounded && !body_below) {
       slab.bottom = upper;  // below the air only a sliver: the slab's back is the air's top
-      bottom_face_[k] = exit_face_[k];
+      bottom_face_[k] = upper_face;
+      break;
     } else if (bounded) {
       slab.top = lower;  // above the air only a sliver: the slab's front is the air's bottom
-      top_face_[k] = entry_face_[k];
-      below_z_[k] = lower;
-      search_on = true;
-    } else if (candidate && enclosed) {
-      below_z_[k] = upper;  // the next exit below this one may open the gap
-      search_on = true;
-    }
-    if (search_on) {
-      next_searching_.push_back(static_cast<uint32_t>(k));
+      top_face_[k] = lower_face;
+      below = lower;
+    } else if (balanced && enclosed) {
+      below = upper;  // the next exit below this one may open the gap
     } else {
-      below_z_[k] = -kInf;
-      exit_face_[k] = kNoFace;
+      break;
+    }
+    // The next candidate: the highest surface leaving the body below `below`.
+    upper = -kInf;
+    upper_face = kNoFace;
+    for (const GapFragment* f = begin; f != end; ++f) {
+      if ((f->face_flags & kEnteringBit) != 0) continue;
+      if (f->z < below - kMinGap && f->z > upper) {
+        upper = f->z;
+        upper_face = f->face_flags & kFaceMask;
+      }
     }
   }
-  searching_.swap(next_searching_);
+  return gaps;
 }
 
 // Stage 4c: the gaps found, per texel in level order (top down), into the collider's compact gap
@@ -202,10 +201,6 @@ void BodyMapRenderer::PublishGaps(const Window& window, BodyMapCollider* maps) {
   const size_t capacity = maps->gaps_.capacity();
   uint32_t layers = 1;
   for (const FoundGap& g : found_) layers = std::max(layers, g.level + 1);
-  // In place (no allocation): level order within a texel, row-major across texels.
-  std::sort(found_.begin(), found_.end(), [](const FoundGap& a, const FoundGap& b) {
-    return a.texel != b.texel ? a.texel < b.texel : a.level < b.level;
-  });
   maps->gap_layers_ = layers;
   maps->gap_texel_bits_.assign((texels + 31) / 32, 0u);
   maps->gaps_.clear();

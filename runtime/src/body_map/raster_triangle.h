@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <span>
+#include <vector>
 
 #include "drape/runtime/math.h"
 #include "drape/runtime/task_system.h"
@@ -15,6 +16,8 @@
 namespace drape::detail {
 
 inline constexpr uint32_t kNoFace = std::numeric_limits<uint32_t>::max();
+// Triangle indices stay below this: the gap search packs two flags above them.
+inline constexpr uint32_t kMaxRasterTriangles = 1u << 30;
 
 // One triangle set up for the rasterizer in window coordinates (texel units; texel (i, j) is
 // sampled at its centre (i + 1/2, j + 1/2)). Each edge is evaluated canonically, from its lower
@@ -209,40 +212,58 @@ struct TileMask {
   }
 };
 
-// The rows a set-up triangle's box holds, kept apart from the set-up: each row band scans every
-// triangle's rows, and a 200-byte set-up per triangle would stream through the cache.
-struct RasterRows {
+// The texel box a set-up triangle holds, kept apart from the set-up: each row band scans every
+// triangle's box, and a 200-byte set-up per triangle would stream through the cache.
+struct RasterBox {
   int32_t first, last;  // texel rows, within [-1, height]; first > last: none
+  int32_t left, right;  // texel columns, within [-1, width]
 };
 
-// Calls fragment(t, r, k, px, py, once) for every texel centre the `drawn` triangles cover
-// (edges inclusive): t the triangle, r its set-up (set_up[d] for drawn[d], rows[d] its rows), k
-// the texel's index, (px, py) its centre, and once whether the centre counts for this triangle
-// when the surfaces along the ray are counted (a centre on an edge two triangles share counts
-// for exactly one of them); r.Depth(px, py) is its depth. tiles: null, or the tiles to draw; a
-// triangle whose box meets none is skipped. Row bands run in parallel, each drawing every
-// triangle that crosses its rows, so a texel is handled by one band only, its triangles in
-// `drawn` order, whatever the banding: a fragment may write texel k's entries without a lock
-// and the result does not depend on the thread count.
+// The positions in `drawn` of the triangles whose box meets a marked tile, ascending: what a
+// pass over a few tiles draws (the others are not scanned by every row band).
+inline void TrianglesOnTiles(std::span<const RasterBox> boxes, const RasterWindow& w,
+                             const TileMask& tiles, std::vector<uint32_t>* positions) {
+  positions->clear();
+  for (size_t d = 0; d < boxes.size(); ++d) {
+    const RasterBox& b = boxes[d];
+    const int64_t j_begin = std::max<int64_t>(b.first, 0);
+    const int64_t j_end = std::min<int64_t>(b.last + 1, w.height);
+    const int64_t i_begin = std::max<int64_t>(b.left, 0);
+    const int64_t i_end = std::min<int64_t>(b.right + 1, w.width);
+    if (j_begin >= j_end || i_begin >= i_end) continue;  // also a triangle with no area
+    if (tiles.Any(i_begin, i_end, j_begin, j_end)) positions->push_back(static_cast<uint32_t>(d));
+  }
+}
+
+// Calls fragment(t, r, k, px, py, once) for every texel centre the triangles at `positions` in
+// `drawn` cover (edges inclusive; null positions: every drawn triangle): t the triangle, r its
+// set-up (set_up[d] for drawn[d], boxes[d] its box), k the texel's index, (px, py) its centre, and
+// once whether the centre counts for this triangle when the surfaces along the ray are counted (a
+// centre on an edge two triangles share counts for exactly one of them); r.Depth(px, py) is its
+// depth. Row bands run in parallel, each drawing every triangle that crosses its rows, so a texel
+// is handled by one band only, its triangles in `drawn` order, whatever the banding: a fragment
+// may write texel k's entries without a lock and the result does not depend on the thread count.
 template <class Fragment>
 void RasterizeInBands(std::span<const uint32_t> drawn, std::span<const RasterTriangle> set_up,
-                      std::span<const RasterRows> rows, const RasterWindow& w,
-                      const TileMask* tiles, Fragment&& fragment) {
+                      std::span<const RasterBox> boxes, const RasterWindow& w,
+                      const std::vector<uint32_t>* positions, Fragment&& fragment) {
   const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};  // balance, not results
   const int64_t rows_per_band = std::max<int64_t>(8, (w.height + bands - 1) / bands);
   const int64_t band_count = (w.height + rows_per_band - 1) / rows_per_band;
+  const size_t count = positions != nullptr ? positions->size() : drawn.size();
   ParallelFor(band_count, 1, [&](int64_t band) {
     const int64_t row_begin = band * rows_per_band;
     const int64_t row_end = std::min(w.height, row_begin + rows_per_band);
-    for (size_t d = 0; d < drawn.size(); ++d) {
-      const int64_t j_begin = std::max<int64_t>(rows[d].first, row_begin);
-      const int64_t j_end = std::min<int64_t>(rows[d].last + 1, row_end);
+    for (size_t n = 0; n < count; ++n) {
+      const size_t d = positions != nullptr ? (*positions)[n] : n;
+      const RasterBox& b = boxes[d];
+      const int64_t j_begin = std::max<int64_t>(b.first, row_begin);
+      const int64_t j_end = std::min<int64_t>(b.last + 1, row_end);
       if (j_begin >= j_end) continue;
-      const RasterTriangle& r = set_up[d];
-      const int64_t i_begin = std::max<int64_t>(r.i_lo, 0), i_end = std::min(r.i_hi + 1, w.width);
-      if (j_begin >= j_end || i_begin >= i_end) continue;  // also a triangle with no area
-      if (tiles != nullptr && !tiles->Any(i_begin, i_end, j_begin, j_end)) continue;
-      DrawTriangleRows(drawn[d], r, j_begin, j_end, i_begin, i_end, w.width, fragment);
+      const int64_t i_begin = std::max<int64_t>(b.left, 0);
+      const int64_t i_end = std::min<int64_t>(b.right + 1, w.width);
+      if (i_begin >= i_end) continue;  // also a triangle with no area
+      DrawTriangleRows(drawn[d], set_up[d], j_begin, j_end, i_begin, i_end, w.width, fragment);
     }
   });
 }
@@ -250,7 +271,7 @@ void RasterizeInBands(std::span<const uint32_t> drawn, std::span<const RasterTri
 // Sets up set_up[d] for each drawn[d] in parallel; a triangle with no area gets an empty box.
 inline void SetUpTriangles(const Float3* vertices, const uint32_t* triangles,
                            std::span<const uint32_t> drawn, const RasterWindow& w,
-                           std::span<RasterTriangle> set_up, std::span<RasterRows> rows) {
+                           std::span<RasterTriangle> set_up, std::span<RasterBox> boxes) {
   ParallelFor(static_cast<int64_t>(drawn.size()), 2048, [&](int64_t d) {
     const size_t n = static_cast<size_t>(d);
     RasterTriangle& r = set_up[n];
@@ -259,7 +280,8 @@ inline void SetUpTriangles(const Float3* vertices, const uint32_t* triangles,
       r.i_lo = r.j_lo = 0;
       r.i_hi = r.j_hi = -1;
     }
-    rows[n] = {static_cast<int32_t>(r.j_lo), static_cast<int32_t>(r.j_hi)};  // |j| <= 16385
+    boxes[n] = {static_cast<int32_t>(r.j_lo), static_cast<int32_t>(r.j_hi),  // |j| <= 16385
+                static_cast<int32_t>(r.i_lo), static_cast<int32_t>(r.i_hi)};
   });
 }
 

@@ -30,7 +30,7 @@ namespace drape {
 namespace detail {
 struct RasterWindow;     // body_map/raster_triangle.h
 struct RasterTriangle;   // body_map/raster_triangle.h
-struct RasterRows;       // body_map/raster_triangle.h
+struct RasterBox;        // body_map/raster_triangle.h
 struct TriangleShading;  // body_map/raster_triangle.h
 }  // namespace detail
 
@@ -49,7 +49,7 @@ struct BodyMapRenderOptions {
   // the front surface, gap by gap going down, from raster passes that count the surfaces along
   // each texel's ray. Without them the air between an arm and the chest is inside; a texel whose
   // surfaces do not nest there (an open or inconsistently wound mesh) keeps its slab. They cost
-  // 1.5-3x the render without them, the most where parts sink into each other.
+  // 1.3-1.7x the render without them, the most where parts sink into each other.
   uint32_t air_gaps = 3;
 };
 
@@ -127,10 +127,14 @@ class BodyMapRenderer {
   size_t memory_bytes() const;  // the renderer's buffers, not the collider's
 
  private:
-  struct FoundGap {         // one air gap the gap passes found
+  struct FoundGap {         // one air gap the gap search found
     uint32_t texel, level;  // row-major texel; level 0: the first gap below the front (0-2)
     float upper, lower;     // view-frame z of its boundaries
     uint32_t upper_face, lower_face;
+  };
+  struct GapFragment {    // one surface on a gap texel's ray
+    float z;              // view-frame depth at the texel centre
+    uint32_t face_flags;  // the triangle, | kEnteringBit, | kCountsOnceBit
   };
   struct Window {                           // the texel grid of one render
     double origin_x = 0.0, origin_y = 0.0;  // metres, a multiple of the texel size
@@ -143,11 +147,11 @@ class BodyMapRenderer {
   void CullTriangles(const RenderRegion& region);
   Status PlaceWindow(const RenderRegion& region, Window* window) const;
   void Rasterize(const Window& window, BodyMapCollider* maps);
-  // The gap passes (body_map_renderer_gaps.cpp).
+  // The gap search (body_map_renderer_gaps.cpp).
   void FindGaps(const Window& window, BodyMapCollider* maps);
-  void FindUpperBoundariesBelow(const Window& window);
-  void RasterizeGapSurfaces(const Window& window, const BodyMapCollider& maps, bool all);
-  void CollectGaps(BodyMapCollider* maps);
+  void SelectGapTexels(const BodyMapCollider& maps, size_t texels);
+  void CollectGapFragments(const Window& window);
+  uint32_t SearchTexelGaps(uint32_t candidate, BodyMapCollider* maps, FoundGap* found);
   void PublishGaps(const Window& window, BodyMapCollider* maps);
   void SetUpShading(const Window& window);
   void ShadeNormals(const Window& window, BodyMapCollider* maps) const;
@@ -167,23 +171,25 @@ class BodyMapRenderer {
   std::vector<Float3> face_normals_;              // per triangle, unnormalised (twice the area)
   std::vector<uint32_t> drawn_;                   // triangles that reach the region, ascending
   std::vector<detail::RasterTriangle> raster_;    // per drawn triangle, window coordinates
-  std::vector<detail::RasterRows> raster_rows_;   // per drawn triangle, its rows
+  std::vector<detail::RasterBox> raster_boxes_;   // per drawn triangle, its box
   std::vector<detail::TriangleShading> shading_;  // per triangle; set for the drawn ones
   std::vector<uint32_t> top_face_;                // per texel: the triangle of the front surface
   std::vector<uint32_t> bottom_face_;             // per texel: the triangle of the back surface
-  // The gap passes (air_gaps), per texel: the highest surface leaving the body going along -z
-  // below where the search is (the candidate upper boundary) and its triangle; the highest
-  // entering one below it (the lower boundary) and its triangle; the winding count just below the
-  // candidate and at the end of the ray (surfaces entering less leaving); flags (gaps.cpp).
-  std::vector<float> exit_z_, entry_z_;
-  std::vector<uint32_t> exit_face_, entry_face_;
-  std::vector<int16_t> winding_above_, winding_total_;
-  std::vector<uint8_t> gap_flags_;
-  std::vector<float> below_z_;      // per texel: where the next search starts, -inf: not searching
-  std::vector<uint8_t> gap_count_;  // per texel: the gaps found
-  std::vector<uint32_t> searching_, next_searching_;  // texels, ascending
-  std::vector<FoundGap> found_;                       // the gaps found, pass by pass
-  std::vector<uint8_t> gap_tiles_;                    // per 8 x 8 tile: whether a gap may lie in it
+  // The gap search (air_gaps). Per texel, from the raster pass: the highest surface leaving the
+  // body going along -z (the first candidate upper boundary) and its triangle, and how many
+  // surfaces its ray crosses (then the fragments still to collect, 0 off the gap texels).
+  std::vector<float> exit_z_;
+  std::vector<uint32_t> exit_face_;
+  std::vector<uint32_t> fragment_count_;
+  std::vector<uint32_t> fragment_cursor_;   // per texel: where its next fragment goes
+  std::vector<uint32_t> gap_texels_;        // texels where a gap may lie, ascending
+  std::vector<uint32_t> fragment_offsets_;  // per gap texel: its fragments' start, and the end
+  std::vector<GapFragment> fragments_;      // every surface on the gap texels' rays, in draw order
+  std::vector<uint8_t> gaps_per_texel_;     // per gap texel: the gaps found
+  std::vector<FoundGap> texel_gaps_;        // per gap texel: air_gaps slots
+  std::vector<FoundGap> found_;             // the gaps found, by texel, then level
+  std::vector<uint8_t> gap_tiles_;          // per 8 x 8 tile: whether a gap texel lies in it
+  std::vector<uint32_t> gap_triangles_;     // positions in drawn_ of the triangles on those tiles
   size_t reserved_texels_ = 0;
 };
 
