@@ -124,6 +124,8 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   face_normals_.resize(triangles);
   shading_.resize(triangles);
   drawn_.reserve(triangles);
+  all_boxes_.reserve(triangles);
+  raster_faces_.reserve(triangles);
   if (o.air_gaps > 0) gap_triangles_.reserve(triangles);
   raster_.reserve(triangles);
   raster_boxes_.reserve(triangles);
@@ -181,6 +183,16 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   if (memory_bytes() != bytes) ++stats_.grew;  // more gap texels or surfaces than reserved
   stats_.grew = std::min(stats_.grew, grew_before + 1);
   return Status::Ok();
+}
+
+std::span<const uint32_t> BodyMapRenderer::RasterFaces() const {
+  return {raster_faces_.data(), raster_count_};
+}
+std::span<const detail::RasterTriangle> BodyMapRenderer::RasterSetUps() const {
+  return {raster_.data(), raster_count_};
+}
+std::span<const detail::RasterBox> BodyMapRenderer::RasterBoxes() const {
+  return {raster_boxes_.data(), raster_count_};
 }
 
 detail::RasterWindow BodyMapRenderer::RasterWindowOf(const Window& window) const {
@@ -386,12 +398,16 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   BodyMapCollider::Slab* slabs = maps->slabs_.data();
   const bool gaps = options_.air_gaps > 0;
   const detail::RasterWindow w = RasterWindowOf(window);
-  raster_.resize(drawn_.size());  // reserved for every triangle at Init
-  raster_boxes_.resize(drawn_.size());
-  detail::SetUpTriangles(offset_.data(), mesh_->triangles.data(), drawn_, w, raster_,
-                         raster_boxes_);
+  // Reserved for every triangle at Init; never shrunk (a set-up is 208 bytes to clear again).
+  const size_t drawn = drawn_.size();
+  all_boxes_.resize(std::max(all_boxes_.size(), drawn));
+  raster_faces_.resize(std::max(raster_faces_.size(), drawn));
+  raster_boxes_.resize(std::max(raster_boxes_.size(), drawn));
+  raster_.resize(std::max(raster_.size(), drawn));
+  raster_count_ = detail::SetUpTriangles(offset_.data(), mesh_->triangles.data(), drawn_, w,
+                                         all_boxes_, raster_faces_, raster_boxes_, raster_);
   detail::RasterizeInBands(
-      drawn_, raster_, raster_boxes_, w, nullptr,
+      RasterFaces(), RasterSetUps(), RasterBoxes(), w, nullptr,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
         const float z = r.Depth(px, py);
         BodyMapCollider::Slab& s = slabs[k];
@@ -418,9 +434,9 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
 void BodyMapRenderer::SetUpShading(const Window& window) {
   const double inverse_texel = 1.0 / static_cast<double>(options_.texel_size);
   const uint32_t* tri = mesh_->triangles.data();
-  const int64_t drawn = static_cast<int64_t>(drawn_.size());
-  detail::ParallelFor(drawn, kVertexGrain, [&](int64_t d) {
-    const uint32_t t = drawn_[d];
+  // Only a triangle that covers a texel centre can give a texel its normal.
+  detail::ParallelFor(static_cast<int64_t>(raster_count_), kVertexGrain, [&](int64_t c) {
+    const uint32_t t = raster_faces_[static_cast<size_t>(c)];
     shading_[t].SetUp(offset_.data(), normals_.data(), tri + 3 * size_t{t}, face_normals_[t],
                       window.origin_x, window.origin_y, inverse_texel);
   });
@@ -508,9 +524,9 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
 size_t BodyMapRenderer::memory_bytes() const {
   return sizeof(*this) +
          (vertex_triangle_offsets_.capacity() + vertex_triangles_.capacity() + drawn_.capacity() +
-          gap_triangles_.capacity() + top_face_.capacity() + bottom_face_.capacity() +
-          exit_face_.capacity() + fragment_count_.capacity() + fragment_cursor_.capacity() +
-          gap_texels_.capacity() + fragment_offsets_.capacity()) *
+          raster_faces_.capacity() + gap_triangles_.capacity() + top_face_.capacity() +
+          bottom_face_.capacity() + exit_face_.capacity() + fragment_count_.capacity() +
+          fragment_cursor_.capacity() + gap_texels_.capacity() + fragment_offsets_.capacity()) *
              sizeof(uint32_t) +
          exit_z_.capacity() * sizeof(float) + fragments_.capacity() * sizeof(GapFragment) +
          (texel_gaps_.capacity() + found_.capacity()) * sizeof(FoundGap) +
@@ -519,7 +535,8 @@ size_t BodyMapRenderer::memory_bytes() const {
              sizeof(Float3) +
          shading_.capacity() * sizeof(detail::TriangleShading) +
          raster_.capacity() * sizeof(detail::RasterTriangle) +
-         raster_boxes_.capacity() * sizeof(detail::RasterBox) + gap_tiles_.capacity();
+         (raster_boxes_.capacity() + all_boxes_.capacity()) * sizeof(detail::RasterBox) +
+         gap_tiles_.capacity();
 }
 
 }  // namespace drape

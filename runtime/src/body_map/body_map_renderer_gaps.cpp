@@ -93,9 +93,9 @@ void BodyMapRenderer::CollectGapFragments(const Window& window) {
   for (const uint32_t k : gap_texels_) tiles.Mark(int64_t{k} % width, int64_t{k} / width);
   if (gap_texels_.empty()) return;
   const detail::RasterWindow w = RasterWindowOf(window);
-  detail::TrianglesOnTiles(raster_boxes_, w, tiles, &gap_triangles_);
+  detail::TrianglesOnTiles(RasterBoxes(), tiles, &gap_triangles_);
   detail::RasterizeInBands(
-      drawn_, raster_, raster_boxes_, w, &gap_triangles_,
+      RasterFaces(), RasterSetUps(), RasterBoxes(), w, &gap_triangles_,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool once) {
         uint32_t& left = fragment_count_[k];  // the same coverage as the raster pass counted
         if (left == 0) return;

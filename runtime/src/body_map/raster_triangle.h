@@ -63,19 +63,26 @@ struct RasterTriangle {
   // Counter-clockwise in the window: the drawn (offset) triangle's normal points to +z, so going
   // along -z the ray enters the body through it (false: leaves it).
   bool entering;
-  int64_t i_lo, i_hi, j_lo, j_hi;  // texel centres the triangle's box holds (may be empty)
 
-  // False when the triangle has no area in the window (it covers no texel centre).
-  bool SetUp(const Float3* vertices, const uint32_t v[3], double origin_x, double origin_y,
-             double inverse_texel, double width, double height) {
+  // Window coordinates (texel units) and depths of a triangle's corners.
+  struct Corners {
     double x[3], y[3], z[3];
+    double Area2() const { return (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]); }
+  };
+  static Corners CornersOf(const Float3* vertices, const uint32_t v[3], double origin_x,
+                           double origin_y, double inverse_texel) {
+    Corners c;
     for (int k = 0; k < 3; ++k) {
-      x[k] = (static_cast<double>(vertices[v[k]].x) - origin_x) * inverse_texel;
-      y[k] = (static_cast<double>(vertices[v[k]].y) - origin_y) * inverse_texel;
-      z[k] = vertices[v[k]].z;
+      c.x[k] = (static_cast<double>(vertices[v[k]].x) - origin_x) * inverse_texel;
+      c.y[k] = (static_cast<double>(vertices[v[k]].y) - origin_y) * inverse_texel;
+      c.z[k] = vertices[v[k]].z;
     }
-    const double area2 = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-    if (!(area2 != 0.0)) return false;
+    return c;
+  }
+
+  // The edges and the depth plane of a triangle with area (corners.Area2() != 0).
+  void SetUp(const Corners& c, const uint32_t v[3]) {
+    const double area2 = c.Area2();
     const double orientation = area2 > 0.0 ? 1.0 : -1.0;
     entering = area2 > 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -85,27 +92,20 @@ struct RasterTriangle {
         std::swap(from, to);
         sign = -sign;
       }
-      const double dy = y[to] - y[from];
-      edge[k] = {x[from], y[from], x[to] - x[from], dy, sign, dy != 0.0 ? 1.0 / dy : 0.0};
+      const double dy = c.y[to] - c.y[from];
+      edge[k] = {c.x[from], c.y[from], c.x[to] - c.x[from], dy, sign, dy != 0.0 ? 1.0 / dy : 0.0};
     }
-    x0 = x[0];
-    y0 = y[0];
+    x0 = c.x[0];
+    y0 = c.y[0];
     const double inverse_area2 = 1.0 / area2;
+    const double* x = c.x;
+    const double* y = c.y;
+    const double* z = c.z;
     grad_x = ((z[1] - z[0]) * (y[2] - y[0]) - (z[2] - z[0]) * (y[1] - y[0])) * inverse_area2;
     grad_y = ((z[2] - z[0]) * (x[1] - x[0]) - (z[1] - z[0]) * (x[2] - x[0])) * inverse_area2;
     z0 = z[0];
     z_min = std::min({z[0], z[1], z[2]});
     z_max = std::max({z[0], z[1], z[2]});
-    // Centres c = i + 1/2 within [min, max]: i in [ceil(min - 1/2), floor(max - 1/2)], kept
-    // within the window before the conversion (a vertex far outside a region).
-    const auto index = [](double c, double size) {
-      return static_cast<int64_t>(std::clamp(c, -1.0, size));
-    };
-    i_lo = index(std::ceil(std::min({x[0], x[1], x[2]}) - 0.5), width);
-    i_hi = index(std::floor(std::max({x[0], x[1], x[2]}) - 0.5), width);
-    j_lo = index(std::ceil(std::min({y[0], y[1], y[2]}) - 0.5), height);
-    j_hi = index(std::floor(std::max({y[0], y[1], y[2]}) - 0.5), height);
-    return true;
   }
   // The plane's z at a texel centre, clamped to the vertices' range (a sliver's steep gradient
   // cannot extrapolate past its corners).
@@ -212,77 +212,108 @@ struct TileMask {
   }
 };
 
-// The texel box a set-up triangle holds, kept apart from the set-up: each row band scans every
-// triangle's box, and a 200-byte set-up per triangle would stream through the cache.
+// The texel box a triangle holds, kept apart from its set-up: each row band scans every
+// triangle's box, and a 208-byte set-up per triangle would stream through the cache.
 struct RasterBox {
   int32_t first, last;  // texel rows, within [-1, height]; first > last: none
   int32_t left, right;  // texel columns, within [-1, width]
+
+  // The texel centres c = i + 1/2 within the corners' box: i in [ceil(min - 1/2),
+  // floor(max - 1/2)], kept within the window before the conversion (a vertex far outside a
+  // region); empty (first > last) when it holds no centre of the window or the triangle has no
+  // area.
+  static RasterBox Of(const RasterTriangle::Corners& c, int64_t width, int64_t height) {
+    const auto index = [](double x, int64_t size) {
+      return static_cast<int32_t>(std::clamp(x, -1.0, static_cast<double>(size)));
+    };
+    RasterBox b;
+    b.left = index(std::ceil(std::min({c.x[0], c.x[1], c.x[2]}) - 0.5), width);
+    b.right = index(std::floor(std::max({c.x[0], c.x[1], c.x[2]}) - 0.5), width);
+    b.first = index(std::ceil(std::min({c.y[0], c.y[1], c.y[2]}) - 0.5), height);
+    b.last = index(std::floor(std::max({c.y[0], c.y[1], c.y[2]}) - 0.5), height);
+    const bool holds = std::max(b.left, 0) < std::min<int64_t>(int64_t{b.right} + 1, width) &&
+                       std::max(b.first, 0) < std::min<int64_t>(int64_t{b.last} + 1, height);
+    if (!holds || !(c.Area2() != 0.0)) b = {0, -1, 0, -1};
+    return b;
+  }
 };
 
-// The positions in `drawn` of the triangles whose box meets a marked tile, ascending: what a
-// pass over a few tiles draws (the others are not scanned by every row band).
-inline void TrianglesOnTiles(std::span<const RasterBox> boxes, const RasterWindow& w,
-                             const TileMask& tiles, std::vector<uint32_t>* positions) {
+// The positions (in the set-up triangles) of those whose box meets a marked tile, ascending: what
+// a pass over a few tiles draws (the others are not scanned by every row band).
+inline void TrianglesOnTiles(std::span<const RasterBox> boxes, const TileMask& tiles,
+                             std::vector<uint32_t>* positions) {
   positions->clear();
-  for (size_t d = 0; d < boxes.size(); ++d) {
-    const RasterBox& b = boxes[d];
-    const int64_t j_begin = std::max<int64_t>(b.first, 0);
-    const int64_t j_end = std::min<int64_t>(b.last + 1, w.height);
-    const int64_t i_begin = std::max<int64_t>(b.left, 0);
-    const int64_t i_end = std::min<int64_t>(b.right + 1, w.width);
-    if (j_begin >= j_end || i_begin >= i_end) continue;  // also a triangle with no area
-    if (tiles.Any(i_begin, i_end, j_begin, j_end)) positions->push_back(static_cast<uint32_t>(d));
+  for (size_t c = 0; c < boxes.size(); ++c) {
+    const RasterBox& b = boxes[c];  // within the window, not empty
+    if (tiles.Any(b.left, int64_t{b.right} + 1, b.first, int64_t{b.last} + 1))
+      positions->push_back(static_cast<uint32_t>(c));
   }
 }
 
-// Calls fragment(t, r, k, px, py, once) for every texel centre the triangles at `positions` in
-// `drawn` cover (edges inclusive; null positions: every drawn triangle): t the triangle, r its
-// set-up (set_up[d] for drawn[d], boxes[d] its box), k the texel's index, (px, py) its centre, and
-// once whether the centre counts for this triangle when the surfaces along the ray are counted (a
-// centre on an edge two triangles share counts for exactly one of them); r.Depth(px, py) is its
-// depth. Row bands run in parallel, each drawing every triangle that crosses its rows, so a texel
-// is handled by one band only, its triangles in `drawn` order, whatever the banding: a fragment
-// may write texel k's entries without a lock and the result does not depend on the thread count.
+// Calls fragment(t, r, k, px, py, once) for every texel centre the set-up triangles at
+// `positions` cover (edges inclusive; null positions: all of them): t the triangle (faces[c]), r
+// its set-up (set_up[c], boxes[c] its box within the window), k the texel's index, (px, py) its
+// centre, and once whether the centre counts for this triangle when the surfaces along the ray
+// are counted (a centre on an edge two triangles share counts for exactly one of them);
+// r.Depth(px, py) is its depth. Row bands run in parallel, each drawing every triangle that
+// crosses its rows, so a texel is handled by one band only, its triangles in order, whatever the
+// banding: a fragment may write texel k's entries without a lock and the result does not depend
+// on the thread count.
 template <class Fragment>
-void RasterizeInBands(std::span<const uint32_t> drawn, std::span<const RasterTriangle> set_up,
+void RasterizeInBands(std::span<const uint32_t> faces, std::span<const RasterTriangle> set_up,
                       std::span<const RasterBox> boxes, const RasterWindow& w,
                       const std::vector<uint32_t>* positions, Fragment&& fragment) {
   const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};  // balance, not results
   const int64_t rows_per_band = std::max<int64_t>(8, (w.height + bands - 1) / bands);
   const int64_t band_count = (w.height + rows_per_band - 1) / rows_per_band;
-  const size_t count = positions != nullptr ? positions->size() : drawn.size();
+  const size_t count = positions != nullptr ? positions->size() : faces.size();
   ParallelFor(band_count, 1, [&](int64_t band) {
     const int64_t row_begin = band * rows_per_band;
     const int64_t row_end = std::min(w.height, row_begin + rows_per_band);
     for (size_t n = 0; n < count; ++n) {
-      const size_t d = positions != nullptr ? (*positions)[n] : n;
-      const RasterBox& b = boxes[d];
+      const size_t c = positions != nullptr ? (*positions)[n] : n;
+      const RasterBox& b = boxes[c];
       const int64_t j_begin = std::max<int64_t>(b.first, row_begin);
-      const int64_t j_end = std::min<int64_t>(b.last + 1, row_end);
+      const int64_t j_end = std::min<int64_t>(int64_t{b.last} + 1, row_end);
       if (j_begin >= j_end) continue;
-      const int64_t i_begin = std::max<int64_t>(b.left, 0);
-      const int64_t i_end = std::min<int64_t>(b.right + 1, w.width);
-      if (i_begin >= i_end) continue;  // also a triangle with no area
-      DrawTriangleRows(drawn[d], set_up[d], j_begin, j_end, i_begin, i_end, w.width, fragment);
+      DrawTriangleRows(faces[c], set_up[c], j_begin, j_end, b.left, int64_t{b.right} + 1, w.width,
+                       fragment);
     }
   });
 }
 
-// Sets up set_up[d] for each drawn[d] in parallel; a triangle with no area gets an empty box.
-inline void SetUpTriangles(const Float3* vertices, const uint32_t* triangles,
-                           std::span<const uint32_t> drawn, const RasterWindow& w,
-                           std::span<RasterTriangle> set_up, std::span<RasterBox> boxes) {
+// The triangles that cover a texel centre of the window, set up in `drawn` order: faces[c] the
+// triangle, boxes[c] its box (clipped to the window), set_up[c] its edges and depth plane.
+// Boxes first (most triangles of a finely meshed body at a coarse texel cover no centre), then
+// the set-up of the covering ones only. `all_boxes`: scratch, one per drawn triangle. Returns
+// how many cover a centre.
+inline size_t SetUpTriangles(const Float3* vertices, const uint32_t* triangles,
+                             std::span<const uint32_t> drawn, const RasterWindow& w,
+                             std::span<RasterBox> all_boxes, std::span<uint32_t> faces,
+                             std::span<RasterBox> boxes, std::span<RasterTriangle> set_up) {
+  const auto corners = [&](uint32_t t) {
+    return RasterTriangle::CornersOf(vertices, triangles + 3 * size_t{t}, w.origin_x, w.origin_y,
+                                     w.inverse_texel);
+  };
   ParallelFor(static_cast<int64_t>(drawn.size()), 2048, [&](int64_t d) {
     const size_t n = static_cast<size_t>(d);
-    RasterTriangle& r = set_up[n];
-    if (!r.SetUp(vertices, triangles + 3 * size_t{drawn[n]}, w.origin_x, w.origin_y,
-                 w.inverse_texel, static_cast<double>(w.width), static_cast<double>(w.height))) {
-      r.i_lo = r.j_lo = 0;
-      r.i_hi = r.j_hi = -1;
-    }
-    boxes[n] = {static_cast<int32_t>(r.j_lo), static_cast<int32_t>(r.j_hi),  // |j| <= 16385
-                static_cast<int32_t>(r.i_lo), static_cast<int32_t>(r.i_hi)};
+    all_boxes[n] = RasterBox::Of(corners(drawn[n]), w.width, w.height);
   });
+  size_t count = 0;
+  for (size_t d = 0; d < drawn.size(); ++d) {
+    const RasterBox& b = all_boxes[d];
+    if (b.first > b.last) continue;
+    faces[count] = drawn[d];
+    boxes[count] = {
+        std::max(b.first, 0), static_cast<int32_t>(std::min<int64_t>(b.last, w.height - 1)),
+        std::max(b.left, 0), static_cast<int32_t>(std::min<int64_t>(b.right, w.width - 1))};
+    ++count;
+  }
+  ParallelFor(static_cast<int64_t>(count), 2048, [&](int64_t c) {
+    const size_t n = static_cast<size_t>(c);
+    set_up[n].SetUp(corners(faces[n]), triangles + 3 * size_t{faces[n]});
+  });
+  return count;
 }
 
 }  // namespace drape::detail

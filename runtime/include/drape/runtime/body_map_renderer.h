@@ -141,6 +141,10 @@ class BodyMapRenderer {
     uint32_t width = 0, height = 0;         // texels
   };
   detail::RasterWindow RasterWindowOf(const Window& window) const;
+  // The triangles of the last raster set-up that cover a texel centre, in draw order.
+  std::span<const uint32_t> RasterFaces() const;
+  std::span<const detail::RasterTriangle> RasterSetUps() const;
+  std::span<const detail::RasterBox> RasterBoxes() const;
   Status CheckRegion(const RenderRegion& region) const;
   Status SkinAndOffset(std::span<const Mat34> skinning);
   void ComputeNormals();
@@ -165,13 +169,18 @@ class BodyMapRenderer {
   // Per vertex: the triangles around it (compressed rows), for gathered normals.
   std::vector<uint32_t> vertex_triangle_offsets_;
   std::vector<uint32_t> vertex_triangles_;
-  std::vector<Float3> posed_;                     // skinned vertices
-  std::vector<Float3> normals_;                   // unit vertex normals (zero where undefined)
-  std::vector<Float3> offset_;                    // posed + epsilon * normal
-  std::vector<Float3> face_normals_;              // per triangle, unnormalised (twice the area)
-  std::vector<uint32_t> drawn_;                   // triangles that reach the region, ascending
-  std::vector<detail::RasterTriangle> raster_;    // per drawn triangle, window coordinates
-  std::vector<detail::RasterBox> raster_boxes_;   // per drawn triangle, its box
+  std::vector<Float3> posed_;         // skinned vertices
+  std::vector<Float3> normals_;       // unit vertex normals (zero where undefined)
+  std::vector<Float3> offset_;        // posed + epsilon * normal
+  std::vector<Float3> face_normals_;  // per triangle, unnormalised (twice the area)
+  std::vector<uint32_t> drawn_;       // triangles that reach the region, ascending
+  // The drawn triangles' boxes; then those covering a texel centre (raster_count_ of them, in
+  // draw order): the triangle, its box within the window, its set-up in window coordinates.
+  std::vector<detail::RasterBox> all_boxes_;
+  size_t raster_count_ = 0;
+  std::vector<uint32_t> raster_faces_;
+  std::vector<detail::RasterBox> raster_boxes_;
+  std::vector<detail::RasterTriangle> raster_;
   std::vector<detail::TriangleShading> shading_;  // per triangle; set for the drawn ones
   std::vector<uint32_t> top_face_;                // per texel: the triangle of the front surface
   std::vector<uint32_t> bottom_face_;             // per texel: the triangle of the back surface
