@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "drape/runtime/math.h"
@@ -112,6 +113,11 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   for (uint32_t index : mesh.triangles) ++vertex_triangle_offsets_[index + 1];
   for (uint32_t v = 0; v < vertices; ++v) {
     vertex_triangle_offsets_[v + 1] += vertex_triangle_offsets_[v];
+  }
+  every_vertex_in_a_triangle_ = true;
+  for (uint32_t v = 0; v < vertices; ++v) {
+    if (vertex_triangle_offsets_[v + 1] == vertex_triangle_offsets_[v])
+      every_vertex_in_a_triangle_ = false;
   }
   vertex_triangles_.resize(mesh.triangles.size());
   std::vector<uint32_t> fill(vertex_triangle_offsets_.begin(), vertex_triangle_offsets_.end() - 1);
@@ -278,6 +284,14 @@ void BodyMapRenderer::CullTriangles(const RenderRegion& region) {
   drawn_.clear();
   const uint32_t* tri = mesh_->triangles.data();
   const uint32_t triangles = static_cast<uint32_t>(face_normals_.size());
+  const bool everywhere = region.min.x == -kInf && region.max.x == kInf && region.min.y == -kInf &&
+                          region.max.y == kInf;
+  if (everywhere) {  // the offset surface is finite: every triangle reaches
+    drawn_.resize(triangles);
+    std::iota(drawn_.begin(), drawn_.end(), 0u);
+    stats_.triangles_drawn = triangles;
+    return;
+  }
   for (uint32_t t = 0; t < triangles; ++t) {
     const Float3 a = offset_[tri[3 * t]], b = offset_[tri[3 * t + 1]], c = offset_[tri[3 * t + 2]];
     const bool reaches =
@@ -295,13 +309,17 @@ Status BodyMapRenderer::PlaceWindow(const RenderRegion& region, Window* window) 
   if (drawn_.empty()) return Status::Ok();
   const uint32_t* tri = mesh_->triangles.data();
   double lo_x = kInf, lo_y = kInf, hi_x = -kInf, hi_y = -kInf;
-  for (uint32_t t : drawn_) {
-    for (int k = 0; k < 3; ++k) {
-      const Float3 p = offset_[tri[3 * t + k]];
-      lo_x = std::min<double>(lo_x, p.x);
-      hi_x = std::max<double>(hi_x, p.x);
-      lo_y = std::min<double>(lo_y, p.y);
-      hi_y = std::max<double>(hi_y, p.y);
+  const auto extend = [&](const Float3& p) {
+    lo_x = std::min<double>(lo_x, p.x);
+    hi_x = std::max<double>(hi_x, p.x);
+    lo_y = std::min<double>(lo_y, p.y);
+    hi_y = std::max<double>(hi_y, p.y);
+  };
+  if (drawn_.size() == face_normals_.size() && every_vertex_in_a_triangle_) {
+    for (const Float3& p : offset_) extend(p);  // the same box, a third of the reads
+  } else {
+    for (uint32_t t : drawn_) {
+      for (int k = 0; k < 3; ++k) extend(offset_[tri[3 * t + k]]);
     }
   }
   lo_x = std::max<double>(lo_x, region.min.x);

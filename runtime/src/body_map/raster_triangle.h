@@ -219,18 +219,28 @@ struct RasterBox {
   int32_t left, right;  // texel columns, within [-1, width]
 
   // The texel centres c = i + 1/2 within the corners' box: i in [ceil(min - 1/2),
-  // floor(max - 1/2)], kept within the window before the conversion (a vertex far outside a
+  // floor(max - 1/2)], clamped to the window before the conversion (a vertex far outside a
   // region); empty (first > last) when it holds no centre of the window or the triangle has no
-  // area.
+  // area. Ceil and floor by truncation and a compare: the baseline build has no SSE4.1 rounding.
   static RasterBox Of(const RasterTriangle::Corners& c, int64_t width, int64_t height) {
-    const auto index = [](double x, int64_t size) {
-      return static_cast<int32_t>(std::clamp(x, -1.0, static_cast<double>(size)));
+    const auto clamped = [](double x, int64_t size) {
+      return std::clamp(x, -1.0, static_cast<double>(size));
+    };
+    const auto ceil = [&](double x, int64_t size) {
+      const double y = clamped(x, size);
+      const int32_t t = static_cast<int32_t>(y);
+      return t + (static_cast<double>(t) < y ? 1 : 0);
+    };
+    const auto floor = [&](double x, int64_t size) {
+      const double y = clamped(x, size);
+      const int32_t t = static_cast<int32_t>(y);
+      return t - (static_cast<double>(t) > y ? 1 : 0);
     };
     RasterBox b;
-    b.left = index(std::ceil(std::min({c.x[0], c.x[1], c.x[2]}) - 0.5), width);
-    b.right = index(std::floor(std::max({c.x[0], c.x[1], c.x[2]}) - 0.5), width);
-    b.first = index(std::ceil(std::min({c.y[0], c.y[1], c.y[2]}) - 0.5), height);
-    b.last = index(std::floor(std::max({c.y[0], c.y[1], c.y[2]}) - 0.5), height);
+    b.left = ceil(std::min({c.x[0], c.x[1], c.x[2]}) - 0.5, width);
+    b.right = floor(std::max({c.x[0], c.x[1], c.x[2]}) - 0.5, width);
+    b.first = ceil(std::min({c.y[0], c.y[1], c.y[2]}) - 0.5, height);
+    b.last = floor(std::max({c.y[0], c.y[1], c.y[2]}) - 0.5, height);
     const bool holds = std::max(b.left, 0) < std::min<int64_t>(int64_t{b.right} + 1, width) &&
                        std::max(b.first, 0) < std::min<int64_t>(int64_t{b.last} + 1, height);
     if (!holds || !(c.Area2() != 0.0)) b = {0, -1, 0, -1};

@@ -164,7 +164,8 @@ class BodyMapRenderer {
 
   const MeshData* mesh_ = nullptr;
   BodyMapRenderOptions options_;
-  uint32_t joints_needed_ = 0;  // 1 + the largest joint index the influences name
+  uint32_t joints_needed_ = 0;               // 1 + the largest joint index the influences name
+  bool every_vertex_in_a_triangle_ = false;  // the drawn box is then the vertices' box
   BodyMapRenderStats stats_;
   // Per vertex: the triangles around it (compressed rows), for gathered normals.
   std::vector<uint32_t> vertex_triangle_offsets_;
