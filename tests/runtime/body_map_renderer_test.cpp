@@ -324,6 +324,51 @@ TEST(BodyMapRenderer, StackedPartsKeepEveryGapUpToTheCap) {
   EXPECT_NE(s.message().find("air_gaps 4"), std::string::npos) << s.message();
 }
 
+// Octahedra (radius 1 cm) stacked along the view axis 4 cm apart, all on joint 0: the central
+// rays cross two surfaces per octahedron. Up to 1024 surfaces a ray's air gaps are searched;
+// beyond, the texel keeps its slab (the bound that keeps a hostile mesh's search finite).
+MeshData StackedOctahedra(int count) {
+  const test::UnitSphereMesh unit = test::OctahedronSphere(0);
+  MeshData mesh;
+  for (int k = 0; k < count; ++k) {
+    const uint32_t base = mesh.vertex_count();
+    for (const auto& p : unit.positions) {
+      mesh.positions.push_back({0.01f * static_cast<float>(p[0]), 0.01f * static_cast<float>(p[1]),
+                                0.01f * static_cast<float>(p[2]) - 0.04f * static_cast<float>(k)});
+    }
+    for (const auto& t : unit.triangles)
+      for (uint32_t v : t) mesh.triangles.push_back(base + v);
+  }
+  mesh.influence_offsets.push_back(0);
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    mesh.influence_joints.push_back(0);
+    mesh.influence_weights.push_back(1.f);
+    mesh.influence_offsets.push_back(v + 1);
+  }
+  return mesh;
+}
+
+TEST(BodyMapRenderer, ARayThroughTooManySurfacesKeepsItsSlab) {
+  const Mat34 identity[1] = {Mat34{}};
+  const Float3 first_air{0.f, 0.f, -0.02f};  // between the top two octahedra
+  for (const int count : {300, 600}) {       // 600 and 1200 surfaces on the central rays
+    const MeshData mesh = StackedOctahedra(count);
+    BodyMapRenderer renderer;
+    ASSERT_TRUE(renderer.Init(mesh, Options()).ok());
+    BodyMapCollider maps;
+    ASSERT_TRUE(renderer.Render(identity, &maps).ok());
+    EXPECT_TRUE(maps.IsInside({0.f, 0.f, 0.f})) << count;
+    if (count == 300) {
+      EXPECT_EQ(maps.layers(), 4u);  // the slab and three gaps
+      EXPECT_GT(renderer.stats().gap_texels, 0u);
+      EXPECT_FALSE(maps.IsInside(first_air));
+    } else {
+      EXPECT_EQ(renderer.stats().gap_texels, 0u);  // no texel searched: the air stays inside
+      EXPECT_TRUE(maps.IsInside(first_air));
+    }
+  }
+}
+
 // A part sunk into another (an arm into the torso) above a third with air between: the highest
 // surface leaving the body along the central rays is the sunk part's, still inside the other, so
 // the gap lies below the next leaving surface; the renderer searches on there, as the bake's

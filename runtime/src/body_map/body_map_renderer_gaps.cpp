@@ -39,6 +39,11 @@ constexpr uint32_t kEnteringBit = 1u << 31, kCountsOnceBit = 1u << 30;
 constexpr uint32_t kFaceMask = kCountsOnceBit - 1u;
 // Gap texels per chunk of the search.
 constexpr int64_t kGapTexelGrain = 256;
+// Bounds on what the search collects, against hostile meshes (a human's gap texels cross 4-8
+// surfaces): a texel whose ray crosses more surfaces, or whose surfaces would take the array
+// past the total, is not searched and keeps its slab (the conservative answer).
+constexpr uint32_t kMaxSurfacesPerGapTexel = 1024;
+constexpr uint32_t kMaxGapFragments = 1u << 24;  // 128 MiB
 
 }  // namespace
 
@@ -62,8 +67,8 @@ void BodyMapRenderer::FindGaps(const Window& window, BodyMapCollider* maps) {
 }
 
 // The texels where a gap may lie (the first candidate lies above the back surface, with room for
-// a gap of kMinGap and its two boundaries), ascending, and where each one's surfaces go. The
-// other texels collect nothing (their count drops to 0).
+// a gap of kMinGap and its two boundaries) within the bounds above, ascending, and where each
+// one's surfaces go. The other texels collect nothing (their count drops to 0).
 void BodyMapRenderer::SelectGapTexels(const BodyMapCollider& maps, size_t texels) {
   gap_texels_.clear();
   fragment_offsets_.clear();
@@ -71,14 +76,15 @@ void BodyMapRenderer::SelectGapTexels(const BodyMapCollider& maps, size_t texels
   for (size_t k = 0; k < texels; ++k) {
     const bool room =
         exit_face_[k] != kNoFace && exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap;
-    if (!room) {
+    const uint32_t surfaces = fragment_count_[k];
+    if (!room || surfaces > kMaxSurfacesPerGapTexel || surfaces > kMaxGapFragments - total) {
       fragment_count_[k] = 0;
       continue;
     }
     gap_texels_.push_back(static_cast<uint32_t>(k));
     fragment_offsets_.push_back(total);
     fragment_cursor_[k] = total;
-    total += fragment_count_[k];  // at most 2^30 triangles per texel
+    total += surfaces;
   }
   fragment_offsets_.push_back(total);
   fragments_.resize(total);

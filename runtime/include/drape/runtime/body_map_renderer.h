@@ -48,8 +48,9 @@ struct BodyMapRenderOptions {
   // Air gaps per texel, [0, 3] (the collider's layers() is 1 + the deepest found): the air below
   // the front surface, gap by gap going down, from raster passes that count the surfaces along
   // each texel's ray. Without them the air between an arm and the chest is inside; a texel whose
-  // surfaces do not nest there (an open or inconsistently wound mesh) keeps its slab. They cost
-  // 1.3-1.7x the render without them, the most where parts sink into each other.
+  // surfaces do not nest there (an open or inconsistently wound mesh), or whose ray crosses more
+  // than 1024 surfaces, keeps its slab. They cost 1.3-1.7x the render without them, the most
+  // where parts sink into each other.
   uint32_t air_gaps = 3;
 };
 
