@@ -183,7 +183,7 @@ class BodyMapRenderer {
   std::vector<uint32_t> raster_faces_;
   std::vector<detail::RasterBox> raster_boxes_;
   std::vector<detail::RasterTriangle> raster_;
-  std::vector<detail::TriangleShading> shading_;  // per triangle; set for the drawn ones
+  std::vector<detail::TriangleShading> shading_;  // per triangle; set for raster_faces_
   std::vector<uint32_t> top_face_;                // per texel: the triangle of the front surface
   std::vector<uint32_t> bottom_face_;             // per texel: the triangle of the back surface
   // The gap search (air_gaps). Per texel, from the raster pass: the highest surface leaving the
