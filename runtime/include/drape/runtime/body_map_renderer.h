@@ -107,10 +107,11 @@ class BodyMapRenderer {
 
   // Renders the pose `skinning` (one matrix per joint, SkeletonPose::skinning()) into *maps,
   // replacing what it held (clip -1, time 0). region: null for the whole body. No allocation
-  // unless the window is larger than every earlier one (stats().grew counts those calls). Identical
-  // bits at any thread count. Too few matrices, a non-finite skinned vertex, an empty or inverted
-  // region, or a window over max_side: kInvalidArgument naming the reason, and *maps empty.
-  // Nothing of the body within the region is Ok with *maps empty: skip the maps this frame.
+  // unless the window, or the air gaps' texels and surfaces, outgrow every earlier pose's
+  // (stats().grew counts those calls). Identical bits at any thread count. Too
+  // few matrices, a non-finite skinned vertex, an empty or inverted region, or a window over
+  // max_side: kInvalidArgument naming the reason, and *maps empty. Nothing of the body within the
+  // region is Ok with *maps empty: skip the maps this frame.
   Status Render(std::span<const Mat34> skinning, BodyMapCollider* maps,
                 const RenderRegion* region = nullptr);
 
