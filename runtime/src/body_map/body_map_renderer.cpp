@@ -405,7 +405,6 @@ void BodyMapRenderer::Reserve(size_t texels) {
   fragments_.reserve(4 * gap_texels);
   gaps_per_texel_.reserve(gap_texels);
   texel_gaps_.reserve(gap_texels * options_.air_gaps);
-  found_.reserve(gap_texels * options_.air_gaps);               // as the collider's gaps
   gap_tiles_.reserve(texels / 64 + options_.max_side / 4 + 1);  // 8 x 8 tiles
 }
 
@@ -547,8 +546,7 @@ size_t BodyMapRenderer::memory_bytes() const {
           fragment_cursor_.capacity() + gap_texels_.capacity() + fragment_offsets_.capacity()) *
              sizeof(uint32_t) +
          exit_z_.capacity() * sizeof(float) + fragments_.capacity() * sizeof(GapFragment) +
-         (texel_gaps_.capacity() + found_.capacity()) * sizeof(FoundGap) +
-         gaps_per_texel_.capacity() +
+         texel_gaps_.capacity() * sizeof(FoundGap) + gaps_per_texel_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *
              sizeof(Float3) +
          shading_.capacity() * sizeof(detail::TriangleShading) +

@@ -47,7 +47,7 @@ constexpr uint32_t kMaxGapFragments = 1u << 24;  // 128 MiB
 
 }  // namespace
 
-// Stage 4b: the air gaps into found_, by texel, then level.
+// Stage 4b: the air gaps of each gap texel into its slots of texel_gaps_, top down.
 void BodyMapRenderer::FindGaps(const Window& window, BodyMapCollider* maps) {
   SelectGapTexels(*maps, static_cast<size_t>(window.width) * window.height);
   CollectGapFragments(window);
@@ -60,10 +60,6 @@ void BodyMapRenderer::FindGaps(const Window& window, BodyMapCollider* maps) {
     gaps_per_texel_[n] =
         static_cast<uint8_t>(SearchTexelGaps(n, maps, &texel_gaps_[size_t{n} * slots]));
   });
-  found_.clear();
-  for (size_t c = 0; c < gap_texels_.size(); ++c) {
-    for (uint32_t g = 0; g < gaps_per_texel_[c]; ++g) found_.push_back(texel_gaps_[c * slots + g]);
-  }
 }
 
 // The texels where a gap may lie (the first candidate lies above the back surface, with room for
@@ -169,7 +165,7 @@ uint32_t BodyMapRenderer::SearchTexelGaps(uint32_t candidate, BodyMapCollider* m
     const bool body_below = lower > slab.bottom + kMinGap;
     float below;  // where the next candidate is searched
     if (bounded && body_above && body_below) {
-      found[gaps] = {k, gaps, upper, lower, upper_face, lower_face};
+      found[gaps] = {upper, lower, upper_face, lower_face};
       if (++gaps == options_.air_gaps) break;
       below = lower;
     } else if (bounded && !body_below) {
@@ -206,21 +202,21 @@ void BodyMapRenderer::PublishGaps(const Window& window, BodyMapCollider* maps) {
   const size_t texels = static_cast<size_t>(window.width) * window.height;
   const size_t capacity = maps->gaps_.capacity();
   uint32_t layers = 1;
-  for (const FoundGap& g : found_) layers = std::max(layers, g.level + 1);
+  for (const uint8_t gaps : gaps_per_texel_) layers = std::max<uint32_t>(layers, gaps);
   maps->gap_layers_ = layers;
   maps->gap_texel_bits_.assign((texels + 31) / 32, 0u);
   maps->gaps_.clear();
   maps->gap_normals_.clear();
   const std::array<uint16_t, 2> up = EncodeOct16({0.f, 0.f, 1.f});
-  for (size_t first = 0; first < found_.size();) {
-    const uint32_t k = found_[first].texel;
+  for (size_t c = 0; c < gap_texels_.size(); ++c) {  // ascending texels
+    if (gaps_per_texel_[c] == 0) continue;
+    const uint32_t k = gap_texels_[c];
     maps->gap_texel_bits_[k >> 5] |= 1u << (k & 31u);
     const float px = static_cast<float>(k % window.width) + 0.5f;
     const float py = static_cast<float>(k / window.width) + 0.5f;
-    size_t next = first;
     for (uint32_t level = 0; level < layers; ++level) {
-      if (next < found_.size() && found_[next].texel == k && found_[next].level == level) {
-        const FoundGap& g = found_[next++];
+      if (level < gaps_per_texel_[c]) {
+        const FoundGap& g = texel_gaps_[c * options_.air_gaps + level];
         maps->gaps_.push_back({g.upper, g.lower});
         const std::array<uint16_t, 2> a =
             EncodeOct16(shading_[g.upper_face].At(px, py, Float3{0.f, 0.f, -1.f}));
@@ -232,7 +228,6 @@ void BodyMapRenderer::PublishGaps(const Window& window, BodyMapCollider* maps) {
         maps->gap_normals_.push_back({{up[0], up[1]}, {up[0], up[1]}});
       }
     }
-    first = next;
   }
   if (maps->gaps_.capacity() != capacity) ++stats_.grew;  // more gap texels than reserved
   maps->CountGapsBeforeWords();

@@ -129,9 +129,8 @@ class BodyMapRenderer {
   size_t memory_bytes() const;  // the renderer's buffers, not the collider's
 
  private:
-  struct FoundGap {         // one air gap the gap search found
-    uint32_t texel, level;  // row-major texel; level 0: the first gap below the front (0-2)
-    float upper, lower;     // view-frame z of its boundaries
+  struct FoundGap {      // one air gap the gap search found
+    float upper, lower;  // view-frame z of its boundaries
     uint32_t upper_face, lower_face;
   };
   struct GapFragment {    // one surface on a gap texel's ray
@@ -198,8 +197,7 @@ class BodyMapRenderer {
   std::vector<uint32_t> fragment_offsets_;  // per gap texel: its fragments' start, and the end
   std::vector<GapFragment> fragments_;      // every surface on the gap texels' rays, in draw order
   std::vector<uint8_t> gaps_per_texel_;     // per gap texel: the gaps found
-  std::vector<FoundGap> texel_gaps_;        // per gap texel: air_gaps slots
-  std::vector<FoundGap> found_;             // the gaps found, by texel, then level
+  std::vector<FoundGap> texel_gaps_;        // per gap texel: air_gaps slots, top down
   std::vector<uint8_t> gap_tiles_;          // per 8 x 8 tile: whether a gap texel lies in it
   std::vector<uint32_t> gap_triangles_;     // positions in drawn_ of the triangles on those tiles
   size_t reserved_texels_ = 0;
