@@ -168,14 +168,21 @@ const JsonSchema<BakeConfig>& HullsSection() {
           .Float("max_bloat", "m", OpenBelow(0, 1),
                  "a warning names every hull and joint sphere whose surface reaches farther than "
                  "this outside the body, beyond its delta (the report's \"fit\"); a bone whose "
-                 "convex hull bulges farther is cut into convex pieces (max_pieces)",
+                 "convex hull bulges farther than cut_fraction of it is cut into convex pieces "
+                 "(max_pieces)",
                  [](BakeConfig& c) -> float& { return c.max_bloat; })
-          .Unsigned<uint32_t>("max_pieces", "count", 1, 64,
-                              "a bone's region is cut into at most this many convex pieces, each "
-                              "its own hull, while its hull bulges beyond max_bloat: its separate "
-                              "parts of the mesh (an eye, a fang) first, then plane cuts (a body "
-                              "without a skeleton is one region); 1: one hull per bone (paper B)",
-                              [](BakeConfig& c) -> uint32_t& { return c.hull_max_pieces; })
+          .Float("cut_fraction", "ratio", OpenBelow(0, 1),
+                 "convex pieces are cut until each one's hull bulges at most this fraction of "
+                 "max_bloat out of the body: simplification and inflation make a collider bulge "
+                 "0.5-3.5 mm more than its piece",
+                 [](BakeConfig& c) -> float& { return c.hull_cut_fraction; })
+          .Unsigned<uint32_t>(
+              "max_pieces", "count", 1, 64,
+              "a bone's region is cut into at most this many convex pieces, each its own hull, "
+              "while its hull bulges beyond cut_fraction x max_bloat: its separate parts of the "
+              "mesh (an eye, a fang) first, then plane cuts (a body without a skeleton is one "
+              "region); 1: one hull per bone (paper B)",
+              [](BakeConfig& c) -> uint32_t& { return c.hull_max_pieces; })
           .Enum<ObbMode>(
               "obb",
               {{"covariance", ObbMode::kCovariance}, {"cgal_optimal", ObbMode::kCgalOptimal}},

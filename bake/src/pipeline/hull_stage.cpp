@@ -60,7 +60,7 @@ std::vector<HullJob> HullJobs(const BakeConfig& config, const Regions& regions,
   std::vector<std::vector<ConvexPiece>> split(joints);
   if (config.hull_max_pieces > 1) {
     ConvexPieceOptions options;
-    options.max_bloat = config.max_bloat;
+    options.max_bloat = config.max_bloat * config.hull_cut_fraction;
     options.max_pieces = config.hull_max_pieces;
     // One bone per iteration, results in per-bone slots: identical at any thread count.
 #pragma omp parallel for schedule(dynamic, 1)

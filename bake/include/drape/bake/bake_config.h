@@ -74,11 +74,16 @@ struct BakeConfig {
   // Metres, > 0: the report warns about every hull or joint sphere whose surface reaches farther
   // than this outside the body beyond its delta (the fit, measured against the exact mesh).
   float max_bloat = 0.015f;
-  // >= 1: a bone's region whose convex hull bulges beyond max_bloat is cut into at most this many
-  // convex pieces, each its own hull (regions/convex_pieces.h); 1: one hull per bone (paper B).
-  // Cuts stop once every piece fits max_bloat, so a person's bones use few of them; a 6 m
+  // >= 1: a bone's region whose convex hull bulges beyond cut_fraction x max_bloat is cut into at
+  // most this many convex pieces, each its own hull (regions/convex_pieces.h); 1: one hull per
+  // bone (paper B). Cuts stop once every piece fits, so a person's bones use few of them; a 6 m
   // creature's head of eyes and fangs needs about 30 to stay within 30 mm of the body.
   uint32_t hull_max_pieces = 32;
+  // (0, 1]: pieces are cut to fit this fraction of max_bloat. A collider is its piece's hull
+  // simplified and inflated, which adds 0.5-3.5 mm; pieces cut to max_bloat itself left most
+  // colliders of a creature's legs at 14-17 mm (the Spider's bloat p99 11.1 mm, 26 colliders
+  // beyond 15 mm; at 0.8: p99 8.5 mm, docs/ALGORITHMS.md §2.3).
+  float hull_cut_fraction = 0.8f;
   KirkpatrickOptions kirkpatrick;
   MapTableOptions map_table;
 
