@@ -1,7 +1,8 @@
 #pragma once
 // The hull stage of the bake pipeline (bake_pipeline.cpp): per bone, its region split into convex
-// pieces that fit the body (hulls.max_bloat, hulls.max_pieces), one hull per piece with its OBB,
-// Kirkpatrick hierarchies and map table, and the faces that lie inside the body marked.
+// pieces that fit the body (hulls.cut_fraction x hulls.max_bloat, hulls.max_pieces), one hull per
+// piece with its OBB, Kirkpatrick hierarchies and map table, and the faces that lie inside the
+// body marked.
 
 #include <nlohmann/json.hpp>
 
