@@ -3,12 +3,9 @@
 #include "preview/collider_preview.h"
 
 #include <algorithm>
-#include <cctype>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <span>
 
 #include "config/clip_lookup.h"
 #include "drape/bake/body_map_baker.h"
@@ -21,8 +18,6 @@
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/hull_collider_set.h"
 #include "drape/runtime/math.h"
-#include "drape/runtime/skeleton_pose.h"
-#include "drape/runtime/skinning.h"
 #include "fit/collider_fit.h"
 #include "fit/fit_report.h"
 #include "pipeline/hull_stage.h"
