@@ -162,7 +162,7 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   stats_.gap_texels = 0;
   if (mesh_ == nullptr) return Invalid("not initialised (Init failed or was not called)");
   // A render that enlarged any buffer is counted once, whichever stages grew.
-  const uint32_t grew_before = stats_.grew;
+  grew_ = false;
   const size_t bytes = memory_bytes();
   RenderRegion box;  // everywhere, or the region in the view frame
   if (region != nullptr) {
@@ -186,8 +186,8 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
   maps->Finish();
   stats_.valid_texels = maps->stats().valid_texels;
   stats_.gap_texels = maps->stats().gap_texels;
-  if (memory_bytes() != bytes) ++stats_.grew;  // more gap texels or surfaces than reserved
-  stats_.grew = std::min(stats_.grew, grew_before + 1);
+  // The renderer's own buffers also grow with more gap texels or surfaces than reserved.
+  if (grew_ || memory_bytes() != bytes) ++stats_.grew;
   return Status::Ok();
 }
 
@@ -348,7 +348,7 @@ Status BodyMapRenderer::PlaceWindow(const RenderRegion& region, Window* window) 
 void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   const size_t texels = static_cast<size_t>(window.width) * window.height;
   if (texels > reserved_texels_) {
-    ++stats_.grew;
+    grew_ = true;
     reserved_texels_ = texels;
   }
   Reserve(reserved_texels_);

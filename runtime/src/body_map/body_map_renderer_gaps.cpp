@@ -229,7 +229,7 @@ void BodyMapRenderer::PublishGaps(const Window& window, BodyMapCollider* maps) {
       }
     }
   }
-  if (maps->gaps_.capacity() != capacity) ++stats_.grew;  // more gap texels than reserved
+  if (maps->gaps_.capacity() != capacity) grew_ = true;  // more gap texels than reserved
   maps->CountGapsBeforeWords();
 }
 

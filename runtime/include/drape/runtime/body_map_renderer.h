@@ -201,6 +201,7 @@ class BodyMapRenderer {
   std::vector<uint8_t> gap_tiles_;          // per 8 x 8 tile: whether a gap texel lies in it
   std::vector<uint32_t> gap_triangles_;     // positions in drawn_ of the triangles on those tiles
   size_t reserved_texels_ = 0;
+  bool grew_ = false;  // this Render enlarged the window or the collider's gap storage
 };
 
 }  // namespace drape
