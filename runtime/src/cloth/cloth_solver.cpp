@@ -5,7 +5,6 @@
 #include "cloth/spring_kernels.h"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -26,19 +25,18 @@ using internal::SpringBlock;
 using internal::SpringGroup;
 using internal::SpringRun;
 
+using detail::AnyNonFinite;
 using detail::Finite;
 using detail::InvalidArgument;
+using detail::kNoParticle;
 using detail::kParticleGrain;
 using detail::ParallelFor;
 using detail::ParallelRanges;
 
-constexpr uint32_t kNoParticle = std::numeric_limits<uint32_t>::max();
 constexpr uint32_t kMaxSubsteps = 256;
 constexpr uint32_t kMaxIterations = 256;
-// Blocks of four springs per chunk of a run shared among the workers (the far springs), and
-// springs per chunk of the stretch measure.
+// Blocks of four springs per chunk of a run shared among the workers (the far springs).
 constexpr int64_t kBlockGrain = 256;
-constexpr int64_t kSpringGrain = 4096;
 
 // Adds the time since the last lap to a stage's seconds, when on (measure_stages).
 class StageClock {
@@ -348,6 +346,18 @@ Status ClothSolver::Init(const Cloth& cloth, const ClothSolverSettings& settings
   skin_normal_start_.assign(targets, Float3{});
   skin_normal_end_.assign(targets, Float3{});
   BuildSpringGroups(cloth);
+  IndexConstraints();
+  // The stretch springs are the first spring_count(kStretch) springs (Cloth::springs()).
+  measured_springs_.clear();
+  for (uint32_t j = 0; j < cloth.spring_count(SpringKind::kStretch); ++j) {
+    const ClothSpring& spring = cloth.springs()[j];
+    measured_springs_.push_back(
+        {std::min(spring.a, spring.b), std::max(spring.a, spring.b), spring.rest_length});
+  }
+  std::sort(measured_springs_.begin(), measured_springs_.end(),
+            [](const MeasuredSpring& x, const MeasuredSpring& y) {
+              return x.a != y.a ? x.a < y.a : x.b < y.b;
+            });
   return Status::Ok();
 }
 
@@ -360,16 +370,6 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
   st = ClothStepStats{};
   StageClock setup_clock(settings_.measure_stages, &st.stage_seconds);
   if (Status s = ValidateFrame(*state, colliders, frame); !s.ok()) return s;
-  if (const uint32_t bad = FirstNonFinite(*state); bad != kNoParticle)
-    return Status(StatusCode::kInvalidState,
-                  "ClothSolver::Step: input state of particle " + std::to_string(bad) +
-                      " is not finite (position or velocity); nothing was simulated");
-  setup_clock.Lap(&ClothStageSeconds::bookkeeping);
-  if (colliders.hulls != nullptr) {
-    if (Status s = colliders.hulls->SetPose(frame.skinning_start, frame.skinning_end); !s.ok())
-      return s;
-  }
-  setup_clock.Lap(&ClothStageSeconds::collide);
   const RootMotion root = ComputeRootMotion(frame);
   ComputeSkinnedTargets(frame);
   setup_clock.Lap(&ClothStageSeconds::constraints);
@@ -384,28 +384,38 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
 
     // Each stage hands its chunks to the task system and returns when they are done.
     StageClock clock(settings_.measure_stages, &st.stage_seconds);
-    BeginSubstep(state, root, sub);
+    // The first substep's backup pass also checks the input state, before anything changes it.
+    if (!BeginSubstep(state, root, sub, k == 0)) {
+      const uint32_t bad = FirstNonFinite(*state);
+      return Status(StatusCode::kInvalidState,
+                    "ClothSolver::Step: input state of particle " + std::to_string(bad) +
+                        " is not finite (position or velocity); nothing was simulated");
+    }
     clock.Lap(&ClothStageSeconds::integrate);
+    if (k == 0 && colliders.hulls != nullptr) {
+      if (Status s = colliders.hulls->SetPose(frame.skinning_start, frame.skinning_end); !s.ok())
+        return s;
+      clock.Lap(&ClothStageSeconds::collide);
+    }
     if (!verlet) AccumulateSpringForces(*state);
     clock.Lap(&ClothStageSeconds::springs);
     Integrate(state, sub, root);
     ApplyAttachments(state, frame, sub);
     clock.Lap(&ClothStageSeconds::integrate);
-    if (verlet) SolveSprings(state);
+    if (verlet) SolveSprings();
     clock.Lap(&ClothStageSeconds::springs);
-    ApplyTethers(state, sub);
-    ApplySkinConstraints(state, sub);
+    ConstrainAndUpdateVelocities(state, sub);
     clock.Lap(&ClothStageSeconds::constraints);
-    UpdateVelocities(state, sub);
-    clock.Lap(&ClothStageSeconds::integrate);
     if (Status s = Collide(state, colliders, sub, &st); !s.ok()) {
       if (settings_.guard_blowups) RestoreBackup(state);
       return s;
     }
     RestoreKinematic(state);
     clock.Lap(&ClothStageSeconds::collide);
-    if (const uint32_t bad = settings_.guard_blowups ? FirstNonFinite(*state) : kNoParticle;
-        bad != kNoParticle) {
+    bool blew_up = false;
+    st.contacts = CountContacts(*state, settings_.guard_blowups, &blew_up);
+    if (blew_up) {
+      const uint32_t bad = FirstNonFinite(*state);
       RestoreBackup(state);
       st.contacts = 0;
       st.max_stretch = MaxStretch(*state);
@@ -415,7 +425,6 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
                         " (a blow-up: for explicit Euler use more substeps); the state is left "
                         "at the end of the last valid substep");
     }
-    st.contacts = CountContacts();
     ++st.substeps;
     clock.Lap(&ClothStageSeconds::bookkeeping);
   }
@@ -462,28 +471,47 @@ Status ClothSolver::ValidateFrame(const ClothState& state, const ClothColliders&
 // done, so a stage sees every write of the stages before it.
 
 // The state's backup (restored if the substep fails), then the carried share of the root's
-// motion, in one pass over the particles.
-void ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub) {
+// motion, in one pass over the particles. With check_input, the same pass first checks that the
+// state is finite and, when it is not, returns false having changed nothing (the carry then
+// takes a second pass).
+bool ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub,
+                               bool check_input) {
   Float3* x = state->positions.data();
   Float3* v = state->velocities.data();
   Float3* backup_x = backup_positions_.data();
   Float3* backup_v = backup_velocities_.data();
-  const bool carry = root.carry;
+  const int64_t n = static_cast<int64_t>(state->positions.size());
   const bool backup = settings_.guard_blowups;
-  if (!carry && !backup) return;
+  const bool carry = root.carry;
+  if (check_input) {
+    detail::ChunkSum bad_chunks;
+    ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
+      if (AnyNonFinite(x, v, begin, end)) bad_chunks.Add(1);
+      if (!backup) return;
+      for (int64_t i = begin; i < end; ++i) {
+        backup_x[i] = x[i];
+        backup_v[i] = v[i];
+      }
+    });
+    if (bad_chunks.total() != 0) return false;
+    if (!carry) return true;
+  } else if (!carry && !backup) {
+    return true;
+  }
+  const bool copy = backup && !check_input;  // else copied above
   const Mat34 carried = carry ? CarriedMotion(root, sub) : Mat34{};
-  ParallelRanges(static_cast<int64_t>(state->positions.size()), kParticleGrain,
-                 [&](int64_t begin, int64_t end) {
-                   for (int64_t i = begin; backup && i < end; ++i) {
-                     backup_x[i] = x[i];
-                     backup_v[i] = v[i];
-                   }
-                   if (!carry) return;
-                   for (int64_t i = begin; i < end; ++i) {
-                     x[i] = TransformPoint(carried, x[i]);
-                     v[i] = TransformVector(carried, v[i]);
-                   }
-                 });
+  ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
+    for (int64_t i = begin; copy && i < end; ++i) {
+      backup_x[i] = x[i];
+      backup_v[i] = v[i];
+    }
+    if (!carry) return;
+    for (int64_t i = begin; i < end; ++i) {
+      x[i] = TransformPoint(carried, x[i]);
+      v[i] = TransformVector(carried, v[i]);
+    }
+  });
+  return true;
 }
 
 // The same traversal as SolveSprings (chunks, even zones, odd zones, far runs): every spring
@@ -548,11 +576,16 @@ void ClothSolver::Integrate(ClothState* state, const Substep& sub, const RootMot
   const Float3 pivot = Lerp(root.pivot0, root.pivot1, sub.s0);
   const float centrifugal_scale = (1.f - settings_.angular_inertia) * settings_.centrifugal_inertia;
   const int64_t n = static_cast<int64_t>(state->positions.size());
+  // Verlet: the spring solver's copy too (SolveSprings works on it), in the same pass.
+  Particle4* p = verlet ? solver_positions_.data() : nullptr;
   ParallelFor(n, kParticleGrain, [&](int64_t i) {
     const Float3 xi = x[i];
     x_start[i] = xi;
     const float w = inverse_mass[i];
-    if (w == 0.f) return;  // pinned or attached: moved by the caller or ApplyAttachments
+    if (w == 0.f) {  // pinned or attached: moved by the caller or ApplyAttachments
+      if (p != nullptr) p[i] = Particle4{xi.x, xi.y, xi.z, 0.f};
+      return;
+    }
     const float drag_rate = drag * area[i] * w;  // 1/s
     const float rate = damping + drag_rate;
     Float3 a = g + wind * drag_rate;
@@ -562,13 +595,21 @@ void ClothSolver::Integrate(ClothState* state, const Substep& sub, const RootMot
     // Verlet (paper B eq. 4): x + (x - x_prev) + h^2 a, with x - x_prev = h v; the velocity is
     // re-estimated from positions after the spring correction. Euler: v' and x + h v'.
     if (!verlet) v[i] = v_new;
-    x[i] = xi + v_new * h;
+    const Float3 moved = xi + v_new * h;
+    x[i] = moved;
+    if (p != nullptr) p[i] = Particle4{moved.x, moved.y, moved.z, 0.f};
   });
 }
 
 void ClothSolver::ApplyAttachments(ClothState* state, const ClothFrame& frame, const Substep& sub) {
   const float s = sub.s1;
   Float3* x = state->positions.data();
+  Particle4* p =
+      settings_.integrator == ClothIntegrator::kVerlet ? solver_positions_.data() : nullptr;
+  const auto place = [x, p](uint32_t i, Float3 position) {
+    x[i] = position;
+    if (p != nullptr) p[i] = Particle4{position.x, position.y, position.z, 0.f};
+  };
   const ClothAttachment* attachments = cloth_->attachments().data();
   const int64_t count = static_cast<int64_t>(cloth_->attachments().size());
   ParallelFor(count, kParticleGrain, [&](int64_t k) {
@@ -576,20 +617,18 @@ void ClothSolver::ApplyAttachments(ClothState* state, const ClothFrame& frame, c
     const size_t j = static_cast<size_t>(a.joint);
     const Float3 start = TransformPoint(frame.skinning_start[j], a.bind_position);
     const Float3 end = TransformPoint(frame.skinning_end[j], a.bind_position);
-    x[a.particle] = start * (1.f - s) + end * s;  // exactly `end` at s = 1
+    place(a.particle, start * (1.f - s) + end * s);  // exactly `end` at s = 1
   });
   ParallelFor(skin_kinematic_count_, kParticleGrain, [&](int64_t k) {
-    x[skin_targets_[k]] = skin_start_[k] * (1.f - s) + skin_end_[k] * s;
+    place(skin_targets_[k], skin_start_[k] * (1.f - s) + skin_end_[k] * s);
   });
 }
 
 // Works on the solver's copy of the positions (16-byte aligned particles for the SSE loads),
-// copied in and out once per substep. Spring order: see BuildSpringGroups.
-void ClothSolver::SolveSprings(ClothState* state) {
-  Float3* x = state->positions.data();
+// which Integrate and ApplyAttachments write and ConstrainAndUpdateVelocities reads back. Spring
+// order: see BuildSpringGroups.
+void ClothSolver::SolveSprings() {
   Particle4* p = solver_positions_.data();
-  const int64_t n = static_cast<int64_t>(state->positions.size());
-  ParallelFor(n, kParticleGrain, [&](int64_t i) { p[i] = Particle4{x[i].x, x[i].y, x[i].z, 0.f}; });
   // The iterations, then the strain limit's pass over the stretch springs.
   const bool limit_stretch = settings_.max_stretch < std::numeric_limits<float>::infinity();
   const uint32_t passes = settings_.iterations + (limit_stretch ? 1 : 0);
@@ -600,7 +639,6 @@ void ClothSolver::SolveSprings(ClothState* state) {
     for (uint32_t r = far_runs_.run_begin; r < far_runs_.run_end; ++r)
       CorrectRun(runs_[r], true, limit, p);
   }
-  ParallelFor(n, kParticleGrain, [&](int64_t i) { x[i] = Float3{p[i].x, p[i].y, p[i].z}; });
 }
 
 void ClothSolver::CorrectGroup(const SpringGroup& group, bool limit, Particle4* p) const {
@@ -623,24 +661,6 @@ void ClothSolver::CorrectRun(const SpringRun& run, bool shared, bool limit, Part
   }
   shared ? CorrectRunShared(blocks, run, side, c, p)
          : CorrectRunSequential(blocks, run, side, c, p);
-}
-
-void ClothSolver::UpdateVelocities(ClothState* state, const Substep& sub) {
-  const Float3* x = state->positions.data();
-  const Float3* x_start = state->previous_positions.data();
-  Float3* v = state->velocities.data();
-  const float inv_h = 1.f / sub.h;
-  if (settings_.integrator == ClothIntegrator::kVerlet) {
-    const int64_t n = static_cast<int64_t>(state->positions.size());
-    ParallelFor(n, kParticleGrain, [&](int64_t i) { v[i] = (x[i] - x_start[i]) * inv_h; });
-  } else {
-    const uint32_t* kinematic = cloth_->kinematic_particles().data();
-    const int64_t count = static_cast<int64_t>(cloth_->kinematic_particles().size());
-    ParallelFor(count, kParticleGrain, [&](int64_t k) {
-      const uint32_t i = kinematic[k];
-      v[i] = (x[i] - x_start[i]) * inv_h;
-    });
-  }
 }
 
 Status ClothSolver::Collide(ClothState* state, const ClothColliders& colliders, const Substep& sub,
@@ -693,99 +713,6 @@ Status ClothSolver::Collide(ClothState* state, const ClothColliders& colliders, 
     stats->shape_contacts += contacts;
   }
   return Status::Ok();
-}
-
-void ClothSolver::RestoreKinematic(ClothState* state) {
-  if (!restore_kinematic_) return;
-  restore_kinematic_ = false;
-  const std::span<const uint32_t> kinematic = cloth_->kinematic_particles();
-  for (size_t k = 0; k < kinematic.size(); ++k) {
-    const uint32_t i = kinematic[k];
-    state->positions[i] = kinematic_positions_[k];
-    state->velocities[i] = kinematic_velocities_[k];
-    flags_[i] = 0;
-    body_map_flags_[i] = 0;
-    shape_flags_[i] = 0;
-  }
-}
-
-uint32_t ClothSolver::FirstNonFinite(const ClothState& state) const {
-  const Float3* x = state.positions.data();
-  const Float3* v = state.velocities.data();
-  const int64_t n = static_cast<int64_t>(state.positions.size());
-  // a - a is +0 for every finite a and NaN for infinities and NaN, so the sum below is 0 exactly
-  // when all six components are finite (an integer OR: the same in any order).
-  detail::ChunkSum bad_count;
-  ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
-    uint32_t bad = 0;
-    for (int64_t i = begin; i < end; ++i) {
-      const Float3 p = x[i], u = v[i];
-      const float zero =
-          (((p.x - p.x) + (p.y - p.y)) + ((p.z - p.z) + (u.x - u.x))) + ((u.y - u.y) + (u.z - u.z));
-      bad |= static_cast<uint32_t>(!(zero == 0.f));
-    }
-    if (bad != 0) bad_count.Add(1);
-  });
-  if (bad_count.total() == 0) return kNoParticle;
-  for (int64_t i = 0; i < n; ++i)  // rare: the first one in order
-    if (!IsFinite(x[i]) || !IsFinite(v[i])) return static_cast<uint32_t>(i);
-  return kNoParticle;
-}
-
-uint32_t ClothSolver::CountContacts() {
-  uint8_t* flags = flags_.data();
-  const uint8_t* body_map = body_map_flags_.data();
-  const uint8_t* shapes = shape_flags_.data();
-  const bool merge_body_map = (merge_flags_ & 1) != 0, merge_shapes = (merge_flags_ & 2) != 0;
-  const int64_t n = static_cast<int64_t>(flags_.size());
-  detail::ChunkSum contacts;
-  ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
-    uint32_t count = 0;
-    for (int64_t i = begin; i < end; ++i) {
-      if (merge_body_map) flags[i] = static_cast<uint8_t>(flags[i] | body_map[i]);
-      if (merge_shapes) flags[i] = static_cast<uint8_t>(flags[i] | shapes[i]);
-      count += flags[i] & kCollisionContact;
-    }
-    contacts.Add(count);
-  });
-  return contacts.total();
-}
-
-void ClothSolver::RestoreBackup(ClothState* state) {
-  const size_t bytes = state->positions.size() * sizeof(Float3);
-  std::memcpy(state->positions.data(), backup_positions_.data(), bytes);
-  std::memcpy(state->previous_positions.data(), backup_positions_.data(), bytes);
-  std::memcpy(state->velocities.data(), backup_velocities_.data(), bytes);
-  restore_kinematic_ = false;
-}
-
-float ClothSolver::MaxStretch(const ClothState& state) const {
-  const Cloth& cloth = *cloth_;
-  if (cloth.spring_count(SpringKind::kStretch) == 0) return 0.f;
-  const ClothSpring* springs = cloth.springs().data();
-  const Float3* x = state.positions.data();
-  // Float max is exact and order-independent: each chunk's max, then the max of those. A chunk
-  // skips the square root and division for springs clearly below its running max (L^2 <
-  // (R (1 + max))^2 (1 - 1e-5): a margin far above the rounding of the test), so the result is
-  // the exact max however the springs are chunked. A spring of length 0 has stretch -1.
-  std::atomic<float> max_stretch{-1.f};
-  // The stretch springs are the first spring_count(kStretch) springs (Cloth::springs()).
-  ParallelRanges(
-      cloth.spring_count(SpringKind::kStretch), kSpringGrain, [&](int64_t begin, int64_t end) {
-        float chunk_max = -1.f;
-        for (int64_t k = begin; k < end; ++k) {
-          const ClothSpring& s = springs[k];
-          const Float3 d = x[s.b] - x[s.a];
-          const float length_squared = Dot(d, d);
-          const float bound = s.rest_length * (1.f + chunk_max);
-          if (length_squared < bound * bound * (1.f - 1e-5f)) continue;
-          chunk_max = std::max(chunk_max, std::sqrt(length_squared) / s.rest_length - 1.f);
-        }
-        float seen = max_stretch.load(std::memory_order_relaxed);
-        while (chunk_max > seen && !max_stretch.compare_exchange_weak(seen, chunk_max)) {
-        }
-      });
-  return max_stretch.load();
 }
 
 }  // namespace drape

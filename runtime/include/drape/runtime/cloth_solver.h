@@ -208,14 +208,17 @@ class ClothSolver {
   // The carried share of the root's motion over a substep, as a rigid transform.
   Mat34 CarriedMotion(const RootMotion& root, const Substep& sub) const;
   // The stages of one substep, in order.
-  void BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub);
+  bool BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub,
+                    bool check_input);
   void ComputeSkinnedTargets(const ClothFrame& frame);
-  void ApplyTethers(ClothState* state, const Substep& sub);
-  void ApplySkinConstraints(ClothState* state, const Substep& sub);
+  void IndexConstraints();
+  Float3 SkinLimit(uint32_t target, Float3 x, float s) const;
+  // Tethers and skinned limits, and the velocities (Verlet: re-estimated from the positions).
+  void ConstrainAndUpdateVelocities(ClothState* state, const Substep& sub);
   void AccumulateSpringForces(const ClothState& state);
   void Integrate(ClothState* state, const Substep& sub, const RootMotion& root);
   void ApplyAttachments(ClothState* state, const ClothFrame& frame, const Substep& sub);
-  void SolveSprings(ClothState* state);
+  void SolveSprings();
   void BuildSpringGroups(const Cloth& cloth);
   // limit: the strain limit's pass (stretch runs only, acting beyond rest * (1 + max_stretch)).
   void CorrectGroup(const internal::SpringGroup& group, bool limit, internal::Particle4* p) const;
@@ -223,14 +226,14 @@ class ClothSolver {
                   internal::Particle4* p) const;
   void AccumulateRun(const internal::SpringRun& run, bool shared, const Float3* x, const Float3* v,
                      Float3* forces) const;
-  void UpdateVelocities(ClothState* state, const Substep& sub);
   Status Collide(ClothState* state, const ClothColliders& colliders, const Substep& sub,
                  ClothStepStats* stats);
   void RestoreKinematic(ClothState* state);
   // The first particle with a non-finite position or velocity, or UINT32_MAX.
   uint32_t FirstNonFinite(const ClothState& state) const;
-  // ORs the other colliders' flags into flags_ (when several ran) and counts the contacts.
-  uint32_t CountContacts();
+  // ORs the other colliders' flags into flags_ (when several ran) and counts the contacts; with
+  // `check_finite`, also whether a position or velocity is not finite (*any_non_finite).
+  uint32_t CountContacts(const ClothState& state, bool check_finite, bool* any_non_finite);
   void RestoreBackup(ClothState* state);
   float MaxStretch(const ClothState& state) const;
 
@@ -245,10 +248,21 @@ class ClothSolver {
   // skin_targets_ (the constrained ones and the kinematic skinned ones).
   std::vector<uint32_t> skin_targets_;
   uint32_t skin_kinematic_count_ = 0;  // the first ones of skin_targets_ are kinematic
+  // Per particle: its tether's index in Cloth::tethers() and its index in skin_targets_ (the
+  // constrained ones), or UINT32_MAX.
+  std::vector<uint32_t> tether_of_, skin_target_of_;
   std::vector<Float3> skin_start_, skin_end_, skin_normal_start_, skin_normal_end_;
-  // SolveSprings' working copy of the positions (16-byte aligned particles for aligned SSE
-  // loads) and the springs in blocks of four, by group and colour (BuildSpringGroups).
+  // The spring solver's working copy of the positions (16-byte aligned particles for aligned SSE
+  // loads; Verlet: written by Integrate and ApplyAttachments, read back after the springs) and the
+  // springs in blocks of four, by group and colour (BuildSpringGroups).
   std::vector<internal::Particle4> solver_positions_;
+  // The stretch springs MaxStretch measures, ordered by their lower particle index: a chunk of
+  // them reads the particles that the same worker's chunk of every per-particle stage wrote.
+  struct MeasuredSpring {
+    uint32_t a = 0, b = 0;
+    float rest_length = 0.f;  // metres, > 0
+  };                          // 12 bytes
+  std::vector<MeasuredSpring> measured_springs_;
   std::vector<internal::SpringBlock> blocks_;
   std::vector<internal::SpringRun> runs_;
   std::vector<internal::SpringGroup> chunk_groups_, even_zones_, odd_zones_;
