@@ -199,10 +199,12 @@ def cloth(doc, gb, sections):
             args = (workers, 1, 1, 0, 0, 1, 1)
             per_workers.append(", ".join(
                 f"{k} {mm(value(gb, p, 'BM_ClothStep', args, f'{k}_ms'), 3)}" for k in stages))
-        doc.add("", "By stage (`ClothSolverSettings::measure_stages`; integrate: backup, root "
-                "motion, integration, attachments, velocities; springs: the 5 passes; "
-                "constraints: tethers, skinning; collide: every collider's batch; bookkeeping: "
-                "finite checks, contact count, stretch measure), ms per frame, 1 substep with "
+        doc.add("", "By stage (`ClothSolverSettings::measure_stages`; integrate: backup and "
+                "input check, root motion, integration, attachments; springs: the 5 passes; "
+                "constraints: tethers, skinned limits and the velocities, in one pass with the "
+                "positions back from the spring solver; collide: every collider's batch; "
+                "bookkeeping: contact count with the blow-up check, stretch measure), ms per "
+                "frame, 1 substep with "
                 f"colliders: 1 worker {per_workers[0]}; 2 workers {per_workers[1]}.")
         source(doc, p)
     if title in sections:

@@ -135,11 +135,11 @@ struct ClothFrame {
 
 // Where a step's time goes, in seconds summed over its substeps (measure_stages on).
 struct ClothStageSeconds {
-  double integrate = 0.0;    // backup, root motion, integration, attachments, velocities
+  double integrate = 0.0;    // backup and input check, root motion, integration, attachments
   double springs = 0.0;      // spring correction (Verlet) or forces (Euler), strain limit
-  double constraints = 0.0;  // tethers, skinned targets, max distance and backstop
-  double collide = 0.0;      // every collider's batch
-  double bookkeeping = 0.0;  // finite check, contact count, stretch measure
+  double constraints = 0.0;  // skinned targets, tethers, max distance, backstop, velocities
+  double collide = 0.0;      // colliders' poses, every collider's batch
+  double bookkeeping = 0.0;  // contact count with the blow-up check, stretch measure
 };
 
 struct ClothStepStats {
