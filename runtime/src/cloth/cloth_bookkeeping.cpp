@@ -76,10 +76,13 @@ uint32_t ClothSolver::CountContacts(const ClothState& state, bool check_finite,
   return contacts.total();
 }
 
+// After Integrate: the previous positions are the substep's start unless the root's motion
+// carried the particles (BeginSubstep then copied them).
 void ClothSolver::RestoreBackup(ClothState* state) {
   const size_t bytes = state->positions.size() * sizeof(Float3);
-  std::memcpy(state->positions.data(), backup_positions_.data(), bytes);
-  std::memcpy(state->previous_positions.data(), backup_positions_.data(), bytes);
+  if (positions_backed_up_)
+    std::memcpy(state->previous_positions.data(), backup_positions_.data(), bytes);
+  std::memcpy(state->positions.data(), state->previous_positions.data(), bytes);
   std::memcpy(state->velocities.data(), backup_velocities_.data(), bytes);
   restore_kinematic_ = false;
 }

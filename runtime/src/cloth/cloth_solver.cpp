@@ -471,9 +471,10 @@ Status ClothSolver::ValidateFrame(const ClothState& state, const ClothColliders&
 // done, so a stage sees every write of the stages before it.
 
 // The state's backup (restored if the substep fails), then the carried share of the root's
-// motion, in one pass over the particles. With check_input, the same pass first checks that the
-// state is finite and, when it is not, returns false having changed nothing (the carry then
-// takes a second pass).
+// motion, in one pass over the particles. The positions need a copy only when they are carried:
+// otherwise Integrate's previous positions are the substep's start. With check_input, the same
+// pass first checks that the state is finite and, when it is not, returns false having changed
+// nothing (the carry then takes a second pass).
 bool ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub,
                                bool check_input) {
   Float3* x = state->positions.data();
@@ -483,28 +484,26 @@ bool ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const 
   const int64_t n = static_cast<int64_t>(state->positions.size());
   const bool backup = settings_.guard_blowups;
   const bool carry = root.carry;
+  positions_backed_up_ = backup && carry;
+  const auto copy = [&](int64_t begin, int64_t end) {
+    for (int64_t i = begin; carry && i < end; ++i) backup_x[i] = x[i];
+    for (int64_t i = begin; i < end; ++i) backup_v[i] = v[i];
+  };
   if (check_input) {
     detail::ChunkSum bad_chunks;
     ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
       if (AnyNonFinite(x, v, begin, end)) bad_chunks.Add(1);
-      if (!backup) return;
-      for (int64_t i = begin; i < end; ++i) {
-        backup_x[i] = x[i];
-        backup_v[i] = v[i];
-      }
+      if (backup) copy(begin, end);
     });
     if (bad_chunks.total() != 0) return false;
     if (!carry) return true;
   } else if (!carry && !backup) {
     return true;
   }
-  const bool copy = backup && !check_input;  // else copied above
+  const bool copied = !backup || check_input;
   const Mat34 carried = carry ? CarriedMotion(root, sub) : Mat34{};
   ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
-    for (int64_t i = begin; copy && i < end; ++i) {
-      backup_x[i] = x[i];
-      backup_v[i] = v[i];
-    }
+    if (!copied) copy(begin, end);
     if (!carry) return;
     for (int64_t i = begin; i < end; ++i) {
       x[i] = TransformPoint(carried, x[i]);

@@ -267,8 +267,9 @@ class ClothSolver {
   std::vector<internal::SpringRun> runs_;
   std::vector<internal::SpringGroup> chunk_groups_, even_zones_, odd_zones_;
   internal::SpringGroup far_runs_;
-  uint8_t merge_flags_ = 0;         // bit 0: OR body_map_flags_, bit 1: shape_flags_ into flags_
-  bool restore_kinematic_ = false;  // Collide saved the kinematic particles
+  uint8_t merge_flags_ = 0;           // bit 0: OR body_map_flags_, bit 1: shape_flags_ into flags_
+  bool restore_kinematic_ = false;    // Collide saved the kinematic particles
+  bool positions_backed_up_ = false;  // this substep's backup holds the (carried) positions
 };
 
 }  // namespace drape
