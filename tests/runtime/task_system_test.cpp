@@ -93,7 +93,9 @@ TEST(TaskSystem, ClothStepRunsThroughTheEnginesTaskSystem) {
   frame.dt = 1.f / 60.f;
   ASSERT_TRUE(solver.Step(&state, ClothColliders{}, frame).ok());
   const uint64_t calls = engine.calls, chunks = engine.chunks;
-  EXPECT_GT(calls, 10u);
+  // Every spring pass (the iterations and the strain limit's) and at least the integration, the
+  // constraints with the velocities, and the contact count.
+  EXPECT_GE(calls, solver.settings().iterations + 1u + 3u);
   EXPECT_GT(chunks, calls * 2);
   ASSERT_TRUE(solver.Step(&state, ClothColliders{}, frame).ok());
   EXPECT_EQ(engine.calls, 2 * calls);

@@ -1,10 +1,11 @@
 #pragma once
 // How the runtime runs in parallel: only through a TaskSystem, which an engine implements with its
-// own job system. The runtime splits each parallel stage into chunks whose number and bounds
-// depend on the data alone (particle, spring or texel counts), never on the threads, and every
-// chunk writes its own slots: the results are bit-identical under any task system and worker
-// count. Three implementations come with the runtime: serial (the calling thread), OpenMP's team
-// (when built with DRAPE_OPENMP) and a small std::thread pool.
+// own job system. The runtime splits each parallel stage into chunks whose bounds depend on the
+// data alone (particle, spring or texel counts), or that follow WorkerCount() only where any split
+// gives the same bits (the cloth's spring passes), and every chunk writes its own slots: the
+// results are bit-identical under any task system and worker count. Three implementations come with
+// the runtime: serial (the calling thread), OpenMP's team (when built with DRAPE_OPENMP) and a
+// small std::thread pool.
 //
 //   class EngineTasks final : public drape::TaskSystem {
 //    public:
@@ -35,8 +36,8 @@ class TaskSystem {
   // caller). The chunks never call ParallelFor themselves. For an allocation-free
   // ClothSolver::Step, this must not allocate either.
   virtual void ParallelFor(uint32_t chunk_count, TaskFunction run, void* context) = 0;
-  // Threads that run chunks at once, >= 1. A hint for stages without a natural chunk size (the
-  // body-map renderer's row bands); it never changes a result.
+  // Threads that run chunks at once, >= 1. A hint for how finely to split a stage (the body-map
+  // renderer's row bands, the cloth's spring passes); it never changes a result.
   virtual uint32_t WorkerCount() const = 0;
 };
 
