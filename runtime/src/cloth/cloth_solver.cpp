@@ -592,12 +592,24 @@ void ClothSolver::Integrate(ClothState* state, const Substep& sub, const RootMot
   const int64_t n = static_cast<int64_t>(state->positions.size());
   // Verlet: the spring solver's copy too (SolveSprings works on it), in the same pass.
   Particle4* p = verlet ? solver_positions_.data() : nullptr;
+  // Without drag (the rate is +0 for every particle: areas and inverse masses are >= 0) nor
+  // centrifugal term, a particle's acceleration and damping factor are the same for all: computed
+  // once, with the same operations (the same bits).
+  const bool uniform = verlet && drag == 0.f && !centrifugal;
+  const Float3 uniform_step = (g + wind * 0.f) * h;
+  const float uniform_factor = 1.f / (1.f + h * (damping + 0.f));
   ParallelFor(n, kParticleGrain, [&](int64_t i) {
     const Float3 xi = x[i];
     x_start[i] = xi;
     const float w = inverse_mass[i];
     if (w == 0.f) {  // pinned or attached: moved by the caller or ApplyAttachments
       if (p != nullptr) p[i] = Particle4{xi.x, xi.y, xi.z, 0.f};
+      return;
+    }
+    if (uniform) {
+      const Float3 moved = xi + ((v[i] + uniform_step) * uniform_factor) * h;
+      x[i] = moved;
+      p[i] = Particle4{moved.x, moved.y, moved.z, 0.f};
       return;
     }
     const float drag_rate = drag * area[i] * w;  // 1/s
