@@ -1,10 +1,12 @@
 // The body maps that follow any pose, on the mannequin (samples/mannequin) at its walk clip
 // between keys: the cost of rendering the maps of a pose, and of the per-bone local maps' batch.
 //
-//  BM_RenderMaps/<region>/<threads>   BodyMapRenderer::Render at the rest maps' texel (N = 1024
-//                                     over the body: 1.7 mm); region 0: the whole body, 1: a
-//                                     skirt's reach (hips to knees, 0.6 x 0.7 x 0.6 m).
-//                                     Reported: ms per pose
+//  BM_RenderMaps/<region>/<threads>/<texel>
+//                                     BodyMapRenderer::Render at the rest maps' texel (N = 1024
+//                                     over the body: 1.7 mm) times <texel> (4: 7 mm, where the
+//                                     people meet the error targets in drape-speed-vs-error);
+//                                     region 0: the whole body, 1: a skirt's reach (hips to
+//                                     knees, 0.6 x 0.7 x 0.6 m). Reported: ms per pose
 //  BM_BoneMapsBatch/<threads>         BoneMapCollider::CollideBatch (SetPose included) on 10k
 //                                     particles within 2 cm of the posed surface moving 5 mm;
 //                                     ns_per_particle
@@ -14,7 +16,6 @@
 // Built by bench/gbench/CMakeLists.txt with -DDRAPE_BUILD_BENCH=ON (bench_following_maps).
 
 #include <benchmark/benchmark.h>
-#include <omp.h>
 
 #include <cmath>
 #include <random>
@@ -26,6 +27,7 @@
 #include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
+#include "drape/runtime/task_system.h"
 #include "test_support.h"
 
 namespace drape {
@@ -78,6 +80,19 @@ const Scene& TheScene() {
   return scene;
 }
 
+// The runtime's std::thread pool on `threads` workers (the serial task system for 1), the way an
+// engine or drape-sim runs the runtime; restored to the default when it goes.
+class Workers {
+ public:
+  explicit Workers(int64_t threads) : pool_(static_cast<uint32_t>(threads)) {
+    SetTaskSystem(threads <= 1 ? &SerialTaskSystem() : &pool_);
+  }
+  ~Workers() { SetTaskSystem(nullptr); }
+
+ private:
+  ThreadPoolTaskSystem pool_;
+};
+
 RenderRegion Region(int which) {
   RenderRegion r;
   if (which == 1) {
@@ -89,9 +104,9 @@ RenderRegion Region(int which) {
 
 void BM_RenderMaps(benchmark::State& state) {
   const Scene& s = TheScene();
-  omp_set_num_threads(static_cast<int>(state.range(1)));
+  const Workers workers(state.range(1));
   BodyMapRenderOptions options;
-  options.texel_size = s.texel;
+  options.texel_size = s.texel * static_cast<float>(state.range(2));
   BodyMapRenderer renderer;
   if (!renderer.Init(s.character.mesh, options).ok()) state.SkipWithError("init");
   BodyMapCollider maps;
@@ -106,7 +121,7 @@ void BM_RenderMaps(benchmark::State& state) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_RenderMaps)
-    ->ArgsProduct({{0, 1}, {1, 2}})
+    ->ArgsProduct({{0, 1}, {1, 2}, {1, 4}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -126,7 +141,7 @@ void RunBatch(benchmark::State& state, const Scene& s, const Collide& collide) {
 
 void BM_BoneMapsBatch(benchmark::State& state) {
   const Scene& s = TheScene();
-  omp_set_num_threads(static_cast<int>(state.range(0)));
+  const Workers workers(state.range(0));
   BoneMapCollider bones;
   if (!bones.Build(s.bone_maps, s.character.skeleton.joint_count()).ok())
     state.SkipWithError("build");
@@ -139,7 +154,7 @@ BENCHMARK(BM_BoneMapsBatch)->Arg(1)->Arg(2)->UseRealTime();
 
 void BM_RenderedMapsBatch(benchmark::State& state) {
   const Scene& s = TheScene();
-  omp_set_num_threads(static_cast<int>(state.range(0)));
+  const Workers workers(state.range(0));
   BodyMapRenderOptions options;
   options.texel_size = s.texel;
   BodyMapRenderer renderer;
