@@ -469,35 +469,54 @@ TEST(ClothSolver, BodyMapAndHullsTogether) {
 // ---- Invalid states --------------------------------------------------------------------------
 
 // A NaN in the input state is reported (kInvalidState, naming the particle) and nothing moves.
-TEST(ClothSolver, NanInputIsReportedAndNotPropagated) {
-  Cloth cloth;
-  ASSERT_TRUE(BuildCloth(SheetDescription(20, 1.f, {0.f, 0.f, 0.f}), &cloth).ok());
-  ClothSolver solver;
-  ASSERT_TRUE(solver.Init(cloth, ClothSolverSettings::PaperB()).ok());
-  ClothState state;
-  state.Reset(cloth);
-  const OneJointFrame joint;
-  for (int step = 0; step < 5; ++step)
-    ASSERT_TRUE(solver.Step(&state, ClothColliders{}, joint.Frame(1.f / 60.f)).ok());
+// Settings that carry the particles with a moving root (inertia below 1) or not, and a joint
+// that moves 5 cm along x over each frame: the state's backup must then hold the positions before
+// the carry.
+ClothSolverSettings Carried(ClothSolverSettings s, bool carry) {
+  if (carry) {
+    s.root_joint = 0;
+    s.linear_inertia = 0.5f;
+  }
+  return s;
+}
+OneJointFrame MovingJoint() {
+  OneJointFrame joint;
+  joint.end.m[3] = 0.05f;
+  return joint;
+}
 
-  for (int which = 0; which < 2; ++which) {
-    ClothState bad = state;
-    const uint32_t particle = which == 0 ? 123 : 45;
-    if (which == 0) {
-      bad.positions[particle].y = std::numeric_limits<float>::quiet_NaN();
-    } else {
-      bad.velocities[particle].z = std::numeric_limits<float>::infinity();
+TEST(ClothSolver, NanInputIsReportedAndNotPropagated) {
+  for (const bool carry : {false, true}) {
+    SCOPED_TRACE(carry ? "carried by the root" : "world");
+    Cloth cloth;
+    ASSERT_TRUE(BuildCloth(SheetDescription(20, 1.f, {0.f, 0.f, 0.f}), &cloth).ok());
+    ClothSolver solver;
+    ASSERT_TRUE(solver.Init(cloth, Carried(ClothSolverSettings::PaperB(), carry)).ok());
+    ClothState state;
+    state.Reset(cloth);
+    const OneJointFrame joint = MovingJoint();
+    for (int step = 0; step < 5; ++step)
+      ASSERT_TRUE(solver.Step(&state, ClothColliders{}, joint.Frame(1.f / 60.f)).ok());
+
+    for (int which = 0; which < 2; ++which) {
+      ClothState bad = state;
+      const uint32_t particle = which == 0 ? 123 : 45;
+      if (which == 0) {
+        bad.positions[particle].y = std::numeric_limits<float>::quiet_NaN();
+      } else {
+        bad.velocities[particle].z = std::numeric_limits<float>::infinity();
+      }
+      const ClothState before = bad;
+      const Status status = solver.Step(&bad, ClothColliders{}, joint.Frame(1.f / 60.f));
+      EXPECT_EQ(status.code(), StatusCode::kInvalidState);
+      EXPECT_NE(status.message().find("particle " + std::to_string(particle)), std::string::npos)
+          << status.message();
+      const size_t bytes = before.positions.size() * sizeof(Float3);
+      EXPECT_EQ(std::memcmp(bad.positions.data(), before.positions.data(), bytes), 0);
+      EXPECT_EQ(std::memcmp(bad.velocities.data(), before.velocities.data(), bytes), 0);
+      EXPECT_EQ(std::memcmp(bad.previous_positions.data(), before.previous_positions.data(), bytes),
+                0);
     }
-    const ClothState before = bad;
-    const Status status = solver.Step(&bad, ClothColliders{}, joint.Frame(1.f / 60.f));
-    EXPECT_EQ(status.code(), StatusCode::kInvalidState);
-    EXPECT_NE(status.message().find("particle " + std::to_string(particle)), std::string::npos)
-        << status.message();
-    const size_t bytes = before.positions.size() * sizeof(Float3);
-    EXPECT_EQ(std::memcmp(bad.positions.data(), before.positions.data(), bytes), 0);
-    EXPECT_EQ(std::memcmp(bad.velocities.data(), before.velocities.data(), bytes), 0);
-    EXPECT_EQ(std::memcmp(bad.previous_positions.data(), before.previous_positions.data(), bytes),
-              0);
   }
 }
 
@@ -505,34 +524,37 @@ TEST(ClothSolver, NanInputIsReportedAndNotPropagated) {
 // a bound near 0.1 ms) blows up. The blow-up is reported as kInvalidState naming a particle, and
 // the state is the one before the failing step (the last valid substep), finite.
 TEST(ClothSolver, BlowUpIsReportedAndStateKept) {
-  ClothDescription d = SheetDescription(10, 1.f, {0.f, 0.f, 0.f});
-  d.stretch.stiffness = 1e4f;
-  d.pinned = {0};
-  Cloth cloth;
-  ASSERT_TRUE(BuildCloth(d, &cloth).ok());
-  EXPECT_LT(cloth.MaxStableEulerStep(), 1e-3f);
-  ClothSolver solver;
-  ASSERT_TRUE(solver.Init(cloth, ClothSolverSettings::PaperA(1)).ok());
-  ClothState state;
-  state.Reset(cloth);
-  state.velocities[60] = {0.f, 1.f, 0.f};  // a kick to start the unstable modes
-  const OneJointFrame joint;
-  Status status;
-  int step = 0;
-  ClothState before;
-  for (; step < 200; ++step) {
-    before = state;
-    status = solver.Step(&state, ClothColliders{}, joint.Frame(1.f / 60.f));
-    if (!status.ok()) break;
+  for (const bool carry : {false, true}) {
+    SCOPED_TRACE(carry ? "carried by the root" : "world");
+    ClothDescription d = SheetDescription(10, 1.f, {0.f, 0.f, 0.f});
+    d.stretch.stiffness = 1e4f;
+    d.pinned = {0};
+    Cloth cloth;
+    ASSERT_TRUE(BuildCloth(d, &cloth).ok());
+    EXPECT_LT(cloth.MaxStableEulerStep(), 1e-3f);
+    ClothSolver solver;
+    ASSERT_TRUE(solver.Init(cloth, Carried(ClothSolverSettings::PaperA(1), carry)).ok());
+    ClothState state;
+    state.Reset(cloth);
+    state.velocities[60] = {0.f, 1.f, 0.f};  // a kick to start the unstable modes
+    const OneJointFrame joint = MovingJoint();
+    Status status;
+    int step = 0;
+    ClothState before;
+    for (; step < 200; ++step) {
+      before = state;
+      status = solver.Step(&state, ClothColliders{}, joint.Frame(1.f / 60.f));
+      if (!status.ok()) break;
+    }
+    ASSERT_LT(step, 200) << "explicit Euler was expected to blow up";
+    EXPECT_EQ(status.code(), StatusCode::kInvalidState);
+    EXPECT_NE(status.message().find("particle "), std::string::npos) << status.message();
+    EXPECT_TRUE(AllFinite(state));
+    const size_t bytes = state.positions.size() * sizeof(Float3);
+    EXPECT_EQ(std::memcmp(state.positions.data(), before.positions.data(), bytes), 0);
+    EXPECT_EQ(std::memcmp(state.velocities.data(), before.velocities.data(), bytes), 0);
+    EXPECT_EQ(std::memcmp(state.previous_positions.data(), state.positions.data(), bytes), 0);
   }
-  ASSERT_LT(step, 200) << "explicit Euler was expected to blow up";
-  EXPECT_EQ(status.code(), StatusCode::kInvalidState);
-  EXPECT_NE(status.message().find("particle "), std::string::npos) << status.message();
-  EXPECT_TRUE(AllFinite(state));
-  const size_t bytes = state.positions.size() * sizeof(Float3);
-  EXPECT_EQ(std::memcmp(state.positions.data(), before.positions.data(), bytes), 0);
-  EXPECT_EQ(std::memcmp(state.velocities.data(), before.velocities.data(), bytes), 0);
-  EXPECT_EQ(std::memcmp(state.previous_positions.data(), state.positions.data(), bytes), 0);
 }
 
 TEST(ClothSolver, RejectsBadFramesAndSettings) {
