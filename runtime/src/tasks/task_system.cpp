@@ -130,7 +130,8 @@ struct ThreadPoolTaskSystem::Pool {
   alignas(64) std::atomic<uint32_t> generation{0};
   alignas(64) std::atomic<uint32_t> active{0};
   alignas(64) std::atomic<uint32_t> done{0};
-  std::atomic<bool> stop{false};
+  // The job, on its own line: the workers only read it while `done` takes their counts.
+  alignas(64) std::atomic<bool> stop{false};
   TaskFunction run = nullptr;
   void* context = nullptr;
   uint32_t count = 0;
