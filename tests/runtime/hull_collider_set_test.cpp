@@ -778,5 +778,28 @@ TEST(HullColliderTest, BindFrameAndSkinningPlaceTheCollider) {
   EXPECT_FALSE(set.Query({1.f, 0.f, 0.f}, {1.f, 0.f, 0.f}).inside_end);
 }
 
+TEST(HullColliderTest, SelectingTheSameSubstepAgainFollowsANewPose) {
+  // SelectSubstep skips the work when the fractions are the selected ones for the current pose
+  // (SetPose selects [0, 1]); a new pose must still be the one CollideBatch meets.
+  HullColliderSet set = BuildSet({MakeBox({0.1f, 0.1f, 0.1f})}, {}, 1);
+  const std::vector<Mat34> here = {Mat34{}};
+  std::vector<Mat34> there = {Mat34{}};
+  there[0].m[3] = 1.f;  // the box 1 m along x
+  for (const float s1 : {1.f, 0.5f}) {
+    SCOPED_TRACE(s1);
+    ASSERT_TRUE(set.SetPose(here, here).ok());
+    ASSERT_TRUE(set.SelectSubstep(0.f, s1).ok());
+    ASSERT_TRUE(set.SetPose(there, there).ok());
+    ASSERT_TRUE(set.SelectSubstep(0.f, s1).ok());
+    std::vector<Float3> previous = {{1.f, 0.5f, 0.f}}, positions = {{1.f, 0.05f, 0.f}};
+    std::vector<Float3> velocities = {{0.f, -1.f, 0.f}};
+    std::vector<uint8_t> flags(1);
+    ASSERT_TRUE(
+        set.CollideBatch(previous, positions, velocities, flags, ResponseParams{}, 0.f, s1).ok());
+    EXPECT_TRUE(flags[0] & kCollisionContact);
+    EXPECT_GE(positions[0].y, 0.1f);  // on the moved box's top face
+  }
+}
+
 }  // namespace
 }  // namespace drape

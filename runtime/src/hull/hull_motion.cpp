@@ -49,6 +49,7 @@ Status HullColliderSet::SetPose(std::span<const Mat34> skinning_start,
       return Status(StatusCode::kInvalidArgument,
                     "HullColliderSet::SetPose: skinning matrix of joint " + std::to_string(j) +
                         " is not finite");
+  selection_current_ = false;  // the motions change below
   const uint32_t hull_total = static_cast<uint32_t>(hulls_.size());
   for (uint32_t k = 0; k < motions_.size(); ++k) {
     Motion& m = motions_[k];
@@ -191,6 +192,8 @@ Status HullColliderSet::SelectSubstep(float s0, float s1) {
   if (!(s0 >= 0.f && s0 <= s1 && s1 <= 1.f))
     return Status(StatusCode::kInvalidArgument,
                   "HullColliderSet::SelectSubstep: fractions are not 0 <= s0 <= s1 <= 1");
+  // Already selected for this pose (a solver's single substep, which SetPose selected).
+  if (selection_current_ && s0 == active_s0_ && s1 == active_s1_) return Status::Ok();
   active_s0_ = s0;
   active_s1_ = s1;
   for (uint32_t k = 0; k < motions_.size(); ++k) {
@@ -225,6 +228,7 @@ Status HullColliderSet::SelectSubstep(float s0, float s1) {
     sweep_union_radius_ =
         static_cast<float>(radius * (1.0 + 1e-4) + 1e-4 * (LengthD(center) + radius) + 1e-6);
   }
+  selection_current_ = true;
   return Status::Ok();
 }
 

@@ -341,6 +341,7 @@ class HullColliderSet {
   std::vector<Motion> motions_;  // hulls then spheres
   std::vector<ActiveFrames> active_;
   float active_s0_ = 0.f, active_s1_ = 1.f;
+  bool selection_current_ = false;  // active_ and sweep_* hold [active_s0_, active_s1_] of the pose
   // Swept spheres, SoA padded to a multiple of 8: over the selected substep and the whole step.
   SimdFloats sweep_x_, sweep_y_, sweep_z_, sweep_r_;
   SimdFloats full_x_, full_y_, full_z_, full_r_;
