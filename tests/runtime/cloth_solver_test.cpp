@@ -485,6 +485,36 @@ OneJointFrame MovingJoint() {
   return joint;
 }
 
+// Colliders whose skeleton the frame does not cover (a hull set of three joints, one matrix): the
+// step fails before anything moves, with the particles carried by the root too.
+TEST(ClothSolver, CollidersThatTheFrameCannotPoseLeaveTheStateAlone) {
+  for (const bool carry : {false, true}) {
+    SCOPED_TRACE(carry ? "carried by the root" : "world");
+    Cloth cloth;
+    ASSERT_TRUE(BuildCloth(SheetDescription(20, 1.f, {0.f, 0.f, 0.f}), &cloth).ok());
+    ClothSolver solver;
+    ASSERT_TRUE(solver.Init(cloth, Carried(ClothSolverSettings::PaperB(), carry)).ok());
+    ClothState state;
+    state.Reset(cloth);
+    state.velocities[7] = {0.f, 0.5f, 0.f};
+    JointSphereData sphere;
+    sphere.joint = 2;
+    sphere.radius = 0.1f;
+    HullColliderSet hulls;
+    ASSERT_TRUE(hulls.Build({}, std::span<const JointSphereData>(&sphere, 1), 3).ok());
+    ClothColliders colliders;
+    colliders.hulls = &hulls;
+    const ClothState before = state;
+    const Status status = solver.Step(&state, colliders, MovingJoint().Frame(1.f / 60.f));
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << status.message();
+    const size_t bytes = before.positions.size() * sizeof(Float3);
+    EXPECT_EQ(std::memcmp(state.positions.data(), before.positions.data(), bytes), 0);
+    EXPECT_EQ(std::memcmp(state.velocities.data(), before.velocities.data(), bytes), 0);
+    EXPECT_EQ(std::memcmp(state.previous_positions.data(), before.previous_positions.data(), bytes),
+              0);
+  }
+}
+
 TEST(ClothSolver, NanInputIsReportedAndNotPropagated) {
   for (const bool carry : {false, true}) {
     SCOPED_TRACE(carry ? "carried by the root" : "world");

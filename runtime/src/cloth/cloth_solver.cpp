@@ -399,19 +399,24 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
 
     // Each stage hands its chunks to the task system and returns when they are done.
     StageClock clock(settings_.measure_stages, &st.stage_seconds);
-    // The first substep's backup pass also checks the input state, before anything changes it.
-    if (!BeginSubstep(state, root, sub, k == 0)) {
-      const uint32_t bad = FirstNonFinite(*state);
-      return Status(StatusCode::kInvalidState,
-                    "ClothSolver::Step: input state of particle " + std::to_string(bad) +
-                        " is not finite (position or velocity); nothing was simulated");
-    }
-    clock.Lap(&ClothStageSeconds::integrate);
-    if (k == 0 && colliders.hulls != nullptr) {
-      if (Status s = colliders.hulls->SetPose(frame.skinning_start, frame.skinning_end); !s.ok())
-        return s;
+    if (k == 0) {
+      // The input state is checked in the backup's pass, then the hulls posed, and only then
+      // does anything change the state: an error leaves it (and the colliders) as they were.
+      if (!CheckInputAndBackUp(state, root.carry)) {
+        const uint32_t bad = FirstNonFinite(*state);
+        return Status(StatusCode::kInvalidState,
+                      "ClothSolver::Step: input state of particle " + std::to_string(bad) +
+                          " is not finite (position or velocity); nothing was simulated");
+      }
+      clock.Lap(&ClothStageSeconds::bookkeeping);
+      if (colliders.hulls != nullptr) {
+        if (Status s = colliders.hulls->SetPose(frame.skinning_start, frame.skinning_end); !s.ok())
+          return s;
+      }
       clock.Lap(&ClothStageSeconds::collide);
     }
+    BeginSubstep(state, root, sub, /*back_up=*/k > 0 && settings_.guard_blowups);
+    clock.Lap(&ClothStageSeconds::integrate);
     if (!verlet) AccumulateSpringForces(*state);
     clock.Lap(&ClothStageSeconds::springs);
     Integrate(state, sub, root);
@@ -485,47 +490,48 @@ Status ClothSolver::ValidateFrame(const ClothState& state, const ClothColliders&
 // kParticleGrain particles, the springs by group. A ParallelFor returns when all its chunks are
 // done, so a stage sees every write of the stages before it.
 
-// The state's backup (restored if the substep fails), then the carried share of the root's
-// motion, in one pass over the particles. The positions need a copy only when they are carried:
-// otherwise Integrate's previous positions are the substep's start. With check_input, the same
-// pass first checks that the state is finite and, when it is not, returns false having changed
-// nothing (the carry then takes a second pass).
-bool ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub,
-                               bool check_input) {
+// The first substep's backup in one pass with the check that the input state is finite; false
+// (and the state untouched: only the backup is written) when it is not. The positions need a copy
+// only when the root's motion carries them: otherwise Integrate's previous positions are the
+// substep's start.
+bool ClothSolver::CheckInputAndBackUp(ClothState* state, bool carry) {
+  const Float3* x = state->positions.data();
+  const Float3* v = state->velocities.data();
+  const bool backup = settings_.guard_blowups;
+  positions_backed_up_ = backup && carry;
+  detail::ChunkSum bad_chunks;
+  ParallelRanges(static_cast<int64_t>(state->positions.size()), kParticleGrain,
+                 [&](int64_t begin, int64_t end) {
+                   if (AnyNonFinite(x, v, begin, end)) bad_chunks.Add(1);
+                   if (backup) BackUpRange(*state, carry, begin, end);
+                 });
+  return bad_chunks.total() == 0;
+}
+
+void ClothSolver::BackUpRange(const ClothState& state, bool positions, int64_t begin, int64_t end) {
+  for (int64_t i = begin; positions && i < end; ++i) backup_positions_[i] = state.positions[i];
+  for (int64_t i = begin; i < end; ++i) backup_velocities_[i] = state.velocities[i];
+}
+
+// The state's backup (restored if the substep fails; see CheckInputAndBackUp), then the carried
+// share of the root's motion, in one pass over the particles.
+void ClothSolver::BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub,
+                               bool back_up) {
+  const bool carry = root.carry;
+  if (back_up) positions_backed_up_ = carry;
+  if (!carry && !back_up) return;
   Float3* x = state->positions.data();
   Float3* v = state->velocities.data();
-  Float3* backup_x = backup_positions_.data();
-  Float3* backup_v = backup_velocities_.data();
-  const int64_t n = static_cast<int64_t>(state->positions.size());
-  const bool backup = settings_.guard_blowups;
-  const bool carry = root.carry;
-  positions_backed_up_ = backup && carry;
-  const auto copy = [&](int64_t begin, int64_t end) {
-    for (int64_t i = begin; carry && i < end; ++i) backup_x[i] = x[i];
-    for (int64_t i = begin; i < end; ++i) backup_v[i] = v[i];
-  };
-  if (check_input) {
-    detail::ChunkSum bad_chunks;
-    ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
-      if (AnyNonFinite(x, v, begin, end)) bad_chunks.Add(1);
-      if (backup) copy(begin, end);
-    });
-    if (bad_chunks.total() != 0) return false;
-    if (!carry) return true;
-  } else if (!carry && !backup) {
-    return true;
-  }
-  const bool copied = !backup || check_input;
   const Mat34 carried = carry ? CarriedMotion(root, sub) : Mat34{};
-  ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
-    if (!copied) copy(begin, end);
-    if (!carry) return;
-    for (int64_t i = begin; i < end; ++i) {
-      x[i] = TransformPoint(carried, x[i]);
-      v[i] = TransformVector(carried, v[i]);
-    }
-  });
-  return true;
+  ParallelRanges(static_cast<int64_t>(state->positions.size()), kParticleGrain,
+                 [&](int64_t begin, int64_t end) {
+                   if (back_up) BackUpRange(*state, carry, begin, end);
+                   if (!carry) return;
+                   for (int64_t i = begin; i < end; ++i) {
+                     x[i] = TransformPoint(carried, x[i]);
+                     v[i] = TransformVector(carried, v[i]);
+                   }
+                 });
 }
 
 // The same traversal as SolveSprings (chunks, even zones, odd zones, far runs): every spring

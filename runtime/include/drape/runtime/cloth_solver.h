@@ -208,8 +208,9 @@ class ClothSolver {
   // The carried share of the root's motion over a substep, as a rigid transform.
   Mat34 CarriedMotion(const RootMotion& root, const Substep& sub) const;
   // The stages of one substep, in order.
-  bool BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub,
-                    bool check_input);
+  bool CheckInputAndBackUp(ClothState* state, bool carry);
+  void BackUpRange(const ClothState& state, bool positions, int64_t begin, int64_t end);
+  void BeginSubstep(ClothState* state, const RootMotion& root, const Substep& sub, bool back_up);
   void ComputeSkinnedTargets(const ClothFrame& frame);
   void IndexConstraints();
   Float3 SkinLimit(uint32_t target, Float3 x, float s) const;
