@@ -36,17 +36,11 @@ void ClothSolver::RestoreKinematic(ClothState* state) {
   }
 }
 
+// Only once a check has found one (an error message names it): a plain scan in order.
 uint32_t ClothSolver::FirstNonFinite(const ClothState& state) const {
-  const Float3* x = state.positions.data();
-  const Float3* v = state.velocities.data();
-  const int64_t n = static_cast<int64_t>(state.positions.size());
-  detail::ChunkSum bad_count;
-  ParallelRanges(n, kParticleGrain, [&](int64_t begin, int64_t end) {
-    if (AnyNonFinite(x, v, begin, end)) bad_count.Add(1);
-  });
-  if (bad_count.total() == 0) return kNoParticle;
-  for (int64_t i = 0; i < n; ++i)  // rare: the first one in order
-    if (!IsFinite(x[i]) || !IsFinite(v[i])) return static_cast<uint32_t>(i);
+  for (size_t i = 0; i < state.positions.size(); ++i)
+    if (!IsFinite(state.positions[i]) || !IsFinite(state.velocities[i]))
+      return static_cast<uint32_t>(i);
   return kNoParticle;
 }
 
@@ -77,7 +71,7 @@ uint32_t ClothSolver::CountContacts(const ClothState& state, bool check_finite,
 }
 
 // After Integrate: the previous positions are the substep's start unless the root's motion
-// carried the particles (BeginSubstep then copied them).
+// carried the particles (CheckInputAndBackUp or BeginSubstep then copied them first).
 void ClothSolver::RestoreBackup(ClothState* state) {
   const size_t bytes = state->positions.size() * sizeof(Float3);
   if (positions_backed_up_)
