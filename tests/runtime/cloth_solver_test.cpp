@@ -468,7 +468,6 @@ TEST(ClothSolver, BodyMapAndHullsTogether) {
 
 // ---- Invalid states --------------------------------------------------------------------------
 
-// A NaN in the input state is reported (kInvalidState, naming the particle) and nothing moves.
 // Settings that carry the particles with a moving root (inertia below 1) or not, and a joint
 // that moves 5 cm along x over each frame: the state's backup must then hold the positions before
 // the carry.
@@ -485,18 +484,34 @@ OneJointFrame MovingJoint() {
   return joint;
 }
 
+// A 21 x 21 sheet's solver, carried by the root or not, and its state at rest.
+struct CarriedSheet {
+  Cloth cloth;
+  ClothSolver solver;
+  ClothState state;
+  explicit CarriedSheet(bool carry) {
+    EXPECT_TRUE(BuildCloth(SheetDescription(20, 1.f, {0.f, 0.f, 0.f}), &cloth).ok());
+    EXPECT_TRUE(solver.Init(cloth, Carried(ClothSolverSettings::PaperB(), carry)).ok());
+    state.Reset(cloth);
+  }
+};
+
+// Positions, velocities and previous positions, bit for bit.
+void ExpectSameState(const ClothState& actual, const ClothState& expected) {
+  const size_t bytes = expected.positions.size() * sizeof(Float3);
+  EXPECT_EQ(std::memcmp(actual.positions.data(), expected.positions.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(actual.velocities.data(), expected.velocities.data(), bytes), 0);
+  EXPECT_EQ(
+      std::memcmp(actual.previous_positions.data(), expected.previous_positions.data(), bytes), 0);
+}
+
 // Colliders whose skeleton the frame does not cover (a hull set of three joints, one matrix): the
 // step fails before anything moves, with the particles carried by the root too.
 TEST(ClothSolver, CollidersThatTheFrameCannotPoseLeaveTheStateAlone) {
   for (const bool carry : {false, true}) {
     SCOPED_TRACE(carry ? "carried by the root" : "world");
-    Cloth cloth;
-    ASSERT_TRUE(BuildCloth(SheetDescription(20, 1.f, {0.f, 0.f, 0.f}), &cloth).ok());
-    ClothSolver solver;
-    ASSERT_TRUE(solver.Init(cloth, Carried(ClothSolverSettings::PaperB(), carry)).ok());
-    ClothState state;
-    state.Reset(cloth);
-    state.velocities[7] = {0.f, 0.5f, 0.f};
+    CarriedSheet sheet(carry);
+    sheet.state.velocities[7] = {0.f, 0.5f, 0.f};
     JointSphereData sphere;
     sphere.joint = 2;
     sphere.radius = 0.1f;
@@ -504,26 +519,21 @@ TEST(ClothSolver, CollidersThatTheFrameCannotPoseLeaveTheStateAlone) {
     ASSERT_TRUE(hulls.Build({}, std::span<const JointSphereData>(&sphere, 1), 3).ok());
     ClothColliders colliders;
     colliders.hulls = &hulls;
-    const ClothState before = state;
-    const Status status = solver.Step(&state, colliders, MovingJoint().Frame(1.f / 60.f));
+    const ClothState before = sheet.state;
+    const Status status =
+        sheet.solver.Step(&sheet.state, colliders, MovingJoint().Frame(1.f / 60.f));
     EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << status.message();
-    const size_t bytes = before.positions.size() * sizeof(Float3);
-    EXPECT_EQ(std::memcmp(state.positions.data(), before.positions.data(), bytes), 0);
-    EXPECT_EQ(std::memcmp(state.velocities.data(), before.velocities.data(), bytes), 0);
-    EXPECT_EQ(std::memcmp(state.previous_positions.data(), before.previous_positions.data(), bytes),
-              0);
+    ExpectSameState(sheet.state, before);
   }
 }
 
+// A NaN in the input state is reported (kInvalidState, naming the particle) and nothing moves.
 TEST(ClothSolver, NanInputIsReportedAndNotPropagated) {
   for (const bool carry : {false, true}) {
     SCOPED_TRACE(carry ? "carried by the root" : "world");
-    Cloth cloth;
-    ASSERT_TRUE(BuildCloth(SheetDescription(20, 1.f, {0.f, 0.f, 0.f}), &cloth).ok());
-    ClothSolver solver;
-    ASSERT_TRUE(solver.Init(cloth, Carried(ClothSolverSettings::PaperB(), carry)).ok());
-    ClothState state;
-    state.Reset(cloth);
+    CarriedSheet sheet(carry);
+    ClothSolver& solver = sheet.solver;
+    ClothState& state = sheet.state;
     const OneJointFrame joint = MovingJoint();
     for (int step = 0; step < 5; ++step)
       ASSERT_TRUE(solver.Step(&state, ClothColliders{}, joint.Frame(1.f / 60.f)).ok());
@@ -541,11 +551,7 @@ TEST(ClothSolver, NanInputIsReportedAndNotPropagated) {
       EXPECT_EQ(status.code(), StatusCode::kInvalidState);
       EXPECT_NE(status.message().find("particle " + std::to_string(particle)), std::string::npos)
           << status.message();
-      const size_t bytes = before.positions.size() * sizeof(Float3);
-      EXPECT_EQ(std::memcmp(bad.positions.data(), before.positions.data(), bytes), 0);
-      EXPECT_EQ(std::memcmp(bad.velocities.data(), before.velocities.data(), bytes), 0);
-      EXPECT_EQ(std::memcmp(bad.previous_positions.data(), before.previous_positions.data(), bytes),
-                0);
+      ExpectSameState(bad, before);
     }
   }
 }
