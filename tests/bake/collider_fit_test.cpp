@@ -19,6 +19,7 @@
 #include "drape/bake/regions.h"
 #include "drape/runtime/math.h"
 #include "fit/fit_report.h"
+#include "fit_targets.h"
 #include "test_support.h"
 
 namespace drape {
@@ -311,10 +312,7 @@ TEST_P(SharedCharacterFit, DefaultBakeMeetsTheFitTargets) {
   bake::BakeResult baked;
   const Status s = bake::BakeCharacter(path, config, &baked);
   ASSERT_TRUE(s.ok()) << s.message();
-  const nlohmann::json& fit = baked.report["fit"];
-  EXPECT_LE(fit["bloat_p99_mm"].get<double>(), 10.0);
-  EXPECT_LE(fit["bloat_max_mm"].get<double>(), 30.0);
-  EXPECT_GE(fit["coverage"].get<double>(), 0.99);
+  test::ExpectFitTargets(baked.report["fit"]);
   RecordProperty("hulls", std::to_string(baked.asset.hulls.size()));
 }
 
