@@ -27,8 +27,8 @@
 #include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
-#include "drape/runtime/task_system.h"
 #include "test_support.h"
+#include "workers.h"
 
 namespace drape {
 namespace {
@@ -81,16 +81,10 @@ const Scene& TheScene() {
 }
 
 // The runtime's std::thread pool on `threads` workers (the serial task system for 1), the way an
-// engine or drape-sim runs the runtime; restored to the default when it goes.
-class Workers {
- public:
-  explicit Workers(int64_t threads) : pool_(static_cast<uint32_t>(threads)) {
-    SetTaskSystem(threads <= 1 ? &SerialTaskSystem() : &pool_);
-  }
-  ~Workers() { SetTaskSystem(nullptr); }
-
- private:
-  ThreadPoolTaskSystem pool_;
+// engine or drape-sim runs the runtime; the default again when it goes.
+struct Workers {
+  explicit Workers(int64_t threads) { test::UseWorkers(static_cast<int>(threads)); }
+  ~Workers() { test::UseDefaultWorkers(); }
 };
 
 RenderRegion Region(int which) {
