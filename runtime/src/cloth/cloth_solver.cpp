@@ -28,7 +28,6 @@ using internal::SpringRun;
 using detail::AnyNonFinite;
 using detail::Finite;
 using detail::InvalidArgument;
-using detail::kNoParticle;
 using detail::kParticleGrain;
 using detail::ParallelFor;
 using detail::ParallelRanges;
