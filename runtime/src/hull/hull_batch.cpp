@@ -11,6 +11,14 @@
 #include "tasks/parallel_for.h"
 
 namespace drape {
+namespace {
+
+// Particles per chunk of a parallel batch. Each chunk taken costs an atomic on a line the workers
+// share: the walking skirt's 10 100 particles on 2 workers collide 5 % faster in chunks of 512
+// than of 256 (40 chunks), and its contacts still spread over 20.
+constexpr int64_t kBatchGrain = 512;
+
+}  // namespace
 
 uint32_t HullColliderSet::BroadPhase(Float3 p0, Float3 p1, float s0, float s1, bool active,
                                      uint32_t* out) const {
@@ -67,7 +75,7 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
   const int64_t count = static_cast<int64_t>(n);
   // Small batches stay on the calling thread: waking workers costs more than it saves, and on a
   // loaded machine far more (measured: a 961-particle sheet 25x slower with 2 threads). Larger
-  // ones go in chunks of 256 particles, taken as the workers finish (contacts cluster).
+  // ones go in chunks of kBatchGrain particles, taken as the workers finish (contacts cluster).
   const bool parallel = count > 4096;
   detail::ChunkSum contacts;
   if (active && collider_count_ <= kMaxGroupedColliders) {
@@ -108,7 +116,7 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
       }
       return group_contacts;
     };
-    detail::ParallelRanges(groups, parallel ? 256 / width : groups,
+    detail::ParallelRanges(groups, parallel ? kBatchGrain / width : groups,
                            [&](int64_t begin, int64_t end) {
                              uint32_t chunk_contacts = 0;
                              for (int64_t g = begin; g < end; ++g)
@@ -133,7 +141,7 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
     }
     return (flags[k] & kCollisionContact) != 0 ? 1u : 0u;
   };
-  detail::ParallelRanges(count, parallel ? 256 : count, [&](int64_t begin, int64_t end) {
+  detail::ParallelRanges(count, parallel ? kBatchGrain : count, [&](int64_t begin, int64_t end) {
     uint32_t chunk_contacts = 0;
     for (int64_t i = begin; i < end; ++i) chunk_contacts += particle(i);
     contacts.Add(chunk_contacts);
