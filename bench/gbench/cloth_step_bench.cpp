@@ -8,8 +8,10 @@
 // the worst-spring measure after each frame; 0: off, max_stretch_pct then reads 0), guard (1:
 // ClothSolverSettings::guard_blowups, the per-substep backup and finite check; 0: off); 5
 // spring-correction iterations per substep (Verlet). max_stretch_pct: the worst stretch spring over
-// the timed frames. BM_BulletSkirt is the peer: Bullet's soft body (bench/peers) on the same skirt
-// mesh, masses and waistband, against the same 4 boxes (btConvexHullShape of their 8 corners)
+// the timed frames. overstretched_per_frame: the stretch springs beyond the strain limit (10 %
+// for paper B's solver) after a frame, the mean over the timed frames.
+// BM_BulletSkirt is the peer: Bullet's soft body (bench/peers) on the same skirt mesh, masses and
+// waistband, against the same 4 boxes (btConvexHullShape of their 8 corners)
 // and 16 spheres posed by the same walk, 5 position iterations per substep, single-threaded.
 // Both report the penetration of the particles into the boxes and spheres after each timed frame
 // (measured outside the timed region): max_depth_mm over all frames, frame_max_depth_mm the mean
@@ -137,7 +139,7 @@ void BM_ClothStep(benchmark::State& state) {
   frame.skinning_start = start;
   frame.skinning_end = end;
   int step = 0;
-  uint64_t contacts = 0;
+  uint64_t contacts = 0, overstretched = 0;
   float worst_stretch = 0.f;
   ClothStageSeconds stages;
   const auto advance = [&]() {
@@ -156,12 +158,14 @@ void BM_ClothStep(benchmark::State& state) {
     stages.collide += stats.stage_seconds.collide;
     stages.bookkeeping += stats.stage_seconds.bookkeeping;
     worst_stretch = std::max(worst_stretch, stats.max_stretch);
+    overstretched += stats.overstretched_springs;
     ++step;
     return true;
   };
   for (int warm = 0; warm < 60; ++warm)
     if (!advance()) return;  // one second: the skirt settles onto the legs
   contacts = 0;
+  overstretched = 0;
   worst_stretch = 0.f;
   stages = ClothStageSeconds{};
   int timed = 0;
@@ -180,6 +184,8 @@ void BM_ClothStep(benchmark::State& state) {
   state.counters["colliders"] = static_cast<double>(scene.collider_count);
   state.counters["contacts_per_frame"] = timed > 0 ? static_cast<double>(contacts) / timed : 0.0;
   state.counters["max_stretch_pct"] = 100.0 * worst_stretch;
+  state.counters["overstretched_per_frame"] =
+      timed > 0 ? static_cast<double>(overstretched) / timed : 0.0;
   // Stage times, ms per frame (ClothSolverSettings::measure_stages).
   const double per_frame_ms = timed > 0 ? 1e3 / timed : 0.0;
   state.counters["integrate_ms"] = stages.integrate * per_frame_ms;

@@ -187,6 +187,7 @@ nlohmann::json FrameJson(const FrameStats& f) {
           {"held_inside_particles", f.held_inside_particles},
           {"held_max_penetration_mm", f.held_max_penetration * 1000.f},
           {"max_stretch", f.max_stretch},
+          {"overstretched_springs", f.overstretched_springs},
           {"nan", !f.finite},
           {"rss_bytes", f.rss_bytes},
           {"measure_ms", f.measure_ms},

@@ -174,6 +174,8 @@ struct FrameLoop {
   uint64_t contact_total = 0;
   uint32_t contact_max = 0;
   float stretch_max = 0.f;
+  uint32_t overstretched_max = 0;
+  uint64_t overstretched_total = 0;
   int64_t written = 0;  // pictures written
   std::vector<Thumbnail> thumbnails;
   Status failure = Status::Ok();  // the step that failed, if one did
@@ -258,6 +260,8 @@ Status SimulateFrames(const bake::Scene& scene, const std::string& dir, SceneSim
     loop->contact_total += stats.contacts;
     loop->contact_max = std::max(loop->contact_max, stats.contacts);
     loop->stretch_max = std::max(loop->stretch_max, stats.max_stretch);
+    loop->overstretched_max = std::max(loop->overstretched_max, stats.overstretched_springs);
+    loop->overstretched_total += stats.overstretched_springs;
     if (!loop->failure.ok()) break;
     if (k % every == 0) {
       const auto render_start = Clock::now();
@@ -348,6 +352,9 @@ int RunScene(const RunOptions& options) {
       return Fail(s.message());
   }
 
+  const double overstretched_mean =
+      simulated > 0 ? static_cast<double>(loop.overstretched_total) / static_cast<double>(simulated)
+                    : 0.0;
   const json totals = {{"frames", simulated},
                        {"frames_written", loop.written},
                        {"particles", sim.particle_count()},
@@ -370,6 +377,8 @@ int RunScene(const RunOptions& options) {
                        {"held_inside_particles_max", summary.held_inside_particles_max},
                        {"held_max_penetration_mm", summary.held_max_penetration * 1000.f},
                        {"max_stretch", loop.stretch_max},
+                       {"overstretched_springs_mean", overstretched_mean},
+                       {"overstretched_springs_max", loop.overstretched_max},
                        {"nan_frames", summary.nan_frames},
                        {"rss_peak_bytes", rss_peak},
                        {"rss_after_100_frames_bytes", summary.rss_after_100_frames},

@@ -299,6 +299,7 @@ Status SceneSimulation::Step(int64_t frame, FrameStats* stats) {
     stats->body_map_contacts += step.body_map_contacts;
     stats->shape_contacts += step.shape_contacts;
     stats->max_stretch = std::max(stats->max_stretch, step.max_stretch);
+    stats->overstretched_springs += step.overstretched_springs;
     if (!result.ok()) {
       result = Status(result.code(), scene_->source + ": frame " + std::to_string(frame) + ", " +
                                          scene_->garments[g].path + ": " + result.message());

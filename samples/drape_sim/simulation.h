@@ -43,7 +43,9 @@ struct FrameStats {
   // they are counted apart from what the solver answers for.
   uint32_t held_inside_particles = 0;
   float held_max_penetration = 0.f;
-  float max_stretch = 0.f;      // max over stretch springs of L / R - 1
+  float max_stretch = 0.f;  // max over stretch springs of L / R - 1
+  // Stretch springs beyond their garment's strain limit (ClothStepStats), all garments.
+  uint32_t overstretched_springs = 0;
   bool finite = true;           // every position and velocity finite
   uint64_t rss_bytes = 0;       // the process's resident set size after the frame (0: unknown)
   double measure_ms = 0.0;      // wall time of the point queries above (not part of step_ms)

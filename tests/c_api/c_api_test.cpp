@@ -28,7 +28,7 @@ const std::string kAsset = std::string(DRAPE_GOLDEN_DIR) + "/mannequin_colliders
 constexpr int kFrames = 60;
 
 // The scenario of garment_scenario.c through the C++ API.
-std::vector<Float3> RunCpp(uint32_t* contacts) {
+std::vector<Float3> RunCpp(uint32_t* contacts, uint32_t* overstretched) {
   CharacterAsset asset;
   EXPECT_TRUE(ReadAssetFile(kAsset, &asset).ok());
   SkeletonPose pose;
@@ -81,14 +81,16 @@ std::vector<Float3> RunCpp(uint32_t* contacts) {
     ClothStepStats stats;
     EXPECT_TRUE(solver.Step(&state, hit, {dt, start, end}, &stats).ok());
     *contacts = stats.contacts;
+    *overstretched = stats.overstretched_springs;
     start = end;
   }
   return state.positions;
 }
 
-std::vector<float> RunC(uint32_t* contacts) {
+std::vector<float> RunC(uint32_t* contacts, uint32_t* overstretched) {
   std::vector<float> positions(3 * kScenarioParticles);
-  const int status = scenario_run(kAsset.c_str(), kFrames, positions.data(), contacts);
+  const int status =
+      scenario_run(kAsset.c_str(), kFrames, positions.data(), contacts, overstretched);
   EXPECT_EQ(status, DRAPE_OK) << drape_last_error();
   return positions;
 }
@@ -100,20 +102,21 @@ void PoolParallelFor(uint32_t chunk_count, drape_task_fn run, void* context, voi
 
 TEST(CApi, GarmentMatchesTheCppApiBitForBit) {
   SetTaskSystem(&SerialTaskSystem());
-  uint32_t cpp_contacts = 0, c_contacts = 0;
-  const std::vector<Float3> cpp = RunCpp(&cpp_contacts);
-  const std::vector<float> c = RunC(&c_contacts);
+  uint32_t cpp_contacts = 0, c_contacts = 0, cpp_overstretched = 0, c_overstretched = 0;
+  const std::vector<Float3> cpp = RunCpp(&cpp_contacts, &cpp_overstretched);
+  const std::vector<float> c = RunC(&c_contacts, &c_overstretched);
   ASSERT_EQ(c.size(), 3 * cpp.size());
   EXPECT_EQ(std::memcmp(c.data(), cpp.data(), c.size() * sizeof(float)), 0);
   EXPECT_EQ(c_contacts, cpp_contacts);
+  EXPECT_EQ(c_overstretched, cpp_overstretched);
   EXPECT_GT(c_contacts, 0u);  // the skirt touches the legs, the floor or the staff
   for (const float v : c) ASSERT_TRUE(std::isfinite(v));
 
   // The same through a job system set from C.
   ThreadPoolTaskSystem pool(2);
   drape_set_task_system(PoolParallelFor, 2, &pool);
-  uint32_t pooled_contacts = 0;
-  EXPECT_EQ(RunC(&pooled_contacts), c);
+  uint32_t pooled_contacts = 0, pooled_overstretched = 0;
+  EXPECT_EQ(RunC(&pooled_contacts, &pooled_overstretched), c);
   drape_set_task_system(nullptr, 0, nullptr);
   EXPECT_EQ(&GetTaskSystem(),
             OpenMpTaskSystem() != nullptr ? OpenMpTaskSystem() : &SerialTaskSystem());

@@ -89,7 +89,8 @@ static drape_status create_cloth(Scenario* s, const float root[12]) {
   return drape_cloth_create(&desc, &settings, &s->cloth);
 }
 
-int scenario_run(const char* asset_path, int frames, float* out_positions, uint32_t* out_contacts) {
+int scenario_run(const char* asset_path, int frames, float* out_positions, uint32_t* out_contacts,
+                 uint32_t* out_overstretched) {
   Scenario s = {NULL, NULL, NULL, NULL, NULL};
   drape_status status = drape_asset_load(asset_path, &s.asset);
   if (status == DRAPE_OK) status = drape_pose_create(s.asset, &s.pose);
@@ -138,6 +139,7 @@ int scenario_run(const char* asset_path, int frames, float* out_positions, uint3
   if (status == DRAPE_OK) {
     memcpy(out_positions, drape_cloth_positions(s.cloth), sizeof(float) * 3 * kScenarioParticles);
     *out_contacts = stats.contacts;
+    *out_overstretched = stats.overstretched_springs;
   }
   destroy(&s);
   return (int)status;

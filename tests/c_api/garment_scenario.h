@@ -22,9 +22,11 @@ void scenario_skirt_mesh(const float top[3], float radius, float length, float* 
 /* Loads `asset_path`, skins the skirt to the root joint (waistband exactly, the rest within
  * 15 cm), then steps `frames` frames of 1/60 s of the asset's first clip against its baked
  * colliders and two engine shapes (a floor and a swinging capsule), 2 substeps. Writes the final
- * positions (kScenarioParticles * 3 floats) and the contacts of the last frame. Returns 0, or
- * the drape_status of the first failing call (its message in drape_last_error()). */
-int scenario_run(const char* asset_path, int frames, float* out_positions, uint32_t* out_contacts);
+ * positions (kScenarioParticles * 3 floats), the contacts and the springs beyond the strain limit
+ * of the last frame. Returns 0, or the drape_status of the first failing call (its message in
+ * drape_last_error()). */
+int scenario_run(const char* asset_path, int frames, float* out_positions, uint32_t* out_contacts,
+                 uint32_t* out_overstretched);
 
 /* The capsule's transform at a frame (12 floats), shared by both scenarios. */
 void scenario_staff(const float root[12], int frame, float out[12]);

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <numbers>
 #include <vector>
@@ -145,6 +146,49 @@ TEST(Tethers, HoldTheWalkingSkirtNearItsRestLengthAtOneSubstep) {
   }
   EXPECT_LT(worst, 0.5f);
   EXPECT_LE(beyond_tether, 1e-5f);
+}
+
+// Stretch springs longer than `allowed` times their rest length.
+uint32_t CountLongerThan(const Cloth& cloth, const ClothState& state, float allowed) {
+  uint32_t count = 0;
+  for (uint32_t k = 0; k < cloth.spring_count(SpringKind::kStretch); ++k) {
+    const ClothSpring& s = cloth.springs()[k];
+    count += Length(state.positions[s.b] - state.positions[s.a]) > allowed * s.rest_length;
+  }
+  return count;
+}
+
+TEST(StretchMeasure, CountsTheSpringsBeyondTheStrainLimit) {
+  // The walking skirt on the legs, where the colliders hold springs beyond the limit: the step's
+  // count is the springs longer than R (1 + max_stretch), to within the rounding margin, or
+  // beyond 10 % under paper B (no limit); nothing when the measure is off.
+  WalkingScene scene;
+  ClothColliders colliders;
+  colliders.hulls = &scene.hulls;
+  for (const float limit : {0.1f, 0.25f, std::numeric_limits<float>::infinity()}) {
+    ClothSolverSettings settings;
+    settings.max_stretch = limit;
+    ClothSolver solver;
+    ASSERT_TRUE(solver.Init(scene.cloth, settings).ok());
+    ClothState state;
+    state.Reset(scene.cloth);
+    Walk(&solver, &state, colliders, 0, 30);
+    Mat34 start[kJoints], end[kJoints];
+    WalkPose(At(30), start);
+    WalkPose(At(31), end);
+    ClothStepStats stats;
+    ASSERT_TRUE(solver.Step(&state, colliders, {kFrame, start, end}, &stats).ok());
+    const float allowed = 1.f + (std::isinf(limit) ? 0.1f : limit);
+    EXPECT_GT(stats.overstretched_springs, 0u) << "limit " << limit;
+    EXPECT_LE(stats.overstretched_springs, CountLongerThan(scene.cloth, state, allowed));
+    EXPECT_GE(stats.overstretched_springs,
+              CountLongerThan(scene.cloth, state, allowed * (1.f + 1e-4f)));
+    settings.measure_stretch = false;
+    ASSERT_TRUE(solver.SetSettings(settings).ok());
+    ASSERT_TRUE(solver.Step(&state, colliders, {kFrame, start, end}, &stats).ok());
+    EXPECT_EQ(stats.overstretched_springs, 0u);
+    EXPECT_EQ(stats.max_stretch, 0.f);
+  }
 }
 
 // A 1 m horizontal sheet skinned to joint 0 (weight 1), its winding facing up; the joint swings.

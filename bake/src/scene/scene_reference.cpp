@@ -130,7 +130,9 @@ colliders' own point queries: `HullColliderSet::Query`, `BodyMapCollider::Query`
 `held_inside_particles` and `held_max_penetration_mm` (the same for the held particles: attached,
 pinned, or skinned with max distance 0; no collider moves them, so one inside is where the scene
 put it, e.g. a waistband drawn inside the hips), `measure_ms` (the wall time of those queries, not
-in `step_ms`), `max_stretch` (max L/R - 1 over stretch springs), `nan`, `rss_bytes`
+in `step_ms`), `max_stretch` (max L/R - 1 over stretch springs), `overstretched_springs` (stretch
+springs longer than the solver's strain limit allows, `max_stretch` of `/solver`, or 10 % without
+one: one spring far off, or the garment stretched all over), `nan`, `rss_bytes`
 (the process's resident set size after the frame: resident pages of `/proc/self/statm` times the
 page size; 0 where it cannot be read). Settle frames are not listed.
 
@@ -147,6 +149,7 @@ page size; 0 where it cannot be read). Settle frames are not listed.
 | `frames_with_particles_inside`, `inside_particles_max` | frames ending with a particle inside; the most particles inside at the end of one frame |
 | `held_inside_particles_max`, `held_max_penetration_mm` | the held particles inside a collider: the most at the end of one frame, the deepest (also in the summary line) |
 | `max_stretch`, `nan_frames` | over the run |
+| `overstretched_springs_mean`, `overstretched_springs_max` | per frame |
 | `rss_peak_bytes` | the peak resident set size (`VmHWM` of `/proc/self/status`) after the last frame: the bake, the setup and the simulation, not the writing of stats.json |
 | `rss_after_100_frames_bytes`, `rss_end_bytes`, `rss_growth_bytes` | `rss_bytes` of frame 99 (the last frame of a shorter run) and of the last frame, and end - after 100 (may be negative) |
 | `render_ms_total`, `wall_s` | picture time, the run's wall time (bake included) |

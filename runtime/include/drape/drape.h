@@ -167,6 +167,8 @@ typedef struct drape_step_stats {
   uint32_t hull_contacts;  /* summed over substeps */
   uint32_t shape_contacts; /* summed over substeps */
   float max_stretch;       /* after the step: max over stretch springs of L / R - 1 */
+  /* After the step: stretch springs beyond the strain limit (10 % without one). */
+  uint32_t overstretched_springs;
 } drape_step_stats;
 
 typedef struct drape_cloth drape_cloth;

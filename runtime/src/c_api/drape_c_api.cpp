@@ -480,6 +480,7 @@ drape_status drape_cloth_step(drape_cloth* cloth, float dt, const float* skinnin
     stats->hull_contacts = st.hull_contacts;
     stats->shape_contacts = st.shape_contacts;
     stats->max_stretch = st.max_stretch;
+    stats->overstretched_springs = st.overstretched_springs;
   }
   return s;
 }

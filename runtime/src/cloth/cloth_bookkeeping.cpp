@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "cloth/cloth_solver_internal.h"
 #include "drape/runtime/cloth_solver.h"
@@ -81,32 +82,44 @@ void ClothSolver::RestoreBackup(ClothState* state) {
   restore_kinematic_ = false;
 }
 
-float ClothSolver::MaxStretch(const ClothState& state) const {
-  if (measured_springs_.empty()) return 0.f;
+ClothSolver::StretchFigures ClothSolver::MeasureStretch(const ClothState& state) const {
+  if (measured_springs_.empty()) return {};
   const MeasuredSpring* springs = measured_springs_.data();
   const Float3* x = state.positions.data();
+  // A spring counts as overstretched beyond the strain limit by more than the limit pass's
+  // rounding (which leaves a spring it shortened within a few ulps of the limit): L^2 > (R (1 +
+  // limit))^2 (1 + 1e-4), the limit 10 % when the strain limit is off.
+  const bool limited = settings_.max_stretch < std::numeric_limits<float>::infinity();
+  const float allowed = 1.f + (limited ? settings_.max_stretch : 0.1f);
+  const float over_factor = allowed * allowed * (1.f + 1e-4f);
   // Float max is exact and order-independent: each chunk's max, then the max of those. A chunk
   // skips the square root and division for springs clearly below its running max (L^2 <
   // (R (1 + max))^2 (1 - 1e-5): a margin far above the rounding of the test), so the result is
-  // the exact max however the springs are chunked. A spring of length 0 has stretch -1.
+  // the exact max however the springs are chunked. A spring of length 0 has stretch -1. The count
+  // is an integer sum over the chunks.
   std::atomic<float> max_stretch{-1.f};
+  detail::ChunkSum overstretched;
   ParallelRanges(static_cast<int64_t>(measured_springs_.size()), kSpringGrain,
                  [&](int64_t begin, int64_t end) {
                    float chunk_max = -1.f;
+                   uint32_t chunk_over = 0;
                    for (int64_t k = begin; k < end; ++k) {
                      const MeasuredSpring& s = springs[k];
                      const Float3 d = x[s.b] - x[s.a];
                      const float length_squared = Dot(d, d);
+                     const float rest_squared = s.rest_length * s.rest_length;
+                     chunk_over += length_squared > rest_squared * over_factor ? 1u : 0u;
                      const float bound = s.rest_length * (1.f + chunk_max);
                      if (length_squared < bound * bound * (1.f - 1e-5f)) continue;
                      chunk_max =
                          std::max(chunk_max, std::sqrt(length_squared) / s.rest_length - 1.f);
                    }
+                   overstretched.Add(chunk_over);
                    float seen = max_stretch.load(std::memory_order_relaxed);
                    while (chunk_max > seen && !max_stretch.compare_exchange_weak(seen, chunk_max)) {
                    }
                  });
-  return max_stretch.load();
+  return {max_stretch.load(), overstretched.total()};
 }
 
 }  // namespace drape

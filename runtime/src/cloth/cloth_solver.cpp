@@ -437,7 +437,9 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
       const uint32_t bad = FirstNonFinite(*state);
       RestoreBackup(state);
       st.contacts = 0;
-      st.max_stretch = MaxStretch(*state);
+      const StretchFigures stretch = MeasureStretch(*state);
+      st.max_stretch = stretch.max_stretch;
+      st.overstretched_springs = stretch.overstretched;
       return Status(StatusCode::kInvalidState,
                     "ClothSolver::Step: particle " + std::to_string(bad) +
                         " became non-finite in substep " + std::to_string(k) +
@@ -448,7 +450,11 @@ Status ClothSolver::Step(ClothState* state, const ClothColliders& colliders,
     clock.Lap(&ClothStageSeconds::bookkeeping);
   }
   StageClock clock(settings_.measure_stages, &st.stage_seconds);
-  if (settings_.measure_stretch) st.max_stretch = MaxStretch(*state);
+  if (settings_.measure_stretch) {
+    const StretchFigures stretch = MeasureStretch(*state);
+    st.max_stretch = stretch.max_stretch;
+    st.overstretched_springs = stretch.overstretched;
+  }
   clock.Lap(&ClothStageSeconds::bookkeeping);
   return Status::Ok();
 }

@@ -148,8 +148,12 @@ struct ClothStepStats {
   uint32_t hull_contacts = 0;      // sum over substeps of the hulls' contact counts
   uint32_t body_map_contacts = 0;  // sum over substeps of the body map's contact counts
   uint32_t shape_contacts = 0;     // sum over substeps of the engine shapes' contact counts
-  // After the step: max over stretch springs of L / R - 1 (0 when measure_stretch is off).
+  // After the step (both 0 when measure_stretch is off): max over stretch springs of L / R - 1,
+  // and how many stretch springs are longer than the strain limit allows, R (1 + max_stretch)
+  // (R 1.1 when the limit is off), by more than rounding: one spring far off, or the garment
+  // stretched all over.
   float max_stretch = 0.f;
+  uint32_t overstretched_springs = 0;
   ClothStageSeconds stage_seconds;  // zeros unless ClothSolverSettings::measure_stages
 };
 
@@ -236,7 +240,12 @@ class ClothSolver {
   // `check_finite`, also whether a position or velocity is not finite (*any_non_finite).
   uint32_t CountContacts(const ClothState& state, bool check_finite, bool* any_non_finite);
   void RestoreBackup(ClothState* state);
-  float MaxStretch(const ClothState& state) const;
+  // The stretch measure's figures: ClothStepStats::max_stretch and overstretched_springs.
+  struct StretchFigures {
+    float max_stretch = 0.f;
+    uint32_t overstretched = 0;
+  };
+  StretchFigures MeasureStretch(const ClothState& state) const;
 
   const Cloth* cloth_ = nullptr;
   ClothSolverSettings settings_;
@@ -257,7 +266,7 @@ class ClothSolver {
   // loads; Verlet: written by Integrate and ApplyAttachments, read back after the springs) and the
   // springs in blocks of four, by group and colour (BuildSpringGroups).
   std::vector<internal::Particle4> solver_positions_;
-  // The stretch springs MaxStretch measures, ordered by their lower particle index: a chunk of
+  // The stretch springs MeasureStretch measures, ordered by their lower particle index: a chunk of
   // them reads the particles that the same worker's chunk of every per-particle stage wrote.
   struct MeasuredSpring {
     uint32_t a = 0, b = 0;
