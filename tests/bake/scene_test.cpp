@@ -392,6 +392,67 @@ TEST_F(SceneTest, SkinnedGarmentTakesItsWeightsFromTheBody) {
   EXPECT_FALSE(Parse(j, &scene).ok());
 }
 
+// A skirt skinned as a skirt: `transfer: held` gives every particle the body weights of its
+// nearest held particle (its column's waist particle), so the legs do not drag the hem along;
+// `paint: ramp` grows max_distance from 0 at the waist to max_distance at the hem. Both need a
+// held part, and the ramp a finite max_distance.
+TEST_F(SceneTest, SkirtFollowsItsWaistbandWithARampedMaxDistance) {
+  json j = DemoJson();
+  j["garments"][0]["skin"] = {{"max_distance", 0.2}, {"smoothing", 0}};
+  Scene scene;
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  ResolvedGarment closest;
+  ASSERT_TRUE(ResolveSkinned(scene, &closest).ok());
+  j["garments"][0]["skin"] = {
+      {"max_distance", 0.2}, {"smoothing", 0}, {"transfer", "held"}, {"paint", "ramp"}};
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  ResolvedGarment held;
+  const Status s = ResolveSkinned(scene, &held);
+  ASSERT_TRUE(s.ok()) << s.message();
+  const ClothDescription& d = held.description;
+  constexpr size_t kSegments = 64;  // the demo skirt's particles around; ring 0 is held
+  const size_t rings = d.positions.size() / kSegments - 1;
+  ASSERT_EQ(d.positions.size(), (rings + 1) * kSegments);
+  std::vector<Mat34> bind(asset().skeleton.joint_count());
+  uint32_t differs_from_closest = 0;
+  for (size_t i = 0; i < d.positions.size(); ++i) {
+    const ClothSkinWeights& waist = closest.description.skin[i % kSegments];
+    Float3 skinned;
+    for (int k = 0; k < 4; ++k) {
+      ASSERT_EQ(d.skin[i].joints[k], waist.joints[k]) << i;
+      ASSERT_EQ(d.skin[i].weights[k], waist.weights[k]) << i;
+      skinned += TransformPoint(bind[d.skin[i].joints[k]], d.skin_bind_positions[i]) *
+                 d.skin[i].weights[k];
+    }
+    ASSERT_LT(Length(skinned - d.positions[i]), 1e-5f) << i;
+    const ClothSkinWeights& own = closest.description.skin[i];
+    differs_from_closest += own.joints[0] != waist.joints[0] || own.weights[0] != waist.weights[0];
+    const size_t ring = i / kSegments;
+    if (ring == 0) {
+      EXPECT_EQ(d.max_distance[i], std::numeric_limits<float>::infinity()) << i;
+    } else {
+      EXPECT_NEAR(d.max_distance[i], 0.2f * static_cast<float>(ring) / static_cast<float>(rings),
+                  1e-5f)
+          << i;
+    }
+  }
+  EXPECT_GT(differs_from_closest, kSegments);  // the closest points of the hem are the legs'
+  j["garments"][0]["skin"]["max_distance"] = "none";
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  Status refused = ResolveSkinned(scene, &held);
+  EXPECT_NE(refused.message().find("/garments/0/skin/paint: \"ramp\" scales max_distance"),
+            std::string::npos)
+      << refused.message();
+  j["garments"][0]["skin"] = {{"transfer", "held"}};
+  j["garments"][0].erase("attach");
+  j["garments"][0]["pin"] = json::array();
+  ASSERT_TRUE(Parse(j, &scene).ok()) << j.dump();
+  refused = ResolveSkinned(scene, &held);
+  EXPECT_NE(refused.message().find("/garments/0/skin/transfer: \"held\" takes the weights"),
+            std::string::npos)
+      << refused.message();
+}
+
 // An OBJ garment painted with vertex colours: the red channel scales max_distance per particle
 // (black: the particle follows the skin exactly, as a held one). Without colours: refused.
 TEST_F(SceneTest, SkinnedObjGarmentTakesItsPaintedMaxDistance) {

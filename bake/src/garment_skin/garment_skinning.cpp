@@ -4,12 +4,16 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <limits>
+#include <queue>
 #include <sstream>
 #include <string>
 #include <utility>
 
 #include "config/name_suggestions.h"
 #include "drape/bake/mesh_reference.h"
+#include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "scene/scene_messages.h"
 
@@ -184,6 +188,48 @@ void SmoothSkinWeights(std::span<const uint32_t> triangles, uint32_t iterations,
     }
     weights->swap(next);
   }
+}
+
+std::vector<float> DistanceAlongEdges(std::span<const uint32_t> triangles,
+                                      std::span<const Float3> positions,
+                                      std::span<const uint32_t> sources,
+                                      std::vector<uint32_t>* nearest) {
+  const size_t n = positions.size();
+  std::vector<std::vector<uint32_t>> neighbours(n);
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = triangles[t + e], b = triangles[t + (e + 1) % 3];
+      neighbours[a].push_back(b);
+      neighbours[b].push_back(a);
+    }
+  }
+  // Doubles: the sums of thousands of edges stay exact enough to order the vertices the same way
+  // on every machine.
+  std::vector<double> distance(n, std::numeric_limits<double>::infinity());
+  std::vector<uint32_t> source_of(n, UINT32_MAX);
+  using Entry = std::pair<double, uint32_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (uint32_t k = 0; k < sources.size(); ++k) {
+    if (distance[sources[k]] == 0.0) continue;  // listed twice: the first one
+    distance[sources[k]] = 0.0;
+    source_of[sources[k]] = k;
+    queue.push({0.0, sources[k]});
+  }
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > distance[v]) continue;
+    for (const uint32_t w : neighbours[v]) {
+      const double through = d + static_cast<double>(Length(positions[w] - positions[v]));
+      if (through < distance[w]) {
+        distance[w] = through;
+        source_of[w] = source_of[v];
+        queue.push({through, w});
+      }
+    }
+  }
+  if (nearest != nullptr) *nearest = std::move(source_of);
+  return std::vector<float>(distance.begin(), distance.end());
 }
 
 }  // namespace drape::bake::detail

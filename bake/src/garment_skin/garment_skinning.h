@@ -37,4 +37,13 @@ Status ReadSkinWeightsFile(const std::string& file, const SkeletonData& skeleton
 void SmoothSkinWeights(std::span<const uint32_t> triangles, uint32_t iterations,
                        std::vector<ClothSkinWeights>* weights);
 
+// Metres from each vertex to the nearest of `sources` along the mesh's edges (Dijkstra over the
+// triangles' edges, rest lengths from `positions`); +inf where no edge path reaches. nearest
+// (optional): that source's index in `sources` per vertex (UINT32_MAX where none reaches; ties:
+// the path found first, the same on every machine).
+std::vector<float> DistanceAlongEdges(std::span<const uint32_t> triangles,
+                                      std::span<const Float3> positions,
+                                      std::span<const uint32_t> sources,
+                                      std::vector<uint32_t>* nearest = nullptr);
+
 }  // namespace drape::bake::detail

@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -23,6 +25,55 @@ Status BodyInGarmentFrame(const SceneGarment& g, const SkeletonData& skeleton, c
   if (Status s = rest.Init(skeleton); !s.ok()) return s;
   rest.SetRest();
   return SkinMesh(body, rest.skinning(), *positions);
+}
+
+// The held particles: attached to a joint or pinned.
+std::vector<uint32_t> HeldParticles(const ClothDescription& d) {
+  std::vector<uint32_t> held(d.pinned.begin(), d.pinned.end());
+  for (const ClothAttachment& a : d.attachments) held.push_back(a.particle);
+  return held;
+}
+
+// Each particle takes the body weights of its nearest held particle along the garment (those
+// d.skin holds, from the body's closest points); a part no edge path joins to a held one keeps
+// its own.
+Status TakeHeldWeights(ClothDescription* d) {
+  const std::vector<uint32_t> held = HeldParticles(*d);
+  if (held.empty())
+    return Invalid(
+        "\"held\" takes the weights of the held particles; the garment has none (add "
+        "an attach or a pin)");
+  std::vector<uint32_t> nearest;
+  (void)detail::DistanceAlongEdges(d->triangles, d->positions, held, &nearest);
+  const std::vector<ClothSkinWeights> body = d->skin;
+  for (size_t i = 0; i < body.size(); ++i)
+    if (nearest[i] != UINT32_MAX) d->skin[i] = body[held[nearest[i]]];
+  return Status::Ok();
+}
+
+// max_distance grows linearly along the garment, from 0 at its held particles (attached or
+// pinned) to `max_distance` at the particle farthest from them: a waistband follows the skin
+// exactly and the hem may swing. A part no edge path joins to a held particle (a loose patch)
+// gets the full max_distance.
+Status PaintRamp(float max_distance, ClothDescription* d) {
+  if (!std::isfinite(max_distance))
+    return Invalid("\"ramp\" scales max_distance, which is \"none\" (give it in metres)");
+  std::vector<uint32_t> held(d->pinned.begin(), d->pinned.end());
+  for (const ClothAttachment& a : d->attachments) held.push_back(a.particle);
+  if (held.empty())
+    return Invalid(
+        "\"ramp\" grows from the held particles; the garment has none (add an "
+        "attach or a pin)");
+  const std::vector<float> from_held = detail::DistanceAlongEdges(d->triangles, d->positions, held);
+  float farthest = 0.f;
+  for (const float distance : from_held)
+    if (std::isfinite(distance)) farthest = std::max(farthest, distance);
+  for (size_t i = 0; i < from_held.size(); ++i) {
+    const bool reached = std::isfinite(from_held[i]) && farthest > 0.f;
+    d->max_distance[i] =
+        reached ? max_distance * std::min(1.f, from_held[i] / farthest) : max_distance;
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -51,6 +102,9 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
       return Invalid(at + ": the body at the rest pose: " + s.message());
     if (Status s = detail::TransferSkinWeights(body, body_positions, d.positions, &d.skin); !s.ok())
       return Invalid(at + ": " + s.message());
+    if (g.skin_transfer == SkinTransfer::kHeld) {
+      if (Status s = TakeHeldWeights(&d); !s.ok()) return Invalid(at + "/transfer: " + s.message());
+    }
     detail::SmoothSkinWeights(d.triangles, g.skin_smoothing, &d.skin);
   }
   const size_t n = d.positions.size();
@@ -75,6 +129,9 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
                      "primitive");
     d.max_distance = garment->painted_max_distance;
     if (garment->painted_backstop.size() == n) d.backstop = garment->painted_backstop;
+  } else if (g.max_distance_channel == SceneGarment::kPaintRamp) {
+    if (Status s = PaintRamp(g.max_distance, &d); !s.ok())
+      return Invalid(at + "/paint: " + s.message());
   } else if (g.max_distance_channel >= 0) {  // painted: the channel scales max_distance
     if (garment->colors.size() != n)
       return Invalid(at +

@@ -247,7 +247,7 @@ Status ReadDistanceOrNone(const JsonAt& at, float* out) {
   return ReadFloat(at, Closed(0, 100), out);
 }
 
-// "r", "g", "b" (a colour channel: 0, 1, 2), "attribute" or "none" (-1).
+// "r", "g", "b" (a colour channel: 0, 1, 2), "attribute", "ramp" or "none" (-1).
 Status ReadPaintChannel(const JsonAt& at, SceneGarment& g) {
   const std::string value = at.value().is_string() ? at.value().get<std::string>() : "";
   const size_t channel = std::string("rgb").find(value);
@@ -255,10 +255,12 @@ Status ReadPaintChannel(const JsonAt& at, SceneGarment& g) {
     g.max_distance_channel = -1;
   } else if (value == "attribute") {
     g.max_distance_channel = SceneGarment::kPaintAttribute;
+  } else if (value == "ramp") {
+    g.max_distance_channel = SceneGarment::kPaintRamp;
   } else if (value.size() == 1 && channel != std::string::npos) {
     g.max_distance_channel = static_cast<int32_t>(channel);
   } else {
-    return at.Error("must be one of \"r\", \"g\", \"b\", \"attribute\", \"none\"");
+    return at.Error("must be one of \"r\", \"g\", \"b\", \"attribute\", \"ramp\", \"none\"");
   }
   return Status::Ok();
 }
@@ -289,15 +291,19 @@ const JsonSchema<SceneGarment>& SkinSchema() {
           .Default("none")
           .Custom(CustomFieldInfo("paint",
                                   "`\"r\"` \\| `\"g\"` \\| `\"b\"` \\| `\"attribute\"` \\| "
-                                  "`\"none\"`",
-                                  "one of \"r\", \"g\", \"b\", \"attribute\", \"none\"",
+                                  "`\"ramp\"` \\| `\"none\"`",
+                                  "one of \"r\", \"g\", \"b\", \"attribute\", \"ramp\", \"none\"",
                                   "a vertex colour channel of the garment file (an OBJ's `v x y z "
                                   "r g b`, a glTF's COLOR_0) that scales `max_distance` per "
                                   "particle (painted black: the particle follows the skin "
                                   "exactly); `attribute`: a glTF garment's `_MAX_DISTANCE` "
                                   "attribute gives it per vertex, and `_BACKSTOP`, when present, "
                                   "the backstop (file units scaled to metres; negative: "
-                                  "unlimited)"),
+                                  "unlimited); `ramp`: `max_distance` times the particle's "
+                                  "distance from the held particles along the garment over the "
+                                  "farthest one's (0 at a waistband, `max_distance` at the hem: "
+                                  "what is painted on a skirt or cape; needs an `attach` or "
+                                  "`pin`)"),
                   [](const JsonAt& at, SceneGarment& g) { return ReadPaintChannel(at, g); })
           .Default("none")
           .FilePath("weights_file",
@@ -306,6 +312,15 @@ const JsonSchema<SceneGarment>& SkinSchema() {
                     "the character's skeleton; the four heaviest kept); `#` starts a comment",
                     [](SceneGarment& g) -> std::string& { return g.skin_weights_file; })
           .Default("none: from the body")
+          .Enum<SkinTransfer>(
+              "transfer", {{"closest", SkinTransfer::kClosest}, {"held", SkinTransfer::kHeld}},
+              "where the weights come from the body. `closest`: each particle takes the body's "
+              "closest point's (a shirt, a sleeve: the garment follows the limb under it). "
+              "`held`: each particle takes those of its nearest held particle along the garment "
+              "(attached or pinned; a skirt or a cape then follows its waistband or shoulders, "
+              "and the legs move under it instead of dragging it along)",
+              [](SceneGarment& g) -> SkinTransfer& { return g.skin_transfer; })
+          .Default("closest")
           .Unsigned<uint32_t>("smoothing", "", 0, 1000,
                               "passes averaging each particle's weights from the body with its "
                               "mesh neighbours' (a skirt then follows the hips and both legs, not "

@@ -25,8 +25,9 @@ constexpr SampleScene kSampleScenes[] = {
     {"cesium_man_cape.json", "`CesiumMan.glb` (shared assets)",
      "a cape held at the upper torso, body maps rendered per frame + hulls"},
     {"cesium_man_skinned_dress.json", "`CesiumMan.glb` (shared assets)",
-     "a dress skinned to the body (weights from the closest body point, smoothed; max distance "
-     "and backstop) whose hem nears a floor the scene adds (`/collision/shapes`)"},
+     "a dress skinned to the body as a skirt is (`transfer: held`: the body's weights at its "
+     "waistband; max distance ramped down the dress, `paint: ramp`; backstop) whose hem nears a "
+     "floor the scene adds (`/collision/shapes`)"},
     {"mannequin_gltf_dress.json", "the built-in mannequin",
      "a dress read from a skinned glTF bound to the skeleton by joint name "
      "(`garments/mannequin_dress.glb`, written by `drape-sim --export-garments`), its max distance "

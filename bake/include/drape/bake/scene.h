@@ -38,6 +38,12 @@ const char* ToString(GarmentType type);
 // is mapped to the bind frame through the inverse of its joint's rest skinning matrix.
 enum class GarmentFrame : uint8_t { kBind, kRest };
 
+// Where a skinned garment's weights come from the body (SceneGarment::skin_transfer).
+enum class SkinTransfer : uint8_t {
+  kClosest,  // each particle: the body's closest point (a shirt, a sleeve, tights)
+  kHeld,     // each particle: its nearest held particle's (a skirt follows its waistband)
+};
+
 // Which particles of a garment: exactly one of a generator ring (by name, see GarmentRingNames),
 // explicit vertex indices, or the particles inside an axis-aligned box.
 struct SceneSelection {
@@ -83,12 +89,16 @@ struct SceneGarment {
   bool skinned = false;
   float max_distance = 0.05f;                               // metres, >= 0
   float backstop = std::numeric_limits<float>::infinity();  // metres, >= 0
-  uint32_t skin_smoothing = 20;   // passes averaging the weights with the mesh neighbours
+  uint32_t skin_smoothing = 20;  // passes averaging the weights with the mesh neighbours
+  SkinTransfer skin_transfer = SkinTransfer::kClosest;
   std::string skin_weights_file;  // authored weights, one line per vertex (empty: from the body)
   // -1: max_distance everywhere; 0, 1, 2: the garment file's vertex colour channel (r, g, b) in
   // [0, 1] scales it per particle (painted 0: the particle follows the skin exactly);
-  // kPaintAttribute: a glTF garment's _MAX_DISTANCE (and _BACKSTOP) attributes give them.
+  // kPaintAttribute: a glTF garment's _MAX_DISTANCE (and _BACKSTOP) attributes give them;
+  // kPaintRamp: max_distance times the particle's distance from the held particles along the
+  // garment, over the farthest particle's (0 at the held ones, max_distance at the farthest).
   static constexpr int32_t kPaintAttribute = 3;
+  static constexpr int32_t kPaintRamp = 4;
   int32_t max_distance_channel = -1;
   float tether_stretch = 0.02f;                   // long-range tethers' allowed stretch, >= 0
   std::array<float, 3> color{0.8f, 0.25f, 0.3f};  // linear RGB in [0, 1], for pictures
