@@ -418,14 +418,14 @@ int RunScene(const RunOptions& options) {
   constexpr double kMiB = 1024.0 * 1024.0;
   std::printf(
       "drape-sim: %lld frames, %.2f ms/step mean (%.2f p99, %.2f max)%s, %.0f contacts/frame, "
-      "max penetration %.2f mm%s, %u NaN frames; RSS peak %.1f MiB, %+.1f MiB after frame 100; "
-      "%lld pictures, %s; %.1f s\n",
+      "max penetration %.2f mm%s, %.0f springs/frame beyond the strain limit, %u NaN frames; "
+      "RSS peak %.1f MiB, %+.1f MiB after frame 100; %lld pictures, %s; %.1f s\n",
       static_cast<long long>(simulated), summary.step_ms_mean, summary.step_ms_p99,
       summary.step_ms_max, RenderNote(scene, summary).c_str(),
       totals["contacts_mean"].get<double>(), static_cast<double>(summary.max_penetration) * 1000.0,
-      HeldNote(summary).c_str(), summary.nan_frames, static_cast<double>(rss_peak) / kMiB,
-      static_cast<double>(summary.rss_growth) / kMiB, static_cast<long long>(loop.written),
-      animation.c_str(), Seconds(wall_start));
+      HeldNote(summary).c_str(), overstretched_mean, summary.nan_frames,
+      static_cast<double>(rss_peak) / kMiB, static_cast<double>(summary.rss_growth) / kMiB,
+      static_cast<long long>(loop.written), animation.c_str(), Seconds(wall_start));
   return 0;
 }
 
