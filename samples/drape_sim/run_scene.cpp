@@ -38,16 +38,25 @@ double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-Status CreateOutputDirectories(const std::string& dir, bool obj) {
+// The output directory, then (CreateFrameDirectories) its picture folders once the scene has
+// been checked: a scene refused after the bake leaves the cached asset, not empty folders.
+Status CreateOutputDirectory(const std::string& dir) {
   std::error_code error;
-  fs::create_directories(dir + "/frames", error);
+  fs::create_directories(dir, error);
   if (error) {
     return Status(StatusCode::kIoError,
                   dir + ": cannot create the output directory: " + error.message());
   }
-  if (obj) {
-    fs::create_directories(dir + "/obj", error);
-    if (error) return Status(StatusCode::kIoError, dir + "/obj: cannot create: " + error.message());
+  return Status::Ok();
+}
+
+Status CreateFrameDirectories(const std::string& dir, bool obj) {
+  std::error_code error;
+  for (const char* sub : {"/frames", "/obj"}) {
+    if (std::string(sub) == "/obj" && !obj) continue;
+    fs::create_directories(dir + sub, error);
+    if (error)
+      return Status(StatusCode::kIoError, dir + sub + ": cannot create: " + error.message());
   }
   return Status::Ok();
 }
@@ -295,7 +304,7 @@ int RunScene(const RunOptions& options) {
     ~RestoreTasks() { SetTaskSystem(nullptr); }
   } restore_tasks;
   const std::string dir = options.out_dir;
-  if (Status s = CreateOutputDirectories(dir, scene.output.obj); !s.ok()) return Fail(s.message());
+  if (Status s = CreateOutputDirectory(dir); !s.ok()) return Fail(s.message());
 
   // The asset: cached, or baked now.
   SceneAsset loaded;
@@ -326,6 +335,7 @@ int RunScene(const RunOptions& options) {
   if (Status s = renderer.Frame(scene, asset, clip, sim); !s.ok()) return Fail(s.message());
 
   // From here on this run writes its outputs: those of an earlier run go first.
+  if (Status s = CreateFrameDirectories(dir, scene.output.obj); !s.ok()) return Fail(s.message());
   RemoveStaleOutputs(dir);
   if (Status s = WriteReach(dir, scene, reach, left_out); !s.ok()) return Fail(s.message());
   json settle;
