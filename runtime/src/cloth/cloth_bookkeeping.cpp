@@ -93,8 +93,8 @@ ClothSolver::StretchFigures ClothSolver::MeasureStretch(const ClothState& state)
   const float allowed = 1.f + (limited ? settings_.max_stretch : 0.1f);
   const float over_factor = allowed * allowed * (1.f + 1e-4f);
   // Float max is exact and order-independent: each chunk's max, then the max of those. A chunk
-  // skips the square root and division for springs clearly below its running max (L^2 <
-  // (R (1 + max))^2 (1 - 1e-5): a margin far above the rounding of the test), so the result is
+  // skips the square root and division for springs clearly below its running max (L^2 < R^2 (1 +
+  // max)^2 (1 - 1e-5): a margin far above the rounding of the test), so the result is
   // the exact max however the springs are chunked. A spring of length 0 has stretch -1. The count
   // is an integer sum over the chunks.
   std::atomic<float> max_stretch{-1.f};
@@ -102,6 +102,7 @@ ClothSolver::StretchFigures ClothSolver::MeasureStretch(const ClothState& state)
   ParallelRanges(static_cast<int64_t>(measured_springs_.size()), kSpringGrain,
                  [&](int64_t begin, int64_t end) {
                    float chunk_max = -1.f;
+                   float skip_factor = 0.f;  // (1 + chunk_max)^2 (1 - 1e-5)
                    uint32_t chunk_over = 0;
                    for (int64_t k = begin; k < end; ++k) {
                      const MeasuredSpring& s = springs[k];
@@ -109,10 +110,10 @@ ClothSolver::StretchFigures ClothSolver::MeasureStretch(const ClothState& state)
                      const float length_squared = Dot(d, d);
                      const float rest_squared = s.rest_length * s.rest_length;
                      chunk_over += length_squared > rest_squared * over_factor ? 1u : 0u;
-                     const float bound = s.rest_length * (1.f + chunk_max);
-                     if (length_squared < bound * bound * (1.f - 1e-5f)) continue;
+                     if (length_squared < rest_squared * skip_factor) continue;
                      chunk_max =
                          std::max(chunk_max, std::sqrt(length_squared) / s.rest_length - 1.f);
+                     skip_factor = (1.f + chunk_max) * (1.f + chunk_max) * (1.f - 1e-5f);
                    }
                    overstretched.Add(chunk_over);
                    float seen = max_stretch.load(std::memory_order_relaxed);
