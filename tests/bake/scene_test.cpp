@@ -552,6 +552,14 @@ TEST_F(SceneTest, SkinnedGarmentTakesAuthoredWeightsFromAFile) {
   s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
   EXPECT_NE(s.message().find("2 weighted vertices for the garment's 3"), std::string::npos)
       << s.message();
+  // Authored weights are not the body's: taking a held particle's is refused, not ignored.
+  j["garments"][0]["skin"]["transfer"] = "held";
+  ASSERT_TRUE(Parse(j, &scene).ok());
+  s = SkinGarment(scene, 0, asset().skeleton, asset().mesh, &garment);
+  EXPECT_NE(s.message().find("/garments/0/skin/transfer: \"held\" takes the body's weights; "
+                             "this garment's are the weights_file's"),
+            std::string::npos)
+      << s.message();
 }
 
 TEST_F(SceneTest, GarmentIsHeldInTheBindFrame) {

@@ -86,6 +86,9 @@ Status SkinGarment(const Scene& scene, size_t index, const SkeletonData& skeleto
   const bool file_skin = !garment->file_skin.empty();
   if (file_skin && !g.skin_weights_file.empty())
     return Invalid(at + "/weights_file: the glTF garment has its own skin; remove one of them");
+  if (g.skin_transfer == SkinTransfer::kHeld && (file_skin || !g.skin_weights_file.empty()))
+    return Invalid(at + "/transfer: \"held\" takes the body's weights; this garment's are " +
+                   (file_skin ? "its glTF skin's" : "the weights_file's"));
   if (body.triangles.empty() && g.skin_weights_file.empty() && !file_skin)
     return Invalid(at + ": the asset has no body mesh to take weights from");
   ClothDescription& d = garment->description;

@@ -318,7 +318,8 @@ const JsonSchema<SceneGarment>& SkinSchema() {
               "closest point's (a shirt, a sleeve: the garment follows the limb under it). "
               "`held`: each particle takes those of its nearest held particle along the garment "
               "(attached or pinned; a skirt or a cape then follows its waistband or shoulders, "
-              "and the legs move under it instead of dragging it along)",
+              "and the legs move under it instead of dragging it along). Not with authored weights "
+              "(a `weights_file`, a skinned glTF garment)",
               [](SceneGarment& g) -> SkinTransfer& { return g.skin_transfer; })
           .Default("closest")
           .Unsigned<uint32_t>("smoothing", "", 0, 1000,
