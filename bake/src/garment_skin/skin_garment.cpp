@@ -41,8 +41,8 @@ Status TakeHeldWeights(ClothDescription* d) {
   const std::vector<uint32_t> held = HeldParticles(*d);
   if (held.empty())
     return Invalid(
-        "\"held\" takes the weights of the held particles; the garment has none (add "
-        "an attach or a pin)");
+        "\"held\" takes the weights of the held particles; the garment has none (add an "
+        "attach or a pin)");
   std::vector<uint32_t> nearest;
   (void)detail::DistanceAlongEdges(d->triangles, d->positions, held, &nearest);
   const std::vector<ClothSkinWeights> body = d->skin;
@@ -58,12 +58,11 @@ Status TakeHeldWeights(ClothDescription* d) {
 Status PaintRamp(float max_distance, ClothDescription* d) {
   if (!std::isfinite(max_distance))
     return Invalid("\"ramp\" scales max_distance, which is \"none\" (give it in metres)");
-  std::vector<uint32_t> held(d->pinned.begin(), d->pinned.end());
-  for (const ClothAttachment& a : d->attachments) held.push_back(a.particle);
+  const std::vector<uint32_t> held = HeldParticles(*d);
   if (held.empty())
     return Invalid(
-        "\"ramp\" grows from the held particles; the garment has none (add an "
-        "attach or a pin)");
+        "\"ramp\" grows from the held particles; the garment has none (add an attach "
+        "or a pin)");
   const std::vector<float> from_held = detail::DistanceAlongEdges(d->triangles, d->positions, held);
   float farthest = 0.f;
   for (const float distance : from_held)
