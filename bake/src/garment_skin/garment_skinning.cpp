@@ -20,6 +20,24 @@
 namespace drape::bake::detail {
 namespace {
 
+// Each vertex's neighbours along the triangles' edges, ascending, each once.
+std::vector<std::vector<uint32_t>> EdgeNeighbours(std::span<const uint32_t> triangles,
+                                                  size_t vertices) {
+  std::vector<std::vector<uint32_t>> neighbours(vertices);
+  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = triangles[t + e], b = triangles[t + (e + 1) % 3];
+      neighbours[a].push_back(b);
+      neighbours[b].push_back(a);
+    }
+  }
+  for (std::vector<uint32_t>& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return neighbours;
+}
+
 // Joint weights summed by joint (a handful of joints: a linear search), then the four heaviest.
 class JointBlend {
  public:
@@ -162,18 +180,7 @@ Status ReadSkinWeightsFile(const std::string& file, const SkeletonData& skeleton
 void SmoothSkinWeights(std::span<const uint32_t> triangles, uint32_t iterations,
                        std::vector<ClothSkinWeights>* weights) {
   const size_t n = weights->size();
-  std::vector<std::vector<uint32_t>> neighbours(n);
-  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = triangles[t + e], b = triangles[t + (e + 1) % 3];
-      neighbours[a].push_back(b);
-      neighbours[b].push_back(a);
-    }
-  }
-  for (std::vector<uint32_t>& list : neighbours) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-  }
+  const std::vector<std::vector<uint32_t>> neighbours = EdgeNeighbours(triangles, n);
   std::vector<ClothSkinWeights> next(n);
   JointBlend blend;
   for (uint32_t it = 0; it < iterations; ++it) {
@@ -195,14 +202,7 @@ std::vector<float> DistanceAlongEdges(std::span<const uint32_t> triangles,
                                       std::span<const uint32_t> sources,
                                       std::vector<uint32_t>* nearest) {
   const size_t n = positions.size();
-  std::vector<std::vector<uint32_t>> neighbours(n);
-  for (size_t t = 0; t + 2 < triangles.size(); t += 3) {
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = triangles[t + e], b = triangles[t + (e + 1) % 3];
-      neighbours[a].push_back(b);
-      neighbours[b].push_back(a);
-    }
-  }
+  const std::vector<std::vector<uint32_t>> neighbours = EdgeNeighbours(triangles, n);
   // Doubles: the sums of thousands of edges stay exact enough to order the vertices the same way
   // on every machine.
   std::vector<double> distance(n, std::numeric_limits<double>::infinity());
