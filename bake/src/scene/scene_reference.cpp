@@ -30,7 +30,8 @@ constexpr SampleScene kSampleScenes[] = {
      "floor the scene adds (`/collision/shapes`)"},
     {"mannequin_gltf_dress.json", "the built-in mannequin",
      "a dress read from a skinned glTF bound to the skeleton by joint name "
-     "(`garments/mannequin_dress.glb`, written by `drape-sim --export-garments`), its max distance "
+     "(`garments/mannequin_dress.glb`, written by `drape-sim --export-garments` from "
+     "`garments/mannequin_dress_source.json`: weighted to its waistband), its max distance "
      "painted per vertex (`_MAX_DISTANCE`: 0 at the waist to 8 cm at the hem), on a floor"},
     {"robot_expressive_cape.json", "`RobotExpressive.glb` (shared assets)",
      "a cape on a rigid-part robot (4.4 m tall as authored), hulls: at its size in metres the "
