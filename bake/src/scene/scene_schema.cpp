@@ -279,8 +279,10 @@ const JsonSchema<Scene>& SolverSchema() {
                 [](Scene& s) -> bool& { return s.solver.tethers; })
           .Custom(CustomFieldInfo("max_stretch", "number ≥ 0 or `\"none\"`",
                                   "a number >= 0 or \"none\"",
-                                  "strain limit: after the iterations no stretch spring stays "
-                                  "longer than rest × (1 + this)"),
+                                  "strain limit: after the iterations one pass shortens every "
+                                  "stretch spring longer than rest × (1 + this) to that length "
+                                  "(springs sharing a particle can stretch each other again, and "
+                                  "colliders can: stats.json counts those beyond it)"),
                   [](const JsonAt& at, Scene& s) {
                     if (at.value().is_string()) {
                       if (at.value().get<std::string>() != "none")
