@@ -317,9 +317,10 @@ const JsonSchema<SceneGarment>& SkinSchema() {
               "where the weights come from the body. `closest`: each particle takes the body's "
               "closest point's (a shirt, a sleeve: the garment follows the limb under it). "
               "`held`: each particle takes those of its nearest held particle along the garment "
-              "(attached or pinned; a skirt or a cape then follows its waistband or shoulders, "
-              "and the legs move under it instead of dragging it along). Not with authored weights "
-              "(a `weights_file`, a skinned glTF garment)",
+              "(attached or pinned; a dress or a cape then follows its waistband or shoulders, "
+              "and the legs move under it instead of dragging it along; a short skirt the thighs "
+              "fill is better with `closest`). Not with authored weights (a `weights_file`, a "
+              "skinned glTF garment)",
               [](SceneGarment& g) -> SkinTransfer& { return g.skin_transfer; })
           .Default("closest")
           .Unsigned<uint32_t>("smoothing", "", 0, 1000,
