@@ -109,7 +109,8 @@ TEST(CApi, GarmentMatchesTheCppApiBitForBit) {
   EXPECT_EQ(std::memcmp(c.data(), cpp.data(), c.size() * sizeof(float)), 0);
   EXPECT_EQ(c_contacts, cpp_contacts);
   EXPECT_EQ(c_overstretched, cpp_overstretched);
-  EXPECT_GT(c_contacts, 0u);  // the skirt touches the legs, the floor or the staff
+  EXPECT_GT(c_contacts, 0u);       // the skirt touches the legs, the floor or the staff
+  EXPECT_GT(c_overstretched, 0u);  // a field the C API left at 0 would not match
   for (const float v : c) ASSERT_TRUE(std::isfinite(v));
 
   // The same through a job system set from C.
@@ -117,6 +118,8 @@ TEST(CApi, GarmentMatchesTheCppApiBitForBit) {
   drape_set_task_system(PoolParallelFor, 2, &pool);
   uint32_t pooled_contacts = 0, pooled_overstretched = 0;
   EXPECT_EQ(RunC(&pooled_contacts, &pooled_overstretched), c);
+  EXPECT_EQ(pooled_contacts, c_contacts);
+  EXPECT_EQ(pooled_overstretched, c_overstretched);
   drape_set_task_system(nullptr, 0, nullptr);
   EXPECT_EQ(&GetTaskSystem(),
             OpenMpTaskSystem() != nullptr ? OpenMpTaskSystem() : &SerialTaskSystem());
