@@ -38,26 +38,13 @@ double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-// The output directory, then (CreateFrameDirectories) its picture folders once the scene has
-// been checked: a scene refused after the bake leaves the cached asset, not empty folders.
-Status CreateOutputDirectory(const std::string& dir) {
+// A directory and its parents. The run creates its output directory first (the bake caches its
+// asset there) and its picture folders only once the scene has been checked: a scene refused
+// after the bake leaves the cached asset, not empty folders.
+Status CreateDirectory(const std::string& path) {
   std::error_code error;
-  fs::create_directories(dir, error);
-  if (error) {
-    return Status(StatusCode::kIoError,
-                  dir + ": cannot create the output directory: " + error.message());
-  }
-  return Status::Ok();
-}
-
-Status CreateFrameDirectories(const std::string& dir, bool obj) {
-  std::error_code error;
-  for (const char* sub : {"/frames", "/obj"}) {
-    if (std::string(sub) == "/obj" && !obj) continue;
-    fs::create_directories(dir + sub, error);
-    if (error)
-      return Status(StatusCode::kIoError, dir + sub + ": cannot create: " + error.message());
-  }
+  fs::create_directories(path, error);
+  if (error) return Status(StatusCode::kIoError, path + ": cannot create: " + error.message());
   return Status::Ok();
 }
 
@@ -304,7 +291,7 @@ int RunScene(const RunOptions& options) {
     ~RestoreTasks() { SetTaskSystem(nullptr); }
   } restore_tasks;
   const std::string dir = options.out_dir;
-  if (Status s = CreateOutputDirectory(dir); !s.ok()) return Fail(s.message());
+  if (Status s = CreateDirectory(dir); !s.ok()) return Fail(s.message());
 
   // The asset: cached, or baked now.
   SceneAsset loaded;
@@ -335,7 +322,10 @@ int RunScene(const RunOptions& options) {
   if (Status s = renderer.Frame(scene, asset, clip, sim); !s.ok()) return Fail(s.message());
 
   // From here on this run writes its outputs: those of an earlier run go first.
-  if (Status s = CreateFrameDirectories(dir, scene.output.obj); !s.ok()) return Fail(s.message());
+  if (Status s = CreateDirectory(dir + "/frames"); !s.ok()) return Fail(s.message());
+  if (scene.output.obj) {
+    if (Status s = CreateDirectory(dir + "/obj"); !s.ok()) return Fail(s.message());
+  }
   RemoveStaleOutputs(dir);
   if (Status s = WriteReach(dir, scene, reach, left_out); !s.ok()) return Fail(s.message());
   json settle;
