@@ -136,19 +136,28 @@ void BodyMapCollider::FinishAirReach() {
       row[i] = static_cast<uint8_t>(std::min<int>(row[i], run));
     }
   }
-  for (int64_t i = 0; i < w; ++i) {
-    uint8_t above[kCap] = {};  // row distances of the rows j - 1 .. j - kCap + 1, by j % kCap
+  // Then down each column over them, in strips of kStrip columns so that the loops run along
+  // the rows (a column walk strides a whole row per texel): each strip's rows above the current
+  // one keep their row distances in a small ring, as they are overwritten.
+  constexpr int64_t kStrip = 256;
+  static constexpr uint8_t kBeyond[kStrip] = {};  // rows beyond the grid: background, distance 0
+  for (int64_t i0 = 0; i0 < w; i0 += kStrip) {
+    const int64_t n = std::min(kStrip, w - i0);
+    uint8_t above[kCap][kStrip];  // the row distances of rows j - 1 .. j - kCap + 1, by j % kCap
     for (int64_t j = 0; j < h; ++j) {
-      const uint8_t own = reach[j * w + i];
-      int best = kCap;
-      for (int d = 0; d < kCap; ++d) {  // d rows away, above and below
-        const int64_t up = j - d, down = j + d;
-        const int along_up = up < 0 ? 0 : d == 0 ? own : above[up % kCap];
-        const int along_down = down >= h ? 0 : d == 0 ? own : reach[down * w + i];
-        best = std::min({best, std::max(d, along_up), std::max(d, along_down)});
+      uint8_t* row = reach + j * w + i0;
+      uint8_t best[kStrip];
+      for (int64_t i = 0; i < n; ++i) best[i] = std::min<uint8_t>(row[i], kCap);
+      for (int d = 1; d < kCap; ++d) {  // d rows away, above and below
+        const uint8_t* up = j - d >= 0 ? above[(j - d) % kCap] : kBeyond;
+        const uint8_t* down = j + d < h ? reach + (j + d) * w + i0 : kBeyond;
+        const uint8_t far = static_cast<uint8_t>(d);
+        for (int64_t i = 0; i < n; ++i) {
+          best[i] = std::min({best[i], std::max(far, up[i]), std::max(far, down[i])});
+        }
       }
-      above[j % kCap] = own;
-      reach[j * w + i] = static_cast<uint8_t>(best);
+      std::copy(row, row + n, above[j % kCap]);
+      std::copy(best, best + n, row);
     }
   }
 }
