@@ -38,23 +38,36 @@ struct RasterTriangle {
     // surfaces along a texel's ray, where Inside would count a shared edge twice.
     bool CountsOnce(double value) const { return value > 0.0 || (value == 0.0 && sign > 0.0); }
     // Narrows [*lo, *hi] to about the texels inside the edge on this row, a texel or two
-    // generous on the side it cuts (the caller still tests each texel exactly). False: none
+    // generous on the side it cuts (the caller still tests each texel exactly), and
+    // [*inner_lo, *inner_hi] to texels whose centre lies inside it by more than a texel, whose
+    // value is then positive whatever the rounding (the caller need not test them). False: none
     // inside.
-    bool Narrow(double row_term, int64_t* lo, int64_t* hi) const {
+    bool Narrow(double row_term, int64_t* lo, int64_t* hi, int64_t* inner_lo,
+                int64_t* inner_hi) const {
       if (dy == 0.0) return Inside(row_term, 0.0);  // the same value all along the row
       // The texel index where the value is 0, to within rounding: the slack below covers it.
       const double boundary = ax + row_term * inverse_dy - 0.5;
-      if (!(std::fabs(boundary) < 1e15)) return true;
+      if (!(std::fabs(boundary) < kMaxInner && std::fabs(ax) < kMaxInner)) {
+        // Nearly along the row, or from a vertex far off: no texel is certain.
+        *inner_hi = std::min(*inner_hi, *inner_lo - 1);
+        if (!(std::fabs(boundary) < 1e15)) return true;
+      }
       // Truncation and one texel more than floor / ceil needs: the library calls cost more
       // than the texel (no SSE4.1 rounding in the baseline build).
       const int64_t truncated = static_cast<int64_t>(boundary);
       if (-sign * dy > 0.0) {
         *lo = std::max(*lo, truncated - 2);
+        *inner_lo = std::max(*inner_lo, truncated + 2);
       } else {
         *hi = std::min(*hi, truncated + 2);
+        *inner_hi = std::min(*inner_hi, truncated - 2);
       }
       return *lo <= *hi;
     }
+    // Texels: with the boundary and the edge's start within this, both terms of Value are at
+    // most about this many times |dy|, so its rounding (and the boundary's) stays far below the
+    // |dy| a texel inside the edge adds.
+    static constexpr double kMaxInner = 1e7;
   };
   Edge edge[3];
   double x0, y0;          // vertex 0
@@ -173,19 +186,35 @@ void DrawTriangleRows(uint32_t t, const RasterTriangle& r, int64_t j_begin, int6
     const double py = static_cast<double>(j) + 0.5;
     const double row[3] = {e[0].RowTerm(py), e[1].RowTerm(py), e[2].RowTerm(py)};
     int64_t lo = i_begin, hi = i_end - 1;
-    if (i_end - i_begin >= kNarrowFrom &&
-        !(e[0].Narrow(row[0], &lo, &hi) && e[1].Narrow(row[1], &lo, &hi) &&
-          e[2].Narrow(row[2], &lo, &hi))) {
-      continue;
+    int64_t inner_lo = lo, inner_hi = -1;  // none certain inside unless narrowed
+    if (i_end - i_begin >= kNarrowFrom) {
+      inner_hi = hi;
+      if (!(e[0].Narrow(row[0], &lo, &hi, &inner_lo, &inner_hi) &&
+            e[1].Narrow(row[1], &lo, &hi, &inner_lo, &inner_hi) &&
+            e[2].Narrow(row[2], &lo, &hi, &inner_lo, &inner_hi))) {
+        continue;
+      }
     }
-    for (int64_t i = lo; i <= hi; ++i) {
+    const auto tested = [&](int64_t i) {
       const double px = static_cast<double>(i) + 0.5;
       const double v0 = e[0].Value(row[0], px), v1 = e[1].Value(row[1], px);
       const double v2 = e[2].Value(row[2], px);
-      if (!(v0 >= 0.0 && v1 >= 0.0 && v2 >= 0.0)) continue;
+      if (!(v0 >= 0.0 && v1 >= 0.0 && v2 >= 0.0)) return;
       const bool once = e[0].CountsOnce(v0) && e[1].CountsOnce(v1) && e[2].CountsOnce(v2);
       fragment(t, r, static_cast<size_t>(j * width + i), px, py, once);
+    };
+    // Texels inside every edge by more than a texel: covered, and counted once (every value > 0).
+    inner_lo = std::max(inner_lo, lo);
+    inner_hi = std::min(inner_hi, hi);
+    if (inner_lo > inner_hi) {
+      for (int64_t i = lo; i <= hi; ++i) tested(i);
+      continue;
     }
+    for (int64_t i = lo; i < inner_lo; ++i) tested(i);
+    for (int64_t i = inner_lo; i <= inner_hi; ++i) {
+      fragment(t, r, static_cast<size_t>(j * width + i), static_cast<double>(i) + 0.5, py, true);
+    }
+    for (int64_t i = inner_hi + 1; i <= hi; ++i) tested(i);
   }
 }
 
