@@ -372,6 +372,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   maps->gap_layers_ = options_.air_gaps > 0 ? 1u : 0u;  // PublishGaps sets the deepest found
   if (options_.air_gaps > 0) {
     exit_z_.assign(texels, -kInf);
+    lowest_entry_z_.assign(texels, kInf);
     exit_face_.assign(texels, kNoFace);
     fragment_count_.assign(texels, 0u);
     fragment_cursor_.resize(texels);  // set by FindGaps
@@ -395,6 +396,7 @@ void BodyMapRenderer::Reserve(size_t texels) {
   bottom_face_.reserve(texels);
   if (options_.air_gaps == 0) return;
   exit_z_.reserve(texels);
+  lowest_entry_z_.reserve(texels);
   for (std::vector<uint32_t>* v : {&exit_face_, &fragment_count_, &fragment_cursor_})
     v->reserve(texels);
   // Gap texels (rays crossing more than one part) on up to an eighth of the window, with four
@@ -443,6 +445,8 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
           exit_z_[k] = z;
           exit_face_[k] = t;
         }
+        // A surface entering it: where none lies below the first candidate, no gap can.
+        if (r.entering && z < lowest_entry_z_[k]) lowest_entry_z_[k] = z;
       });
 }
 
@@ -545,8 +549,9 @@ size_t BodyMapRenderer::memory_bytes() const {
           bottom_face_.capacity() + exit_face_.capacity() + fragment_count_.capacity() +
           fragment_cursor_.capacity() + gap_texels_.capacity() + fragment_offsets_.capacity()) *
              sizeof(uint32_t) +
-         exit_z_.capacity() * sizeof(float) + fragments_.capacity() * sizeof(GapFragment) +
-         texel_gaps_.capacity() * sizeof(FoundGap) + gaps_per_texel_.capacity() +
+         (exit_z_.capacity() + lowest_entry_z_.capacity()) * sizeof(float) +
+         fragments_.capacity() * sizeof(GapFragment) + texel_gaps_.capacity() * sizeof(FoundGap) +
+         gaps_per_texel_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *
              sizeof(Float3) +
          shading_.capacity() * sizeof(detail::TriangleShading) +

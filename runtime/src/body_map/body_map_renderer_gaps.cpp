@@ -63,15 +63,19 @@ void BodyMapRenderer::FindGaps(const Window& window, BodyMapCollider* maps) {
 }
 
 // The texels where a gap may lie (the first candidate lies above the back surface, with room for
-// a gap of kMinGap and its two boundaries) within the bounds above, ascending, and where each
-// one's surfaces go. The other texels collect nothing (their count drops to 0).
+// a gap of kMinGap and its two boundaries, and a surface enters the body below it) within the
+// bounds above, ascending, and where each one's surfaces go. The other texels collect nothing
+// (their count drops to 0).
 void BodyMapRenderer::SelectGapTexels(const BodyMapCollider& maps, size_t texels) {
   gap_texels_.clear();
   fragment_offsets_.clear();
   uint32_t total = 0;
   for (size_t k = 0; k < texels; ++k) {
-    const bool room =
-        exit_face_[k] != kNoFace && exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap;
+    // A gap's lower boundary is a surface entering the body below its upper one, which lies at
+    // or below the first candidate: none there, no gap (parts sunk into each other).
+    const bool room = exit_face_[k] != kNoFace &&
+                      exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap &&
+                      lowest_entry_z_[k] < exit_z_[k];
     const uint32_t surfaces = fragment_count_[k];
     if (!room || surfaces > kMaxSurfacesPerGapTexel || surfaces > kMaxGapFragments - total) {
       fragment_count_[k] = 0;

@@ -190,6 +190,7 @@ class BodyMapRenderer {
   // body going along -z (the first candidate upper boundary) and its triangle, and how many
   // surfaces its ray crosses (then the fragments still to collect, 0 off the gap texels).
   std::vector<float> exit_z_;
+  std::vector<float> lowest_entry_z_;  // per texel: the lowest surface entering the body
   std::vector<uint32_t> exit_face_;
   std::vector<uint32_t> fragment_count_;
   std::vector<uint32_t> fragment_cursor_;   // per texel: where its next fragment goes
