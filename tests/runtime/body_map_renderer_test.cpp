@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -200,6 +201,73 @@ TEST(BodyMapRenderer, AllocatesOnlyWhenTheWindowGrows) {
   ASSERT_TRUE(renderer.Render(far, &maps).ok());
   EXPECT_EQ(renderer.stats().grew, 1u);
   EXPECT_TRUE(maps.IsInside({0.5f, 1.f, 0.f}));
+}
+
+// A tetrahedron with a base near the origin and its apex far off along +x (faces
+// counter-clockwise seen from outside), rigid on joint 0.
+MeshData FarTetrahedron(Float3 apex) {
+  MeshData mesh;
+  mesh.positions = {{0.f, -0.1f, -0.1f}, {0.f, 0.1f, -0.1f}, {0.f, 0.f, 0.1f}, apex};
+  const Float3 interior{0.05f, 0.f, -0.03f};
+  for (const auto& face : {std::array<uint32_t, 3>{0, 1, 2}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}}) {
+    const Float3 a = mesh.positions[face[0]], b = mesh.positions[face[1]];
+    const Float3 c = mesh.positions[face[2]];
+    const bool outward = Dot(Cross(b - a, c - a), a - interior) > 0.f;
+    mesh.triangles.insert(mesh.triangles.end(),
+                          {face[0], outward ? face[1] : face[2], outward ? face[2] : face[1]});
+  }
+  mesh.influence_offsets = {0, 1, 2, 3, 4};
+  mesh.influence_joints = {0, 0, 0, 0};
+  mesh.influence_weights = {1.f, 1.f, 1.f, 1.f};
+  return mesh;
+}
+
+// The rasterizer works in fixed point on the finest grid its drawn corners allow (1/65536 texel
+// for a body in its window). A triangle reaching 10^6 texels away coarsens it and keeps its shape
+// (the apex's edges cross the region slanted); a corner 10^12 m off (10^15 texels) is clamped to
+// 2^29 texels, here along the same direction. Either way the triangles near the region are drawn
+// where they are.
+TEST(BodyMapRenderer, ACornerFarAwayStillDrawsItsTriangles) {
+  BodyMapRenderOptions options = Options();
+  options.epsilon = 0.f;  // the slab is the tetrahedron itself
+  RenderRegion region;
+  region.min = {-0.05f, -0.2f, -0.2f};
+  region.max = {0.25f, 0.2f, 0.2f};
+  const Mat34 identity[1] = {Mat34{}};
+  for (const Float3 apex : {Float3{1000.f, 600.f, 0.f}, Float3{1e12f, 0.f, 0.f}}) {
+    const float far = apex.x;
+    const MeshData mesh = FarTetrahedron(apex);
+    BodyMapRenderer renderer;
+    ASSERT_TRUE(renderer.Init(mesh, options).ok());
+    BodyMapCollider maps;
+    const Status status = renderer.Render(identity, &maps, &region);
+    ASSERT_TRUE(status.ok()) << far << ": " << status.message();
+    ASSERT_FALSE(maps.empty()) << far;
+    // Inside where every face plane has the point behind it, by more than a few texels.
+    size_t checked = 0;
+    for (float x = 0.01f; x < 0.19f; x += 0.0131f) {
+      for (float y = -0.1f; y < 0.1f; y += 0.0097f) {
+        for (float z = -0.1f; z < 0.1f; z += 0.0093f) {
+          const Float3 p{x, y, z};
+          double nearest = 1e9;
+          bool inside = true;
+          for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+            const Float3 a = mesh.positions[mesh.triangles[t]];
+            const Float3 b = mesh.positions[mesh.triangles[t + 1]];
+            const Float3 c = mesh.positions[mesh.triangles[t + 2]];
+            const Float3 n = NormalizeOr(Cross(b - a, c - a), Float3{0.f, 0.f, 1.f});
+            const double distance = double(Dot(n, p - a));
+            inside = inside && distance < 0.0;
+            nearest = std::min(nearest, std::fabs(distance));
+          }
+          if (nearest < 3.0 * kTexel) continue;
+          ++checked;
+          EXPECT_EQ(maps.IsInside(p), inside) << far << ": " << x << " " << y << " " << z;
+        }
+      }
+    }
+    EXPECT_GT(checked, 2000u);
+  }
 }
 
 TEST(BodyMapRenderer, HostileInputIsAnErrorAndAnEmptyCollider) {

@@ -131,6 +131,7 @@ Status BodyMapRenderer::Init(const MeshData& mesh, const BodyMapRenderOptions& o
   shading_.resize(triangles);
   drawn_.reserve(triangles);
   all_boxes_.reserve(triangles);
+  placed_.reserve(vertices);
   raster_faces_.reserve(triangles);
   if (o.air_gaps > 0) gap_triangles_.reserve(triangles);
   raster_.reserve(triangles);
@@ -202,8 +203,12 @@ std::span<const detail::RasterBox> BodyMapRenderer::RasterBoxes() const {
 }
 
 detail::RasterWindow BodyMapRenderer::RasterWindowOf(const Window& window) const {
-  return {window.origin_x, window.origin_y, window.width, window.height,
-          1.0 / static_cast<double>(options_.texel_size)};
+  return {window.origin_x,
+          window.origin_y,
+          window.width,
+          window.height,
+          1.0 / static_cast<double>(options_.texel_size),
+          window.sub_bits};
 }
 
 Status BodyMapRenderer::CheckRegion(const RenderRegion& region) const {
@@ -322,6 +327,7 @@ Status BodyMapRenderer::PlaceWindow(const RenderRegion& region, Window* window) 
       for (int k = 0; k < 3; ++k) extend(offset_[tri[3 * t + k]]);
     }
   }
+  const double drawn_lo_x = lo_x, drawn_hi_x = hi_x, drawn_lo_y = lo_y, drawn_hi_y = hi_y;
   lo_x = std::max<double>(lo_x, region.min.x);
   hi_x = std::min<double>(hi_x, region.max.x);
   lo_y = std::max<double>(lo_y, region.min.y);
@@ -341,6 +347,14 @@ Status BodyMapRenderer::PlaceWindow(const RenderRegion& region, Window* window) 
   window->origin_y = static_cast<float>(gy + j0 * t);
   window->width = static_cast<uint32_t>(width);
   window->height = static_cast<uint32_t>(height);
+  // The raster grid's precision: the farthest drawn corner from the origin, a texel to spare.
+  const double reach =
+      std::max({std::fabs(drawn_lo_x - window->origin_x), std::fabs(drawn_hi_x - window->origin_x),
+                std::fabs(drawn_lo_y - window->origin_y),
+                std::fabs(drawn_hi_y - window->origin_y)}) /
+          t +
+      1.0;
+  window->sub_bits = detail::RasterWindow::SubBitsFor(reach);
   return Status::Ok();
 }
 
@@ -417,14 +431,23 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   BodyMapCollider::Slab* slabs = maps->slabs_.data();
   const bool gaps = options_.air_gaps > 0;
   const detail::RasterWindow w = RasterWindowOf(window);
-  // Reserved for every triangle at Init; never shrunk (a set-up is 208 bytes to clear again).
+  // Reserved for every triangle at Init; never shrunk (a set-up is 112 bytes to clear again).
   const size_t drawn = drawn_.size();
   all_boxes_.resize(std::max(all_boxes_.size(), drawn));
+  placed_.resize(offset_.size());
   raster_faces_.resize(std::max(raster_faces_.size(), drawn));
   raster_boxes_.resize(std::max(raster_boxes_.size(), drawn));
   raster_.resize(std::max(raster_.size(), drawn));
-  raster_count_ = detail::SetUpTriangles(offset_.data(), mesh_->triangles.data(), drawn_, w,
+  raster_count_ = detail::SetUpTriangles(offset_, mesh_->triangles.data(), drawn_, w, placed_,
                                          all_boxes_, raster_faces_, raster_boxes_, raster_);
+  // The per-texel arrays as plain pointers: the fragment writes through them, and the compiler
+  // would reload each vector's data pointer after every store.
+  uint32_t* top_face = top_face_.data();
+  uint32_t* bottom_face = bottom_face_.data();
+  uint32_t* fragment_count = fragment_count_.data();
+  float* exit_z = exit_z_.data();
+  uint32_t* exit_face = exit_face_.data();
+  float* lowest_entry_z = lowest_entry_z_.data();
   detail::RasterizeInBands(
       RasterFaces(), RasterSetUps(), RasterBoxes(), w, nullptr,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
@@ -432,21 +455,21 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
         BodyMapCollider::Slab& s = slabs[k];
         if (z > s.top) {
           s.top = z;
-          top_face_[k] = t;
+          top_face[k] = t;
         }
         if (z < s.bottom) {
           s.bottom = z;
-          bottom_face_[k] = t;
+          bottom_face[k] = t;
         }
         if (!gaps) return;
-        ++fragment_count_[k];
+        ++fragment_count[k];
         // A surface leaving the body going along -z: a gap's upper boundary candidate.
-        if (!r.entering && z > exit_z_[k]) {
-          exit_z_[k] = z;
-          exit_face_[k] = t;
+        if (!r.entering && z > exit_z[k]) {
+          exit_z[k] = z;
+          exit_face[k] = t;
         }
         // A surface entering it: where none lies below the first candidate, no gap can.
-        if (r.entering && z < lowest_entry_z_[k]) lowest_entry_z_[k] = z;
+        if (r.entering && z < lowest_entry_z[k]) lowest_entry_z[k] = z;
       });
 }
 
@@ -557,7 +580,7 @@ size_t BodyMapRenderer::memory_bytes() const {
          shading_.capacity() * sizeof(detail::TriangleShading) +
          raster_.capacity() * sizeof(detail::RasterTriangle) +
          (raster_boxes_.capacity() + all_boxes_.capacity()) * sizeof(detail::RasterBox) +
-         gap_tiles_.capacity();
+         placed_.capacity() * sizeof(detail::RasterVertex) + gap_tiles_.capacity();
 }
 
 }  // namespace drape

@@ -19,114 +19,136 @@ inline constexpr uint32_t kNoFace = std::numeric_limits<uint32_t>::max();
 // Triangle indices stay below this: the gap search packs two flags above them.
 inline constexpr uint32_t kMaxRasterTriangles = 1u << 30;
 
-// One triangle set up for the rasterizer in window coordinates (texel units; texel (i, j) is
-// sampled at its centre (i + 1/2, j + 1/2)). Each edge is evaluated canonically, from its lower
-// to its higher vertex index, so the two triangles sharing an edge compute exactly negated values
-// and a texel centre on it is covered by both (the tests are inclusive): no crack, and a texel
-// covered twice keeps the same extreme depth whichever triangle draws it first.
+// The texel grid one render draws into: texel (i, j) is entry j * width + i. Triangles are drawn
+// in fixed point: corners snapped to 1 / 2^sub_bits texel, texel centres on the same grid, so
+// every edge value is an exact 64-bit integer and a row is stepped by adding a constant. A render
+// takes the finest grid (at most 1/65536 texel) on which its drawn corners stay below 2^29 units
+// from the window's origin: every coordinate and edge difference then fits 32 bits, every edge
+// value 62 bits. Only a triangle reaching 2^13 texels away coarsens the grid; corners beyond
+// 2^29 texels (a hostile pose) are clamped there.
+struct RasterWindow {
+  double origin_x = 0.0, origin_y = 0.0;  // metres, view frame
+  int64_t width = 0, height = 0;          // texels
+  double inverse_texel = 0.0;             // 1 / metres
+  int sub_bits = kMaxSubBits;             // [0, kMaxSubBits]: grid units per texel = 2^sub_bits
+
+  static constexpr int kMaxSubBits = 16;
+  static constexpr double kUnitLimit = 536870912.0;  // 2^29 grid units
+  int64_t unit() const { return int64_t{1} << sub_bits; }
+  // The finest grid on which |coordinate| (texels) stays below kUnitLimit units.
+  static int SubBitsFor(double max_abs_texels) {
+    int bits = kMaxSubBits;
+    while (bits > 0 && !(max_abs_texels * static_cast<double>(int64_t{1} << bits) < kUnitLimit))
+      --bits;
+    return bits;
+  }
+  // Texels to grid units: rounded to nearest (halves away from zero), within +-(2^29 - 1).
+  int32_t Snap(double texels) const {
+    constexpr double kMax = kUnitLimit - 1.0;
+    const double units = std::clamp(texels * static_cast<double>(unit()), -kMax, kMax);
+    return static_cast<int32_t>(units + (units >= 0.0 ? 0.5 : -0.5));
+  }
+};
+
+// One vertex in the window: texels, and snapped to the grid. Placed once per vertex (a vertex
+// is shared by about six triangles). 24 bytes.
+struct RasterVertex {
+  double x, y;
+  int32_t gx, gy;  // grid units
+  static RasterVertex Of(const Float3& p, const RasterWindow& w) {
+    RasterVertex v;
+    v.x = (static_cast<double>(p.x) - w.origin_x) * w.inverse_texel;
+    v.y = (static_cast<double>(p.y) - w.origin_y) * w.inverse_texel;
+    v.gx = w.Snap(v.x);
+    v.gy = w.Snap(v.y);
+    return v;
+  }
+};
+
+// One triangle set up for the rasterizer (RasterWindow's grid). Each edge is evaluated
+// canonically, from its lower to its higher vertex index, so the two triangles sharing an edge
+// compute exactly negated values and a texel centre on it is covered by both (the tests are
+// inclusive): no crack, and a texel covered twice keeps the same extreme depth whichever triangle
+// draws it first. 112 bytes: written and read once per render, so kept small.
 struct RasterTriangle {
+  // value(x, y) = dx (y - ay) - dy (x - ax), grid units, exact in 64 bits.
   struct Edge {
-    double ax, ay, dx, dy;  // canonical start vertex and its difference to the end vertex
-    double sign;            // +1 or -1: makes the value >= 0 inside the triangle
-    double inverse_dy;      // 1 / dy, or 0 where dy is 0: Narrow's bound without a division
-    double RowTerm(double py) const { return dx * (py - ay); }
-    // >= 0: the texel centre is inside the edge (inclusive).
-    double Value(double row_term, double px) const { return sign * (row_term - dy * (px - ax)); }
-    bool Inside(double row_term, double px) const { return Value(row_term, px) >= 0.0; }
-    // The tie rule: a texel centre on an edge belongs to exactly one of the two triangles
-    // sharing it (their values are exactly negated, and so are their signs). For counting the
-    // surfaces along a texel's ray, where Inside would count a shared edge twice.
-    bool CountsOnce(double value) const { return value > 0.0 || (value == 0.0 && sign > 0.0); }
-    // Narrows [*lo, *hi] to about the texels inside the edge on this row, a texel or two
-    // generous on the side it cuts (the caller still tests each texel exactly), and
-    // [*inner_lo, *inner_hi] to texels whose centre lies inside it by more than a texel, whose
-    // value is then positive whatever the rounding (the caller need not test them). False: none
-    // inside.
-    bool Narrow(double row_term, int64_t* lo, int64_t* hi, int64_t* inner_lo,
-                int64_t* inner_hi) const {
-      if (dy == 0.0) return Inside(row_term, 0.0);  // the same value all along the row
-      // The texel index where the value is 0, to within rounding: the slack below covers it.
-      const double boundary = ax + row_term * inverse_dy - 0.5;
-      if (!(std::fabs(boundary) < kMaxInner && std::fabs(ax) < kMaxInner)) {
-        // Nearly along the row, or from a vertex far off: no texel is certain.
-        *inner_hi = std::min(*inner_hi, *inner_lo - 1);
-        if (!(std::fabs(boundary) < 1e15)) return true;
-      }
-      // Truncation and one texel more than floor / ceil needs: the library calls cost more
-      // than the texel (no SSE4.1 rounding in the baseline build).
-      const int64_t truncated = static_cast<int64_t>(boundary);
-      if (-sign * dy > 0.0) {
-        *lo = std::max(*lo, truncated - 2);
-        *inner_lo = std::max(*inner_lo, truncated + 2);
-      } else {
-        *hi = std::min(*hi, truncated + 2);
-        *inner_hi = std::min(*inner_hi, truncated - 2);
-      }
-      return *lo <= *hi;
+    int32_t ax, ay;  // canonical start vertex
+    int32_t dx, dy;  // sign * (end - start): the value is >= 0 inside the triangle
+    int32_t tie;     // 1 where the sign is -1, else 0: value - tie >= 0 counts the texel once
+    int64_t Value(int64_t x, int64_t y) const {
+      return int64_t{dx} * (y - ay) - int64_t{dy} * (x - ax);
     }
-    // Texels: with the boundary and the edge's start within this, both terms of Value are at
-    // most about this many times |dy|, so its rounding (and the boundary's) stays far below the
-    // |dy| a texel inside the edge adds.
-    static constexpr double kMaxInner = 1e7;
   };
   Edge edge[3];
-  double x0, y0;          // vertex 0
-  double grad_x, grad_y;  // dz per texel along x and y
-  double z0, z_min, z_max;
   // Counter-clockwise in the window: the drawn (offset) triangle's normal points to +z, so going
   // along -z the ray enters the body through it (false: leaves it).
   bool entering;
+  double x0, y0;          // vertex 0, texels
+  double grad_x, grad_y;  // dz per texel along x and y
+  float z0, z_min, z_max;
 
-  // Window coordinates (texel units) and depths of a triangle's corners.
+  // Window coordinates (texels, and snapped to the grid) and depths of a triangle's corners.
   struct Corners {
-    double x[3], y[3], z[3];
+    double x[3], y[3];
+    float z[3];
+    int32_t gx[3], gy[3];  // grid units
     double Area2() const { return (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]); }
+    int64_t GridArea2() const {
+      return (int64_t{gx[1]} - gx[0]) * (int64_t{gy[2]} - gy[0]) -
+             (int64_t{gy[1]} - gy[0]) * (int64_t{gx[2]} - gx[0]);
+    }
   };
-  static Corners CornersOf(const Float3* vertices, const uint32_t v[3], double origin_x,
-                           double origin_y, double inverse_texel) {
+  static Corners CornersOf(const Float3* vertices, const RasterVertex* placed,
+                           const uint32_t v[3]) {
     Corners c;
     for (int k = 0; k < 3; ++k) {
-      c.x[k] = (static_cast<double>(vertices[v[k]].x) - origin_x) * inverse_texel;
-      c.y[k] = (static_cast<double>(vertices[v[k]].y) - origin_y) * inverse_texel;
+      const RasterVertex& p = placed[v[k]];
+      c.x[k] = p.x;
+      c.y[k] = p.y;
       c.z[k] = vertices[v[k]].z;
+      c.gx[k] = p.gx;
+      c.gy[k] = p.gy;
     }
     return c;
   }
 
-  // The edges and the depth plane of a triangle with area (corners.Area2() != 0).
+  // The edges and the depth plane of a triangle with area on the grid (GridArea2() != 0).
   void SetUp(const Corners& c, const uint32_t v[3]) {
-    const double area2 = c.Area2();
-    const double orientation = area2 > 0.0 ? 1.0 : -1.0;
-    entering = area2 > 0.0;
+    entering = c.GridArea2() > 0;
     for (int k = 0; k < 3; ++k) {
       int from = (k + 1) % 3, to = (k + 2) % 3;  // counter-clockwise: the inside is on the left
-      double sign = orientation;
+      bool flipped = !entering;
       if (v[from] > v[to]) {
         std::swap(from, to);
-        sign = -sign;
+        flipped = !flipped;
       }
-      const double dy = c.y[to] - c.y[from];
-      edge[k] = {c.x[from], c.y[from], c.x[to] - c.x[from], dy, sign, dy != 0.0 ? 1.0 / dy : 0.0};
+      const int32_t sign = flipped ? -1 : 1;
+      edge[k] = {c.gx[from], c.gy[from], sign * (c.gx[to] - c.gx[from]),
+                 sign * (c.gy[to] - c.gy[from]), flipped ? 1 : 0};
     }
     x0 = c.x[0];
     y0 = c.y[0];
-    const double inverse_area2 = 1.0 / area2;
+    // A sliver with area on the grid but none in double has a flat depth.
+    const double area2 = c.Area2();
+    const double inverse_area2 = area2 != 0.0 ? 1.0 / area2 : 0.0;
     const double* x = c.x;
     const double* y = c.y;
-    const double* z = c.z;
+    const double z[3] = {c.z[0], c.z[1], c.z[2]};
     grad_x = ((z[1] - z[0]) * (y[2] - y[0]) - (z[2] - z[0]) * (y[1] - y[0])) * inverse_area2;
     grad_y = ((z[2] - z[0]) * (x[1] - x[0]) - (z[1] - z[0]) * (x[2] - x[0])) * inverse_area2;
-    z0 = z[0];
-    z_min = std::min({z[0], z[1], z[2]});
-    z_max = std::max({z[0], z[1], z[2]});
+    z0 = c.z[0];
+    z_min = std::min({c.z[0], c.z[1], c.z[2]});
+    z_max = std::max({c.z[0], c.z[1], c.z[2]});
   }
   // The plane's z at a texel centre, clamped to the vertices' range (a sliver's steep gradient
   // cannot extrapolate past its corners).
   float Depth(double px, double py) const {
     const double z = z0 + grad_x * (px - x0) + grad_y * (py - y0);
-    return static_cast<float>(std::clamp(z, z_min, z_max));
+    return static_cast<float>(std::clamp(z, double{z_min}, double{z_max}));
   }
 };
+static_assert(sizeof(RasterTriangle) == 112);
 
 // The normal rule of one triangle at a texel centre: its vertex normals interpolated with the
 // clamped barycentrics; its face normal where they cancel; the caller's fallback where it has
@@ -169,52 +191,47 @@ struct TriangleShading {
   }
 };
 
-// The texel grid one render draws into: texel (i, j) is entry j * width + i.
-struct RasterWindow {
-  double origin_x = 0.0, origin_y = 0.0;  // metres, view frame
-  int64_t width = 0, height = 0;          // texels
-  double inverse_texel = 0.0;             // 1 / metres
-};
-
-// Walks the texel centres of rows [j_begin, j_end) and columns [i_begin, i_end) of r's box.
+// Walks the texel centres of rows [j_begin, j_end) and columns [i_begin, i_end) of r's box: each
+// row's edge values at its first texel, then a constant step per texel. On a wide row the texels
+// outside an edge are skipped by an exact division instead of visited.
 template <class Fragment>
-void DrawTriangleRows(uint32_t t, const RasterTriangle& r, int64_t j_begin, int64_t j_end,
-                      int64_t i_begin, int64_t i_end, int64_t width, Fragment& fragment) {
-  constexpr int64_t kNarrowFrom = 5;  // texels: a narrower box is tested texel by texel
+void DrawTriangleRows(uint32_t t, const RasterTriangle& r, const RasterWindow& w, int64_t j_begin,
+                      int64_t j_end, int64_t i_begin, int64_t i_end, Fragment& fragment) {
+  constexpr int64_t kSkipFrom = 12;  // texels: a narrower row is tested texel by texel
   const RasterTriangle::Edge* e = r.edge;
+  const int64_t unit = w.unit(), half = unit / 2;
+  const int64_t x_begin = i_begin * unit + half;
+  const int64_t step[3] = {-int64_t{e[0].dy} * unit, -int64_t{e[1].dy} * unit,
+                           -int64_t{e[2].dy} * unit};
   for (int64_t j = j_begin; j < j_end; ++j) {
-    const double py = static_cast<double>(j) + 0.5;
-    const double row[3] = {e[0].RowTerm(py), e[1].RowTerm(py), e[2].RowTerm(py)};
-    int64_t lo = i_begin, hi = i_end - 1;
-    int64_t inner_lo = lo, inner_hi = -1;  // none certain inside unless narrowed
-    if (i_end - i_begin >= kNarrowFrom) {
-      inner_hi = hi;
-      if (!(e[0].Narrow(row[0], &lo, &hi, &inner_lo, &inner_hi) &&
-            e[1].Narrow(row[1], &lo, &hi, &inner_lo, &inner_hi) &&
-            e[2].Narrow(row[2], &lo, &hi, &inner_lo, &inner_hi))) {
-        continue;
+    const int64_t y = j * unit + half;
+    int64_t v[3] = {e[0].Value(x_begin, y), e[1].Value(x_begin, y), e[2].Value(x_begin, y)};
+    int64_t begin = i_begin, end = i_end;
+    if (i_end - i_begin >= kSkipFrom) {
+      // Where each edge's value changes sign along the row, exactly.
+      for (int k = 0; k < 3; ++k) {
+        if (step[k] > 0 && v[k] < 0) {
+          begin = std::max(begin, i_begin + (step[k] - 1 - v[k]) / step[k]);
+        } else if (step[k] < 0 && v[k] >= 0) {
+          end = std::min(end, i_begin + v[k] / -step[k] + 1);
+        } else if (v[k] < 0) {
+          end = i_begin;  // outside the edge along the whole row
+        }
       }
+      if (begin >= end) continue;
+      for (int k = 0; k < 3; ++k) v[k] += (begin - i_begin) * step[k];
     }
-    const auto tested = [&](int64_t i) {
-      const double px = static_cast<double>(i) + 0.5;
-      const double v0 = e[0].Value(row[0], px), v1 = e[1].Value(row[1], px);
-      const double v2 = e[2].Value(row[2], px);
-      if (!(v0 >= 0.0 && v1 >= 0.0 && v2 >= 0.0)) return;
-      const bool once = e[0].CountsOnce(v0) && e[1].CountsOnce(v1) && e[2].CountsOnce(v2);
-      fragment(t, r, static_cast<size_t>(j * width + i), px, py, once);
-    };
-    // Texels inside every edge by more than a texel: covered, and counted once (every value > 0).
-    inner_lo = std::max(inner_lo, lo);
-    inner_hi = std::min(inner_hi, hi);
-    if (inner_lo > inner_hi) {
-      for (int64_t i = lo; i <= hi; ++i) tested(i);
-      continue;
+    const double py = static_cast<double>(j) + 0.5;
+    for (int64_t i = begin; i < end; ++i) {
+      if ((v[0] | v[1] | v[2]) >= 0) {
+        const bool once = ((v[0] - e[0].tie) | (v[1] - e[1].tie) | (v[2] - e[2].tie)) >= 0;
+        fragment(t, r, static_cast<size_t>(j * w.width + i), static_cast<double>(i) + 0.5, py,
+                 once);
+      }
+      v[0] += step[0];
+      v[1] += step[1];
+      v[2] += step[2];
     }
-    for (int64_t i = lo; i < inner_lo; ++i) tested(i);
-    for (int64_t i = inner_lo; i <= inner_hi; ++i) {
-      fragment(t, r, static_cast<size_t>(j * width + i), static_cast<double>(i) + 0.5, py, true);
-    }
-    for (int64_t i = inner_hi + 1; i <= hi; ++i) tested(i);
   }
 }
 
@@ -242,37 +259,31 @@ struct TileMask {
 };
 
 // The texel box a triangle holds, kept apart from its set-up: each row band scans every
-// triangle's box, and a 208-byte set-up per triangle would stream through the cache.
+// triangle's box, and the set-ups would stream through the cache.
 struct RasterBox {
   int32_t first, last;  // texel rows, within [-1, height]; first > last: none
   int32_t left, right;  // texel columns, within [-1, width]
 
-  // The texel centres c = i + 1/2 within the corners' box: i in [ceil(min - 1/2),
-  // floor(max - 1/2)], clamped to the window before the conversion (a vertex far outside a
-  // region); empty (first > last) when it holds no centre of the window or the triangle has no
-  // area. Ceil and floor by truncation and a compare: the baseline build has no SSE4.1 rounding.
-  static RasterBox Of(const RasterTriangle::Corners& c, int64_t width, int64_t height) {
-    const auto clamped = [](double x, int64_t size) {
-      return std::clamp(x, -1.0, static_cast<double>(size));
+  // The texel centres within the snapped corners' box, clamped to [-1, size]; empty (first >
+  // last) when it holds no centre of the window or the triangle has no area on the grid.
+  static RasterBox Of(const RasterTriangle::Corners& c, const RasterWindow& w) {
+    // Floor division by the unit, a power of two: an arithmetic shift (C++20), not a divide.
+    const int bits = w.sub_bits;
+    const int64_t half = w.unit() / 2;
+    const auto first_centre = [&](int64_t lo, int64_t size) {  // the least i: centre >= lo
+      return static_cast<int32_t>(std::clamp<int64_t>(-((half - lo) >> bits), -1, size));
     };
-    const auto ceil = [&](double x, int64_t size) {
-      const double y = clamped(x, size);
-      const int32_t t = static_cast<int32_t>(y);
-      return t + (static_cast<double>(t) < y ? 1 : 0);
-    };
-    const auto floor = [&](double x, int64_t size) {
-      const double y = clamped(x, size);
-      const int32_t t = static_cast<int32_t>(y);
-      return t - (static_cast<double>(t) > y ? 1 : 0);
+    const auto last_centre = [&](int64_t hi, int64_t size) {  // the greatest i: centre <= hi
+      return static_cast<int32_t>(std::clamp<int64_t>((hi - half) >> bits, -1, size));
     };
     RasterBox b;
-    b.left = ceil(std::min({c.x[0], c.x[1], c.x[2]}) - 0.5, width);
-    b.right = floor(std::max({c.x[0], c.x[1], c.x[2]}) - 0.5, width);
-    b.first = ceil(std::min({c.y[0], c.y[1], c.y[2]}) - 0.5, height);
-    b.last = floor(std::max({c.y[0], c.y[1], c.y[2]}) - 0.5, height);
-    const bool holds = std::max(b.left, 0) < std::min<int64_t>(int64_t{b.right} + 1, width) &&
-                       std::max(b.first, 0) < std::min<int64_t>(int64_t{b.last} + 1, height);
-    if (!holds || !(c.Area2() != 0.0)) b = {0, -1, 0, -1};
+    b.left = first_centre(std::min({c.gx[0], c.gx[1], c.gx[2]}), w.width);
+    b.right = last_centre(std::max({c.gx[0], c.gx[1], c.gx[2]}), w.width);
+    b.first = first_centre(std::min({c.gy[0], c.gy[1], c.gy[2]}), w.height);
+    b.last = last_centre(std::max({c.gy[0], c.gy[1], c.gy[2]}), w.height);
+    const bool holds = std::max(b.left, 0) < std::min<int64_t>(int64_t{b.right} + 1, w.width) &&
+                       std::max(b.first, 0) < std::min<int64_t>(int64_t{b.last} + 1, w.height);
+    if (!holds || c.GridArea2() == 0) b = {0, -1, 0, -1};
     return b;
   }
 };
@@ -315,7 +326,7 @@ void RasterizeInBands(std::span<const uint32_t> faces, std::span<const RasterTri
       const int64_t j_begin = std::max<int64_t>(b.first, row_begin);
       const int64_t j_end = std::min<int64_t>(int64_t{b.last} + 1, row_end);
       if (j_begin >= j_end) continue;
-      DrawTriangleRows(faces[c], set_up[c], j_begin, j_end, b.left, int64_t{b.right} + 1, w.width,
+      DrawTriangleRows(faces[c], set_up[c], w, j_begin, j_end, b.left, int64_t{b.right} + 1,
                        fragment);
     }
   });
@@ -323,20 +334,24 @@ void RasterizeInBands(std::span<const uint32_t> faces, std::span<const RasterTri
 
 // The triangles that cover a texel centre of the window, set up in `drawn` order: faces[c] the
 // triangle, boxes[c] its box (clipped to the window), set_up[c] its edges and depth plane.
-// Boxes first (most triangles of a finely meshed body at a coarse texel cover no centre), then
-// the set-up of the covering ones only. `all_boxes`: scratch, one per drawn triangle. Returns
-// how many cover a centre.
-inline size_t SetUpTriangles(const Float3* vertices, const uint32_t* triangles,
+// Every vertex placed in the window first, then the boxes (most triangles of a finely meshed body
+// at a coarse texel cover no centre), then the set-up of the covering ones only. `placed`: one
+// per vertex, `all_boxes`: one per drawn triangle, both scratch. Returns how many cover a centre.
+inline size_t SetUpTriangles(std::span<const Float3> vertices, const uint32_t* triangles,
                              std::span<const uint32_t> drawn, const RasterWindow& w,
-                             std::span<RasterBox> all_boxes, std::span<uint32_t> faces,
-                             std::span<RasterBox> boxes, std::span<RasterTriangle> set_up) {
+                             std::span<RasterVertex> placed, std::span<RasterBox> all_boxes,
+                             std::span<uint32_t> faces, std::span<RasterBox> boxes,
+                             std::span<RasterTriangle> set_up) {
+  ParallelFor(static_cast<int64_t>(vertices.size()), 4096, [&](int64_t v) {
+    const size_t n = static_cast<size_t>(v);
+    placed[n] = RasterVertex::Of(vertices[n], w);
+  });
   const auto corners = [&](uint32_t t) {
-    return RasterTriangle::CornersOf(vertices, triangles + 3 * size_t{t}, w.origin_x, w.origin_y,
-                                     w.inverse_texel);
+    return RasterTriangle::CornersOf(vertices.data(), placed.data(), triangles + 3 * size_t{t});
   };
   ParallelFor(static_cast<int64_t>(drawn.size()), 2048, [&](int64_t d) {
     const size_t n = static_cast<size_t>(d);
-    all_boxes[n] = RasterBox::Of(corners(drawn[n]), w.width, w.height);
+    all_boxes[n] = RasterBox::Of(corners(drawn[n]), w);
   });
   size_t count = 0;
   for (size_t d = 0; d < drawn.size(); ++d) {

@@ -31,6 +31,7 @@ namespace detail {
 struct RasterWindow;     // body_map/raster_triangle.h
 struct RasterTriangle;   // body_map/raster_triangle.h
 struct RasterBox;        // body_map/raster_triangle.h
+struct RasterVertex;     // body_map/raster_triangle.h
 struct TriangleShading;  // body_map/raster_triangle.h
 }  // namespace detail
 
@@ -140,6 +141,7 @@ class BodyMapRenderer {
   struct Window {                           // the texel grid of one render
     double origin_x = 0.0, origin_y = 0.0;  // metres, a multiple of the texel size
     uint32_t width = 0, height = 0;         // texels
+    int sub_bits = 0;  // the raster grid: 2^sub_bits units per texel (raster_triangle.h)
   };
   detail::RasterWindow RasterWindowOf(const Window& window) const;
   // The triangles of the last raster set-up that cover a texel centre, in draw order.
@@ -178,6 +180,7 @@ class BodyMapRenderer {
   std::vector<uint32_t> drawn_;       // triangles that reach the region, ascending
   // The drawn triangles' boxes; then those covering a texel centre (raster_count_ of them, in
   // draw order): the triangle, its box within the window, its set-up in window coordinates.
+  std::vector<detail::RasterVertex> placed_;  // every vertex in the window (raster set-up)
   std::vector<detail::RasterBox> all_boxes_;
   size_t raster_count_ = 0;
   std::vector<uint32_t> raster_faces_;
