@@ -313,7 +313,10 @@ template <class Fragment>
 void RasterizeInBands(std::span<const uint32_t> faces, std::span<const RasterTriangle> set_up,
                       std::span<const RasterBox> boxes, const RasterWindow& w,
                       const std::vector<uint32_t>* positions, Fragment&& fragment) {
-  const int64_t bands = 4 * int64_t{GetTaskSystem().WorkerCount()};  // balance, not results
+  // Balance, not results: four bands per worker, one without a second worker (each band scans
+  // every triangle's box).
+  const int64_t workers = GetTaskSystem().WorkerCount();
+  const int64_t bands = workers > 1 ? 4 * workers : 1;
   const int64_t rows_per_band = std::max<int64_t>(8, (w.height + bands - 1) / bands);
   const int64_t band_count = (w.height + rows_per_band - 1) / rows_per_band;
   const size_t count = positions != nullptr ? positions->size() : faces.size();
