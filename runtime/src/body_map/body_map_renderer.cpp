@@ -381,14 +381,17 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   }
   maps->slabs_.assign(texels, BodyMapCollider::Slab{-kInf, kInf});
   maps->normals_.resize(texels);
-  top_face_.assign(texels, kNoFace);
-  bottom_face_.assign(texels, kNoFace);
+  // The renderer's per-texel entries are set by a texel's first fragment (its slab's top is
+  // then still -inf) and read only where the slab is valid: not cleared here, where most of the
+  // window is background.
+  top_face_.resize(texels);
+  bottom_face_.resize(texels);
   maps->gap_layers_ = options_.air_gaps > 0 ? 1u : 0u;  // PublishGaps sets the deepest found
   if (options_.air_gaps > 0) {
-    exit_z_.assign(texels, -kInf);
-    lowest_entry_z_.assign(texels, kInf);
-    exit_face_.assign(texels, kNoFace);
-    fragment_count_.assign(texels, 0u);
+    exit_z_.resize(texels);
+    lowest_entry_z_.resize(texels);
+    exit_face_.resize(texels);
+    fragment_count_.resize(texels);
     fragment_cursor_.resize(texels);  // set by FindGaps
   }
   maps->width_ = window.width;
@@ -453,6 +456,12 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
         const float z = r.Depth(px, py);
         BodyMapCollider::Slab& s = slabs[k];
+        if (gaps && s.top == -kInf) {  // the texel's first fragment (z is finite)
+          fragment_count[k] = 0;
+          exit_z[k] = -kInf;
+          exit_face[k] = kNoFace;
+          lowest_entry_z[k] = kInf;
+        }
         if (z > s.top) {
           s.top = z;
           top_face[k] = t;
@@ -495,11 +504,12 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
     for (int64_t i = 0; i < width; ++i) {
       const size_t k = static_cast<size_t>(j * width + i);
       BodyMapCollider::TexelNormals& out = maps->normals_[k];
-      const uint32_t front_face = top_face_[k], back_face = bottom_face_[k];
-      if (front_face == kNoFace) {
+      const BodyMapCollider::Slab& slab = maps->slabs_[k];
+      if (!(slab.top >= slab.bottom)) {  // background: no fragment set its faces
         out = {{up[0], up[1]}, {up[0], up[1]}};
         continue;
       }
+      const uint32_t front_face = top_face_[k], back_face = bottom_face_[k];
       const float px = static_cast<float>(i) + 0.5f;
       const std::array<uint16_t, 2> a = EncodeOct16(shading_[front_face].At(px, py, kUp));
       const std::array<uint16_t, 2> b = EncodeOct16(shading_[back_face].At(px, py, kDown));

@@ -71,10 +71,12 @@ void BodyMapRenderer::SelectGapTexels(const BodyMapCollider& maps, size_t texels
   fragment_offsets_.clear();
   uint32_t total = 0;
   for (size_t k = 0; k < texels; ++k) {
+    // Background: no fragment, and its entries were never set (nor are they collected).
+    const BodyMapCollider::Slab& slab = maps.slabs_[k];
+    if (!(slab.top >= slab.bottom)) continue;
     // A gap's lower boundary is a surface entering the body below its upper one, which lies at
     // or below the first candidate: none there, no gap (parts sunk into each other).
-    const bool room = exit_face_[k] != kNoFace &&
-                      exit_z_[k] > maps.slabs_[k].bottom + 2.f * kMinGap &&
+    const bool room = exit_face_[k] != kNoFace && exit_z_[k] > slab.bottom + 2.f * kMinGap &&
                       lowest_entry_z_[k] < exit_z_[k];
     const uint32_t surfaces = fragment_count_[k];
     if (!room || surfaces > kMaxSurfacesPerGapTexel || surfaces > kMaxGapFragments - total) {
