@@ -660,6 +660,70 @@ TEST(HullColliderTest, GroupedBroadPhaseOfManyCollidersMatchesThePerParticleOne)
   }
 }
 
+// A cloth's neighbouring particles share their candidates, so the batch tests the hulls' boxes
+// for a whole group at once and drops the candidates a box rejects (most, near limbs whose
+// bounding spheres overlap). The contacts must come out as the per-particle path gives them.
+TEST(HullColliderTest, TheGroupBoxFilterKeepsASheetsContacts) {
+  // Twelve thin limb-like hulls in a column of pairs, turning a little over the step.
+  std::vector<HullColliderData> hulls;
+  for (int i = 0; i < 12; ++i) {
+    Float3 axes[3];
+    RotatedAxes(9.0 * i, {0.3f, 1.f, 0.2f}, axes);
+    const Float3 centre{i % 2 == 0 ? -0.04f : 0.04f, 0.12f * float(i / 2), 0.f};
+    HullColliderData h = MakeEllipsoid({0.015f, 0.06f, 0.015f}, 1, centre, axes);
+    h.joint = i % 2;
+    hulls.push_back(h);
+  }
+  const std::vector<JointSphereData> spheres = {{0, -1, {-0.04f, 0.3f, 0.f}, 0.02f},
+                                                {1, -1, {0.04f, 0.3f, 0.f}, 0.02f}};
+  HullColliderSet set = BuildSet(hulls, spheres, 2);
+  const std::vector<Mat34> start = {Mat34{}, Mat34{}};
+  const std::vector<Mat34> end = {RotationAbout(4, {1, 0, 0}, {0, 0.7f, 0}),
+                                  RotationAbout(-4, {1, 0, 0}, {0, 0.7f, 0})};
+  ASSERT_TRUE(set.SetPose(start, end).ok());
+  // A 120 x 60 sheet in grid order wrapped half round the column, falling 1 cm and pushed 3 to
+  // 9 cm towards it: many segments cross a hull and end beyond it.
+  std::vector<Float3> previous, positions, velocities;
+  for (int j = 0; j < 60; ++j) {
+    for (int i = 0; i < 120; ++i) {
+      const float angle = 3.14159f * float(i) / 119.f, radius = 0.08f + 0.002f * float(i % 7);
+      const Float3 out{std::cos(angle), 0.f, std::sin(angle)};
+      const Float3 p = out * radius + Float3{0.f, 0.012f * float(j) - 0.02f, 0.f};
+      const float push = 0.03f + 0.01f * float((i + j) % 7);
+      previous.push_back(p);
+      positions.push_back(p + Float3{0.f, -0.01f, 0.f} - out * push);
+      velocities.push_back((positions.back() - p) * 60.f);
+    }
+  }
+  const ResponseParams params;
+  const float s0 = 0.25f, s1 = 0.75f;
+  std::vector<Float3> p1 = positions, v1 = velocities;
+  std::vector<uint8_t> f1(positions.size());
+  uint32_t c1 = 0;
+  ASSERT_TRUE(set.CollideBatch(previous, p1, v1, f1, params, s0, s1, &c1).ok());  // per particle
+  EXPECT_GT(c1, 200u);
+  for (InstructionSet instruction_set :
+       {InstructionSet::kScalar, InstructionSet::kSse2, InstructionSet::kAvx2}) {
+    HullColliderOptions options;
+    options.instruction_set = instruction_set;
+    ASSERT_TRUE(set.SetOptions(options).ok());
+    if (set.instruction_set() != instruction_set) continue;  // the CPU lacks it
+    SCOPED_TRACE(ToString(instruction_set));
+    ASSERT_TRUE(set.SelectSubstep(s0, s1).ok());
+    // The filter runs: the lanes share their hulls, and many candidates are beyond a box.
+    EXPECT_GT(HullColliderSetAccess::GroupBoxRejections(set, previous, positions),
+              positions.size() / 2);
+    std::vector<Float3> p2 = positions, v2 = velocities;
+    std::vector<uint8_t> f2(positions.size());
+    uint32_t c2 = 0;
+    ASSERT_TRUE(set.CollideBatch(previous, p2, v2, f2, params, s0, s1, &c2).ok());  // grouped
+    EXPECT_EQ(c1, c2);
+    EXPECT_EQ(std::memcmp(p1.data(), p2.data(), p1.size() * sizeof(Float3)), 0);
+    EXPECT_EQ(std::memcmp(v1.data(), v2.data(), v1.size() * sizeof(Float3)), 0);
+    EXPECT_EQ(f1, f2);
+  }
+}
+
 TEST(HullColliderTest, InvalidInputIsFlaggedAndLeftUntouched) {
   HullColliderSet set = BuildSet({MakeBox({0.1f, 0.1f, 0.1f})}, {}, 1);
   const float nan = std::nanf(""), inf = std::numeric_limits<float>::infinity();

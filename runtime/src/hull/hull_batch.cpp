@@ -94,6 +94,12 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
           kernels_->sphere_masks(&previous[first], &positions[first], &velocities[first], lanes,
                                  sweep_x_.data(), sweep_y_.data(), sweep_z_.data(), sweep_r_.data(),
                                  collider_count_, sweep_union_center_, sweep_union_radius_, masks);
+      // Then the hulls' boxes, for the whole group at once: a candidate ColliderContact would
+      // reject by its box is dropped here (most are: near a body a segment's sphere meets several
+      // limbs' bounding spheres), and a particle left without one is done.
+      kernels_->obb_masks(&previous[first], &positions[first], lanes, obb_start_.data(),
+                          obb_end_.data(), obb_half_.data(), static_cast<uint32_t>(hulls_.size()),
+                          collider_count_, options_.continuous, kMaxCandidates, masks);
       // Only the invalid lanes and those with candidates need more; the others are done.
       uint32_t work = ~finite;
       for (uint32_t l = 0; l < width; ++l) {

@@ -280,6 +280,10 @@ Status HullColliderSet::Build(std::span<const HullColliderData> hulls,
   collider_count_ = static_cast<uint32_t>(colliders);
   motions_.assign(colliders, Motion{});
   active_.assign(colliders, ActiveFrames{});
+  obb_start_.assign(hulls_.size(), Mat34{});
+  obb_end_.assign(hulls_.size(), Mat34{});
+  obb_half_.resize(hulls_.size());
+  for (size_t h = 0; h < hulls_.size(); ++h) obb_half_[h] = hulls_[h].obb_half;
   const size_t padded = (colliders + 7) / 8 * 8;
   for (auto* v : {&sweep_x_, &sweep_y_, &sweep_z_, &full_x_, &full_y_, &full_z_})
     v->assign(padded, kPadCenter);
@@ -305,6 +309,7 @@ size_t HullColliderSet::memory_bytes() const {
           map_triangles_.size()) *
              sizeof(uint32_t) +
          motions_.size() * sizeof(Motion) + active_.size() * sizeof(ActiveFrames) +
+         (obb_start_.size() + obb_end_.size()) * sizeof(Mat34) + obb_half_.size() * sizeof(Float3) +
          (sweep_x_.size() * 8) * sizeof(float);
 }
 

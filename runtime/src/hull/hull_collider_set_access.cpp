@@ -1,5 +1,10 @@
 #include "hull/hull_collider_set_access.h"
 
+#include <algorithm>
+#include <vector>
+
+#include "hull/plane_kernels.h"
+
 namespace drape {
 
 bool HullColliderSetAccess::InsideLocal(const HullColliderSet& set, uint32_t hull, Float3 p,
@@ -49,6 +54,31 @@ bool HullColliderSetAccess::MapTableRayLocal(const HullColliderSet& set, uint32_
   if (!set.MapRay(h, p, point, &plane)) return false;
   *normal = set.planes_[h.plane_begin + plane].normal;
   return true;
+}
+
+uint64_t HullColliderSetAccess::GroupBoxRejections(const HullColliderSet& set,
+                                                   std::span<const Float3> previous,
+                                                   std::span<const Float3> current) {
+  const detail::PlaneKernels& k = *set.kernels_;
+  const uint32_t words = (set.collider_count_ + 31) / 32;
+  std::vector<uint32_t> masks(size_t{k.group_width} * words), before;
+  uint64_t cleared = 0;
+  for (size_t first = 0; first < current.size(); first += k.group_width) {
+    const uint32_t lanes =
+        static_cast<uint32_t>(std::min<size_t>(k.group_width, current.size() - first));
+    k.sphere_masks(&previous[first], &current[first], &current[first], lanes, set.sweep_x_.data(),
+                   set.sweep_y_.data(), set.sweep_z_.data(), set.sweep_r_.data(),
+                   set.collider_count_, set.sweep_union_center_, set.sweep_union_radius_,
+                   masks.data());
+    before = masks;
+    k.obb_masks(&previous[first], &current[first], lanes, set.obb_start_.data(),
+                set.obb_end_.data(), set.obb_half_.data(), static_cast<uint32_t>(set.hulls_.size()),
+                set.collider_count_, set.options_.continuous, HullColliderSet::kMaxCandidates,
+                masks.data());
+    for (size_t i = 0; i < size_t{lanes} * words; ++i)
+      cleared += static_cast<uint64_t>(__builtin_popcount(before[i] & ~masks[i]));
+  }
+  return cleared;
 }
 
 }  // namespace drape

@@ -3,6 +3,7 @@
 // the tests and the benchmarks that measure a kernel alone. Indices must be valid.
 
 #include <cstdint>
+#include <span>
 
 #include "drape/runtime/hull_collider_set.h"
 
@@ -32,6 +33,10 @@ struct HullColliderSetAccess {
   // The sum over all colliders of the depth of world point p inside them (selected substep): the
   // bound a response inside overlapping colliders stays within, beside the motion.
   static double DepthSum(const HullColliderSet& set, Float3 p);
+  // The batch's group box filter on the selected substep, over `previous` -> `current` in the
+  // batch's groups: how many candidate bits of the sphere broad phase it clears.
+  static uint64_t GroupBoxRejections(const HullColliderSet& set, std::span<const Float3> previous,
+                                     std::span<const Float3> current);
   // The map-table response ray through p: false when it finds no listed triangle.
   static bool MapTableRayLocal(const HullColliderSet& set, uint32_t hull, Float3 p, Float3* point,
                                Float3* normal);

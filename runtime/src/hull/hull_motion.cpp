@@ -198,6 +198,10 @@ Status HullColliderSet::SelectSubstep(float s0, float s1) {
   active_s1_ = s1;
   for (uint32_t k = 0; k < motions_.size(); ++k) {
     ComputeFrames(k, s0, s1, &active_[k]);
+    if (k < obb_start_.size()) {
+      obb_start_[k] = active_[k].to_obb_start;
+      obb_end_[k] = active_[k].to_obb_end;
+    }
     Float3 center;
     float radius;
     ComputeSweep(k, s0, s1, &center, &radius);

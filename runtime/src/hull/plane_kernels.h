@@ -62,6 +62,17 @@ struct PlaneKernels {
                            uint32_t lanes, const float* xs, const float* ys, const float* zs,
                            const float* rs, uint32_t total, Float3 union_center, float union_radius,
                            uint32_t* masks);
+  // The group's OBB filter after sphere_masks (the same lanes and masks): for every hull k <
+  // hulls whose bit a lane holds, clears the bit of each lane whose segment p0 -> p1 the OBB test
+  // of ColliderContact rejects (the end outside the box and, when continuous, both ends beyond
+  // one face), with the same arithmetic. Hull k's box: world -> box frames obb_start[k] at the
+  // substep's start and obb_end[k] at its end, half extents half[k]. `total`: the colliders the
+  // masks count. Lanes with more than max_candidates candidates keep theirs (the resolution then
+  // keeps the lowest indices, which the filter would change). Skipped (the masks left as they
+  // are) when the lanes share fewer than half their hulls: each test serves all lanes.
+  void (*obb_masks)(const Float3* p0, const Float3* p1, uint32_t lanes, const Mat34* obb_start,
+                    const Mat34* obb_end, const Float3* half, uint32_t hulls, uint32_t total,
+                    bool continuous, uint32_t max_candidates, uint32_t* masks);
 };
 
 // The kernels of `set`, which the CPU must run (BestInstructionSet() or narrower).

@@ -229,6 +229,96 @@ struct PlaneLanes {
     return finite_lanes;
   }
 
+  // TransformPoint(m, p) per lane: ((m0 x + m1 y) + m2 z) + m3, row by row.
+  static void TransformLanes(const Mat34& m, F x, F y, F z, F* ox, F* oy, F* oz) {
+    const auto row = [&](int r) {
+      const float* c = m.m + 4 * r;
+      return Add(Add(Add(Mul(P::Splat(c[0]), x), Mul(P::Splat(c[1]), y)), Mul(P::Splat(c[2]), z)),
+                 P::Splat(c[3]));
+    };
+    *ox = row(0);
+    *oy = row(1);
+    *oz = row(2);
+  }
+
+  static void ObbMasks(const Float3* p0, const Float3* p1, uint32_t lanes, const Mat34* obb_start,
+                       const Mat34* obb_end, const Float3* half, uint32_t hulls, uint32_t total,
+                       bool continuous, uint32_t max_candidates, uint32_t* masks) {
+    F ax, ay, az, bx, by, bz;
+    if (lanes == static_cast<uint32_t>(P::kCount)) {
+      P::LoadFloat3s(p0, &ax, &ay, &az);
+      P::LoadFloat3s(p1, &bx, &by, &bz);
+    } else {
+      const auto from = [lanes](int l) { return static_cast<uint32_t>(l) < lanes ? l : 0; };
+      ax = P::FromLanes([&](int l) { return p0[from(l)].x; });
+      ay = P::FromLanes([&](int l) { return p0[from(l)].y; });
+      az = P::FromLanes([&](int l) { return p0[from(l)].z; });
+      bx = P::FromLanes([&](int l) { return p1[from(l)].x; });
+      by = P::FromLanes([&](int l) { return p1[from(l)].y; });
+      bz = P::FromLanes([&](int l) { return p1[from(l)].z; });
+    }
+    const uint32_t words = (total + 31) / 32;
+    const auto hulls_in = [hulls](uint32_t w, uint32_t mask) {  // the hull bits of word w
+      return hulls - 32 * w < 32 ? mask & ((1u << (hulls - 32 * w)) - 1u) : mask;
+    };
+    // Only lanes within max_candidates: beyond it the resolution keeps the lowest indices, which
+    // dropping a rejected hull would change; within it the same contacts come out, bit for bit.
+    uint32_t filtered = 0;
+    for (uint32_t l = 0; l < lanes; ++l) {
+      uint32_t count = 0;
+      for (uint32_t w = 0; w < words; ++w)
+        count += static_cast<uint32_t>(__builtin_popcount(masks[l * words + w]));
+      filtered |= count <= max_candidates ? 1u << l : 0u;
+    }
+    // One test here serves every lane, one in ColliderContact a lane: worth it when the lanes
+    // share their hulls (a cloth's neighbouring particles), not for scattered particles.
+    uint32_t shared = 0, per_lane = 0;
+    for (uint32_t w = 0; w * 32 < hulls; ++w) {
+      uint32_t any = 0;
+      for (uint32_t l = 0; l < lanes; ++l) {
+        if (!((filtered >> l) & 1u)) continue;
+        const uint32_t mask = hulls_in(w, masks[l * words + w]);
+        any |= mask;
+        per_lane += static_cast<uint32_t>(__builtin_popcount(mask));
+      }
+      shared += static_cast<uint32_t>(__builtin_popcount(any));
+    }
+    if (2 * shared > per_lane) return;
+    for (uint32_t w = 0; w * 32 < hulls; ++w) {
+      uint32_t any = 0;
+      for (uint32_t l = 0; l < lanes; ++l) {
+        if ((filtered >> l) & 1u) any |= hulls_in(w, masks[l * words + w]);
+      }
+      for (; any != 0; any &= any - 1u) {
+        const uint32_t bit = static_cast<uint32_t>(__builtin_ctz(any));
+        const uint32_t k = 32 * w + bit;
+        F ox, oy, oz, ex, ey, ez;  // the start and the end in the OBB frame
+        TransformLanes(obb_start[k], ax, ay, az, &ox, &oy, &oz);
+        TransformLanes(obb_end[k], bx, by, bz, &ex, &ey, &ez);
+        const Float3 h = half[k];
+        const F hx = P::Splat(h.x), hy = P::Splat(h.y), hz = P::Splat(h.z);
+        const F mx = P::Splat(-h.x), my = P::Splat(-h.y), mz = P::Splat(-h.z);
+        const F end_in =
+            And(And(LessEq(AbsLanes(ex), hx), LessEq(AbsLanes(ey), hy)), LessEq(AbsLanes(ez), hz));
+        F reject_when_out = Equal(P::Zero(), P::Zero());  // discrete: the end outside suffices
+        if (continuous) {
+          const F beyond_x =
+              Or(And(Greater(ox, hx), Greater(ex, hx)), And(Less(ox, mx), Less(ex, mx)));
+          const F beyond_y =
+              Or(And(Greater(oy, hy), Greater(ey, hy)), And(Less(oy, my), Less(ey, my)));
+          const F beyond_z =
+              Or(And(Greater(oz, hz), Greater(ez, hz)), And(Less(oz, mz), Less(ez, mz)));
+          reject_when_out = Or(Or(beyond_x, beyond_y), beyond_z);
+        }
+        uint32_t rejected = LaneBits(AndNot(end_in, reject_when_out)) & filtered;
+        for (; rejected != 0; rejected &= rejected - 1u) {
+          const uint32_t l = static_cast<uint32_t>(__builtin_ctz(rejected));
+          masks[l * words + w] &= ~(1u << bit);
+        }
+      }
+    }
+  }
+
   static const PlaneKernels& Table() {
     static const PlaneKernels kernels{static_cast<uint32_t>(P::kCount),
                                       Max,
@@ -238,7 +328,8 @@ struct PlaneLanes {
                                       Clip,
                                       Entry,
                                       SphereFilter,
-                                      SphereMasks};
+                                      SphereMasks,
+                                      ObbMasks};
     return kernels;
   }
 };

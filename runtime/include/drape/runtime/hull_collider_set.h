@@ -340,6 +340,9 @@ class HullColliderSet {
   // Pose.
   std::vector<Motion> motions_;  // hulls then spheres
   std::vector<ActiveFrames> active_;
+  // Per hull, from active_: the boxes the batch's group filter tests (plane_kernels.h).
+  std::vector<Mat34> obb_start_, obb_end_;  // world -> OBB frame at the substep's ends
+  std::vector<Float3> obb_half_;            // metres
   float active_s0_ = 0.f, active_s1_ = 1.f;
   bool selection_current_ = false;  // active_ and sweep_* hold [active_s0_, active_s1_] of the pose
   // Swept spheres, SoA padded to a multiple of 8: over the selected substep and the whole step.
