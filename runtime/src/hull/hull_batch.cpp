@@ -84,6 +84,7 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
     // (ResolveParticle would leave it as it is).
     const uint32_t width = kernels_->group_width;
     const uint32_t words = (collider_count_ + 31) / 32;
+    const uint32_t hull_count = static_cast<uint32_t>(hulls_.size());
     const int64_t groups = (count + width - 1) / width;
     const auto group_of_particles = [&](int64_t g) -> uint32_t {
       uint32_t group_contacts = 0;
@@ -94,19 +95,27 @@ Status HullColliderSet::CollideBatch(std::span<const Float3> previous, std::span
           kernels_->sphere_masks(&previous[first], &positions[first], &velocities[first], lanes,
                                  sweep_x_.data(), sweep_y_.data(), sweep_z_.data(), sweep_r_.data(),
                                  collider_count_, sweep_union_center_, sweep_union_radius_, masks);
-      // Then the hulls' boxes, for the whole group at once: a candidate ColliderContact would
-      // reject by its box is dropped here (most are: near a body a segment's sphere meets several
-      // limbs' bounding spheres), and a particle left without one is done.
-      kernels_->obb_masks(&previous[first], &positions[first], lanes, obb_start_.data(),
-                          obb_end_.data(), obb_half_.data(), static_cast<uint32_t>(hulls_.size()),
-                          collider_count_, options_.continuous, kMaxCandidates, masks);
-      // Only the invalid lanes and those with candidates need more; the others are done.
-      uint32_t work = ~finite;
-      for (uint32_t l = 0; l < width; ++l) {
-        uint32_t any = 0;
-        for (uint32_t w = 0; w < words; ++w) any |= masks[l * words + w];
-        work |= any != 0 ? 1u << l : 0u;
+      const auto lanes_with_candidates = [&] {
+        uint32_t bits = 0;
+        for (uint32_t l = 0; l < width; ++l) {
+          uint32_t any = 0;
+          for (uint32_t w = 0; w < words; ++w) any |= masks[l * words + w];
+          bits |= any != 0 ? 1u << l : 0u;
+        }
+        return bits;
+      };
+      uint32_t candidates = lanes_with_candidates();
+      if (candidates != 0 && hull_count > 0) {
+        // Then the hulls' boxes, for the whole group at once: a candidate ColliderContact would
+        // reject by its box is dropped here (most are: near a body a segment's sphere meets
+        // several limbs' bounding spheres), and a particle left without one is done.
+        kernels_->obb_masks(&previous[first], &positions[first], lanes, obb_start_.data(),
+                            obb_end_.data(), obb_half_.data(), hull_count, collider_count_,
+                            options_.continuous, kMaxCandidates, masks);
+        candidates = lanes_with_candidates();
       }
+      // Only the invalid lanes and those with candidates need more; the others are done.
+      uint32_t work = ~finite | candidates;
       work &= (1u << lanes) - 1;
       std::memset(&flags[first], kCollisionNone, lanes);
       for (; work != 0; work &= work - 1) {
