@@ -603,6 +603,41 @@ TEST(HullColliderTest, BatchIsBitwiseIdenticalAtOneAndTwoThreads) {
 // particles in the middle reach more than kMaxCandidates of them: the grouped first broad phase
 // (selected substep) keeps exactly the candidates of each particle's own broad phase (other
 // fractions), at every instruction set.
+// Collides previous -> positions over [s0, s1] through the per-particle path (fractions not
+// selected), then through the grouped path of every lane pack the CPU runs, and expects the same
+// bits. `per_pack` runs with each pack selected, before its batch. Returns the contacts.
+template <class PerPack>
+uint32_t ExpectGroupedAsPerParticle(HullColliderSet& set, const std::vector<Float3>& previous,
+                                    const std::vector<Float3>& positions,
+                                    const std::vector<Float3>& velocities, float s0, float s1,
+                                    const PerPack& per_pack) {
+  const ResponseParams params;
+  std::vector<Float3> p1 = positions, v1 = velocities;
+  std::vector<uint8_t> f1(positions.size());
+  uint32_t c1 = 0;
+  EXPECT_TRUE(set.CollideBatch(previous, p1, v1, f1, params, s0, s1, &c1).ok());  // per particle
+  for (InstructionSet instruction_set :
+       {InstructionSet::kScalar, InstructionSet::kSse2, InstructionSet::kAvx2}) {
+    HullColliderOptions options;
+    options.instruction_set = instruction_set;
+    EXPECT_TRUE(set.SetOptions(options).ok());
+    if (set.instruction_set() != instruction_set) continue;  // the CPU lacks it
+    SCOPED_TRACE(ToString(instruction_set));
+    EXPECT_TRUE(set.SelectSubstep(s0, s1).ok());
+    per_pack();
+    std::vector<Float3> p2 = positions, v2 = velocities;
+    std::vector<uint8_t> f2(positions.size());
+    uint32_t c2 = 0;
+    EXPECT_TRUE(set.CollideBatch(previous, p2, v2, f2, params, s0, s1, &c2).ok());  // grouped
+    EXPECT_EQ(c1, c2);
+    EXPECT_EQ(std::memcmp(p1.data(), p2.data(), p1.size() * sizeof(Float3)), 0);
+    EXPECT_EQ(std::memcmp(v1.data(), v2.data(), v1.size() * sizeof(Float3)), 0);
+    EXPECT_EQ(f1, f2);
+    EXPECT_TRUE(set.SelectSubstep(0.f, 1.f).ok());
+  }
+  return c1;
+}
+
 TEST(HullColliderTest, GroupedBroadPhaseOfManyCollidersMatchesThePerParticleOne) {
   std::mt19937 rng(21);
   std::vector<HullColliderData> hulls;
@@ -633,31 +668,8 @@ TEST(HullColliderTest, GroupedBroadPhaseOfManyCollidersMatchesThePerParticleOne)
     positions.push_back(p + RandomIn(rng, {-0.03f, -0.03f, -0.03f}, {0.03f, 0.03f, 0.03f}));
     velocities.push_back(RandomIn(rng, {-1, -1, -1}, {1, 1, 1}));
   }
-  const ResponseParams params;
-  const float s0 = 0.25f, s1 = 0.5f;
-  std::vector<Float3> p1 = positions, v1 = velocities;
-  std::vector<uint8_t> f1(positions.size());
-  uint32_t c1 = 0;
-  ASSERT_TRUE(set.CollideBatch(previous, p1, v1, f1, params, s0, s1, &c1).ok());  // per particle
-  EXPECT_GT(c1, 400u);
-  for (InstructionSet instruction_set :
-       {InstructionSet::kScalar, InstructionSet::kSse2, InstructionSet::kAvx2}) {
-    HullColliderOptions options;
-    options.instruction_set = instruction_set;
-    ASSERT_TRUE(set.SetOptions(options).ok());
-    if (set.instruction_set() != instruction_set) continue;  // the CPU lacks it
-    SCOPED_TRACE(ToString(instruction_set));
-    ASSERT_TRUE(set.SelectSubstep(s0, s1).ok());
-    std::vector<Float3> p2 = positions, v2 = velocities;
-    std::vector<uint8_t> f2(positions.size());
-    uint32_t c2 = 0;
-    ASSERT_TRUE(set.CollideBatch(previous, p2, v2, f2, params, s0, s1, &c2).ok());  // grouped
-    EXPECT_EQ(c1, c2);
-    EXPECT_EQ(std::memcmp(p1.data(), p2.data(), p1.size() * sizeof(Float3)), 0);
-    EXPECT_EQ(std::memcmp(v1.data(), v2.data(), v1.size() * sizeof(Float3)), 0);
-    EXPECT_EQ(f1, f2);
-    ASSERT_TRUE(set.SelectSubstep(0.f, 1.f).ok());
-  }
+  EXPECT_GT(ExpectGroupedAsPerParticle(set, previous, positions, velocities, 0.25f, 0.5f, [] {}),
+            400u);
 }
 
 // A cloth's neighbouring particles share their candidates, so the batch tests the hulls' boxes
@@ -695,33 +707,14 @@ TEST(HullColliderTest, TheGroupBoxFilterKeepsASheetsContacts) {
       velocities.push_back((positions.back() - p) * 60.f);
     }
   }
-  const ResponseParams params;
-  const float s0 = 0.25f, s1 = 0.75f;
-  std::vector<Float3> p1 = positions, v1 = velocities;
-  std::vector<uint8_t> f1(positions.size());
-  uint32_t c1 = 0;
-  ASSERT_TRUE(set.CollideBatch(previous, p1, v1, f1, params, s0, s1, &c1).ok());  // per particle
-  EXPECT_GT(c1, 200u);
-  for (InstructionSet instruction_set :
-       {InstructionSet::kScalar, InstructionSet::kSse2, InstructionSet::kAvx2}) {
-    HullColliderOptions options;
-    options.instruction_set = instruction_set;
-    ASSERT_TRUE(set.SetOptions(options).ok());
-    if (set.instruction_set() != instruction_set) continue;  // the CPU lacks it
-    SCOPED_TRACE(ToString(instruction_set));
-    ASSERT_TRUE(set.SelectSubstep(s0, s1).ok());
-    // The filter runs: the lanes share their hulls, and many candidates are beyond a box.
+  // The filter runs: the lanes share their hulls, and many candidates are beyond a box.
+  const auto filter_runs = [&] {
     EXPECT_GT(HullColliderSetAccess::GroupBoxRejections(set, previous, positions),
               positions.size() / 2);
-    std::vector<Float3> p2 = positions, v2 = velocities;
-    std::vector<uint8_t> f2(positions.size());
-    uint32_t c2 = 0;
-    ASSERT_TRUE(set.CollideBatch(previous, p2, v2, f2, params, s0, s1, &c2).ok());  // grouped
-    EXPECT_EQ(c1, c2);
-    EXPECT_EQ(std::memcmp(p1.data(), p2.data(), p1.size() * sizeof(Float3)), 0);
-    EXPECT_EQ(std::memcmp(v1.data(), v2.data(), v1.size() * sizeof(Float3)), 0);
-    EXPECT_EQ(f1, f2);
-  }
+  };
+  EXPECT_GT(
+      ExpectGroupedAsPerParticle(set, previous, positions, velocities, 0.25f, 0.75f, filter_runs),
+      200u);
 }
 
 TEST(HullColliderTest, InvalidInputIsFlaggedAndLeftUntouched) {
