@@ -10,11 +10,15 @@
 #include <vector>
 
 #include "drape/runtime/normal_encoding.h"
+#include "tasks/parallel_for.h"
 
 namespace drape {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+// Rows per chunk of the derived-data passes on the workers (a chunk's work is a few microseconds
+// at the smallest; the chunking depends on the grid alone).
+constexpr int64_t kFinishRowGrain = 32;
 
 // `top` with its lowest mantissa bit equal to `has_gaps` (0 or 1): itself, or the next float up
 // (out of the body, above any gap), or down from the largest float. Without a branch on the
@@ -120,7 +124,7 @@ void BodyMapCollider::FinishAirReach() {
   constexpr int kCap = kSideExitTexels + 1;
   air_reach_.resize(static_cast<size_t>(w * h));
   uint8_t* reach = air_reach_.data();
-  for (int64_t j = 0; j < h; ++j) {
+  detail::ParallelFor(h, kFinishRowGrain, [&](int64_t j) {
     uint8_t* row = reach + j * w;
     const Slab* slab = slabs_.data() + j * w;
     int run = 0;  // texels since the last one with air (the grid's edge is one)
@@ -135,13 +139,15 @@ void BodyMapCollider::FinishAirReach() {
       run = row[i] == 0 ? 0 : std::min(run + 1, kCap);
       row[i] = static_cast<uint8_t>(std::min<int>(row[i], run));
     }
-  }
+  });
   // Then down each column over them, in strips of kStrip columns so that the loops run along
-  // the rows (a column walk strides a whole row per texel): each strip's rows above the current
-  // one keep their row distances in a small ring, as they are overwritten.
-  constexpr int64_t kStrip = 256;
+  // the rows (a column walk strides a whole row per texel) and the strips on separate workers:
+  // each strip's rows above the current one keep their row distances in a small ring, as they
+  // are overwritten.
+  constexpr int64_t kStrip = 64;
   static constexpr uint8_t kBeyond[kStrip] = {};  // rows beyond the grid: background, distance 0
-  for (int64_t i0 = 0; i0 < w; i0 += kStrip) {
+  detail::ParallelFor((w + kStrip - 1) / kStrip, 1, [&](int64_t strip) {
+    const int64_t i0 = strip * kStrip;
     const int64_t n = std::min(kStrip, w - i0);
     uint8_t above[kCap][kStrip];  // the row distances of rows j - 1 .. j - kCap + 1, by j % kCap
     for (int64_t j = 0; j < h; ++j) {
@@ -159,29 +165,55 @@ void BodyMapCollider::FinishAirReach() {
       std::copy(row, row + n, above[j % kCap]);
       std::copy(best, best + n, row);
     }
-  }
+  });
 }
 
 // Marks the texels with gaps in their slabs' tops (WithGapFlag: the lanes read the flag from the
 // slab they load anyway), counts the valid texels, and sets the bounds and the clip box.
 void BodyMapCollider::FinishBounds() {
   const size_t w = width_, h = height_;
-  uint32_t valid = 0;
-  size_t i_lo = w, i_hi = 0, j_lo = h, j_hi = 0;  // valid texel range, [lo, hi)
-  float z_lo = kInf, z_hi = -kInf;
-  for (size_t j = 0; j < h; ++j) {
-    for (size_t i = 0; i < w; ++i) {
-      Slab& s = slabs_[j * w + i];
-      if (!(s.top >= s.bottom)) continue;  // background: top -inf, no gaps, its low bit clear
-      if (gap_layers_ != 0) s.top = WithGapFlag(s.top, TexelHasGaps(j * w + i) ? 1u : 0u);
-      ++valid;
-      i_lo = std::min(i_lo, i);
-      i_hi = std::max(i_hi, i + 1);
-      j_lo = std::min(j_lo, j);
-      j_hi = std::max(j_hi, j + 1);
-      z_lo = std::min(z_lo, s.bottom);
-      z_hi = std::max(z_hi, s.top);
+  // Row chunks on the workers, each with its own counts and bounds, joined in chunk order: the
+  // same bits as one pass in row order (the first of equal z values kept, as std::min keeps it).
+  struct Partial {
+    uint32_t valid = 0;
+    size_t i_lo = SIZE_MAX, i_hi = 0, j_lo = SIZE_MAX, j_hi = 0;  // valid texel range, [lo, hi)
+    float z_lo = kInf, z_hi = -kInf;
+  };
+  constexpr int64_t kMaxChunks = 64;
+  const int64_t rows_per_chunk =
+      std::max<int64_t>(kFinishRowGrain, (static_cast<int64_t>(h) + kMaxChunks - 1) / kMaxChunks);
+  Partial partials[kMaxChunks];
+  detail::ParallelRanges(static_cast<int64_t>(h), rows_per_chunk, [&](int64_t begin, int64_t end) {
+    Partial& p = partials[begin / rows_per_chunk];
+    for (size_t j = static_cast<size_t>(begin); j < static_cast<size_t>(end); ++j) {
+      for (size_t i = 0; i < w; ++i) {
+        Slab& s = slabs_[j * w + i];
+        if (!(s.top >= s.bottom)) continue;  // background: top -inf, no gaps, its low bit clear
+        if (gap_layers_ != 0) s.top = WithGapFlag(s.top, TexelHasGaps(j * w + i) ? 1u : 0u);
+        ++p.valid;
+        p.i_lo = std::min(p.i_lo, i);
+        p.i_hi = std::max(p.i_hi, i + 1);
+        p.j_lo = std::min(p.j_lo, j);
+        p.j_hi = std::max(p.j_hi, j + 1);
+        p.z_lo = std::min(p.z_lo, s.bottom);
+        p.z_hi = std::max(p.z_hi, s.top);
+      }
     }
+  });
+  uint32_t valid = 0;
+  size_t i_lo = w, i_hi = 0, j_lo = h, j_hi = 0;
+  float z_lo = kInf, z_hi = -kInf;
+  const int64_t chunks = (static_cast<int64_t>(h) + rows_per_chunk - 1) / rows_per_chunk;
+  for (int64_t c = 0; c < chunks; ++c) {
+    const Partial& p = partials[c];
+    if (p.valid == 0) continue;
+    valid += p.valid;
+    i_lo = std::min(i_lo, p.i_lo);
+    i_hi = std::max(i_hi, p.i_hi);
+    j_lo = std::min(j_lo, p.j_lo);
+    j_hi = std::max(j_hi, p.j_hi);
+    z_lo = std::min(z_lo, p.z_lo);
+    z_hi = std::max(z_hi, p.z_hi);
   }
   stats_.valid_texels = valid;
   stats_.gap_texels = gap_layers_ == 0 ? 0u : static_cast<uint32_t>(gaps_.size() / gap_layers_);
@@ -260,28 +292,30 @@ void BodyMapCollider::FinishMinMaxBlocks() {
   blocks_w_ = static_cast<uint32_t>((w + kBlockTexels - 1) >> kBlockShift);
   blocks_h_ = static_cast<uint32_t>((h + kBlockTexels - 1) >> kBlockShift);
   blocks_.resize(static_cast<size_t>(blocks_w_) * blocks_h_);
-  for (size_t bj = 0; bj < blocks_h_; ++bj) {
-    for (size_t bi = 0; bi < blocks_w_; ++bi) {
-      const size_t i_begin = bi * kBlockTexels > 0 ? bi * kBlockTexels - 1 : 0;
-      const size_t j_begin = bj * kBlockTexels > 0 ? bj * kBlockTexels - 1 : 0;
-      const size_t i_end = std::min(w, (bi + 1) * kBlockTexels + 1);
-      const size_t j_end = std::min(h, (bj + 1) * kBlockTexels + 1);
-      float max_top = -kInf, min_bottom = kInf;
-      for (size_t j = j_begin; j < j_end; ++j) {
-        for (size_t i = i_begin; i < i_end; ++i) {
-          const Slab& c = slabs_[j * w + i];
-          if (!(c.top >= c.bottom)) continue;
-          max_top = std::max(max_top, c.top);
-          min_bottom = std::min(min_bottom, c.bottom);
-        }
-      }
-      if (max_top >= min_bottom) {
-        max_top += 1e-5f * (1.f + std::fabs(max_top));
-        min_bottom -= 1e-5f * (1.f + std::fabs(min_bottom));
-      }
-      blocks_[bj * blocks_w_ + bi] = {max_top, min_bottom};
-    }
-  }
+  detail::ParallelFor(blocks_h_, std::max<int64_t>(1, kFinishRowGrain / kBlockTexels),
+                      [&](int64_t block_row) {
+                        const size_t bj = static_cast<size_t>(block_row);
+                        for (size_t bi = 0; bi < blocks_w_; ++bi) {
+                          const size_t i_begin = bi * kBlockTexels > 0 ? bi * kBlockTexels - 1 : 0;
+                          const size_t j_begin = bj * kBlockTexels > 0 ? bj * kBlockTexels - 1 : 0;
+                          const size_t i_end = std::min(w, (bi + 1) * kBlockTexels + 1);
+                          const size_t j_end = std::min(h, (bj + 1) * kBlockTexels + 1);
+                          float max_top = -kInf, min_bottom = kInf;
+                          for (size_t j = j_begin; j < j_end; ++j) {
+                            for (size_t i = i_begin; i < i_end; ++i) {
+                              const Slab& c = slabs_[j * w + i];
+                              if (!(c.top >= c.bottom)) continue;
+                              max_top = std::max(max_top, c.top);
+                              min_bottom = std::min(min_bottom, c.bottom);
+                            }
+                          }
+                          if (max_top >= min_bottom) {
+                            max_top += 1e-5f * (1.f + std::fabs(max_top));
+                            min_bottom -= 1e-5f * (1.f + std::fabs(min_bottom));
+                          }
+                          blocks_[bj * blocks_w_ + bi] = {max_top, min_bottom};
+                        }
+                      });
 }
 
 InstructionSet BodyMapCollider::instruction_set() const {
