@@ -397,4 +397,8 @@ def following_maps(doc, gb, rows):
         cells = ([cell(by_kind.get("rest"))] + [rendered_cell(r) for r in rendered] +
                  [cell(by_kind.get("bones"))])
         doc.add(f"| {character} | " + " | ".join(cells) + " |")
-    doc.source("speed against error, posed bodies" + (f"; {p}" if costs else ""))
+    # A program re-run alone (--gbench-only) names its own commit on a line of its own.
+    alone = bool(CONTEXTS.get(p, {}).get("drape_commit"))
+    doc.source("speed against error, posed bodies" + (f"; {p}" if costs and not alone else ""))
+    if costs and alone:
+        source(doc, p)
