@@ -292,30 +292,30 @@ void BodyMapCollider::FinishMinMaxBlocks() {
   blocks_w_ = static_cast<uint32_t>((w + kBlockTexels - 1) >> kBlockShift);
   blocks_h_ = static_cast<uint32_t>((h + kBlockTexels - 1) >> kBlockShift);
   blocks_.resize(static_cast<size_t>(blocks_w_) * blocks_h_);
-  detail::ParallelFor(blocks_h_, std::max<int64_t>(1, kFinishRowGrain / kBlockTexels),
-                      [&](int64_t block_row) {
-                        const size_t bj = static_cast<size_t>(block_row);
-                        for (size_t bi = 0; bi < blocks_w_; ++bi) {
-                          const size_t i_begin = bi * kBlockTexels > 0 ? bi * kBlockTexels - 1 : 0;
-                          const size_t j_begin = bj * kBlockTexels > 0 ? bj * kBlockTexels - 1 : 0;
-                          const size_t i_end = std::min(w, (bi + 1) * kBlockTexels + 1);
-                          const size_t j_end = std::min(h, (bj + 1) * kBlockTexels + 1);
-                          float max_top = -kInf, min_bottom = kInf;
-                          for (size_t j = j_begin; j < j_end; ++j) {
-                            for (size_t i = i_begin; i < i_end; ++i) {
-                              const Slab& c = slabs_[j * w + i];
-                              if (!(c.top >= c.bottom)) continue;
-                              max_top = std::max(max_top, c.top);
-                              min_bottom = std::min(min_bottom, c.bottom);
-                            }
-                          }
-                          if (max_top >= min_bottom) {
-                            max_top += 1e-5f * (1.f + std::fabs(max_top));
-                            min_bottom -= 1e-5f * (1.f + std::fabs(min_bottom));
-                          }
-                          blocks_[bj * blocks_w_ + bi] = {max_top, min_bottom};
-                        }
-                      });
+  const auto block_row = [&](int64_t row) {  // every block of block row `row`
+    const size_t bj = static_cast<size_t>(row);
+    for (size_t bi = 0; bi < blocks_w_; ++bi) {
+      const size_t i_begin = bi * kBlockTexels > 0 ? bi * kBlockTexels - 1 : 0;
+      const size_t j_begin = bj * kBlockTexels > 0 ? bj * kBlockTexels - 1 : 0;
+      const size_t i_end = std::min(w, (bi + 1) * kBlockTexels + 1);
+      const size_t j_end = std::min(h, (bj + 1) * kBlockTexels + 1);
+      float max_top = -kInf, min_bottom = kInf;
+      for (size_t j = j_begin; j < j_end; ++j) {
+        for (size_t i = i_begin; i < i_end; ++i) {
+          const Slab& c = slabs_[j * w + i];
+          if (!(c.top >= c.bottom)) continue;
+          max_top = std::max(max_top, c.top);
+          min_bottom = std::min(min_bottom, c.bottom);
+        }
+      }
+      if (max_top >= min_bottom) {
+        max_top += 1e-5f * (1.f + std::fabs(max_top));
+        min_bottom -= 1e-5f * (1.f + std::fabs(min_bottom));
+      }
+      blocks_[bj * blocks_w_ + bi] = {max_top, min_bottom};
+    }
+  };
+  detail::ParallelFor(blocks_h_, std::max<int64_t>(1, kFinishRowGrain / kBlockTexels), block_row);
 }
 
 InstructionSet BodyMapCollider::instruction_set() const {

@@ -163,28 +163,27 @@ struct PlaneLanes {
     return count;
   }
 
+  // P::kCount consecutive Float3 as lanes; lanes at and beyond `lanes` repeat the first.
+  static void LoadGroup(const Float3* v, uint32_t lanes, F* x, F* y, F* z) {
+    if (lanes == static_cast<uint32_t>(P::kCount)) {
+      P::LoadFloat3s(v, x, y, z);
+      return;
+    }
+    const auto from = [lanes](int l) { return static_cast<uint32_t>(l) < lanes ? l : 0; };
+    *x = P::FromLanes([&](int l) { return v[from(l)].x; });
+    *y = P::FromLanes([&](int l) { return v[from(l)].y; });
+    *z = P::FromLanes([&](int l) { return v[from(l)].z; });
+  }
+
   static uint32_t SphereMasks(const Float3* p0, const Float3* p1, const Float3* velocity,
                               uint32_t lanes, const float* xs, const float* ys, const float* zs,
                               const float* rs, uint32_t total, Float3 union_center,
                               float union_radius, uint32_t* masks) {
     using I = typename P::I;
     F ax, ay, az, bx, by, bz, vx, vy, vz;
-    if (lanes == static_cast<uint32_t>(P::kCount)) {
-      P::LoadFloat3s(p0, &ax, &ay, &az);
-      P::LoadFloat3s(p1, &bx, &by, &bz);
-      P::LoadFloat3s(velocity, &vx, &vy, &vz);
-    } else {
-      const auto from = [lanes](int l) { return static_cast<uint32_t>(l) < lanes ? l : 0; };
-      ax = P::FromLanes([&](int l) { return p0[from(l)].x; });
-      ay = P::FromLanes([&](int l) { return p0[from(l)].y; });
-      az = P::FromLanes([&](int l) { return p0[from(l)].z; });
-      bx = P::FromLanes([&](int l) { return p1[from(l)].x; });
-      by = P::FromLanes([&](int l) { return p1[from(l)].y; });
-      bz = P::FromLanes([&](int l) { return p1[from(l)].z; });
-      vx = P::FromLanes([&](int l) { return velocity[from(l)].x; });
-      vy = P::FromLanes([&](int l) { return velocity[from(l)].y; });
-      vz = P::FromLanes([&](int l) { return velocity[from(l)].z; });
-    }
+    LoadGroup(p0, lanes, &ax, &ay, &az);
+    LoadGroup(p1, lanes, &bx, &by, &bz);
+    LoadGroup(velocity, lanes, &vx, &vy, &vz);
     // IsFinite's answer: x - x == 0 for every coordinate.
     const F zero = P::Zero();
     F finite = Equal(zero, zero);
@@ -245,18 +244,8 @@ struct PlaneLanes {
                        const Mat34* obb_end, const Float3* half, uint32_t hulls, uint32_t total,
                        bool continuous, uint32_t max_candidates, uint32_t* masks) {
     F ax, ay, az, bx, by, bz;
-    if (lanes == static_cast<uint32_t>(P::kCount)) {
-      P::LoadFloat3s(p0, &ax, &ay, &az);
-      P::LoadFloat3s(p1, &bx, &by, &bz);
-    } else {
-      const auto from = [lanes](int l) { return static_cast<uint32_t>(l) < lanes ? l : 0; };
-      ax = P::FromLanes([&](int l) { return p0[from(l)].x; });
-      ay = P::FromLanes([&](int l) { return p0[from(l)].y; });
-      az = P::FromLanes([&](int l) { return p0[from(l)].z; });
-      bx = P::FromLanes([&](int l) { return p1[from(l)].x; });
-      by = P::FromLanes([&](int l) { return p1[from(l)].y; });
-      bz = P::FromLanes([&](int l) { return p1[from(l)].z; });
-    }
+    LoadGroup(p0, lanes, &ax, &ay, &az);
+    LoadGroup(p1, lanes, &bx, &by, &bz);
     const uint32_t words = (total + 31) / 32;
     const auto hulls_in = [hulls](uint32_t w, uint32_t mask) {  // the hull bits of word w
       return hulls - 32 * w < 32 ? mask & ((1u << (hulls - 32 * w)) - 1u) : mask;
