@@ -354,15 +354,27 @@ def following_maps(doc, gb, rows):
         return
     costs = ""
     if p in gb:
-        render = {(region, t, x): value(gb, p, "BM_RenderMaps", (region, t, x), "real_time")
-                  for region in (0, 1) for t in (1, 2) for x in (1, 4)}
+        render = {(region, t, x, m): value(gb, p, "BM_RenderMaps", (region, t, x, m), "real_time")
+                  for region in (0, 1) for t in (1, 2) for x in (1, 4) for m in (0, 1, 2, 3)}
+        triangles = {m: value(gb, p, "BM_RenderMaps", (0, 1, 4, m), "triangles")
+                     for m in (0, 1, 2, 3)}
+        count = lambda v: "–" if v is None else f"{v:,.0f}".replace(",", " ")  # noqa: E731
         ms = lambda v: "–" if v is None else (f"{v:.1f}" if v >= 1.0 else f"{v:.2f}")  # noqa: E731
         costs = (f" `{p}` on the mannequin walking (7 584 triangles): rendering one pose's maps "
-                 f"at 1.7 mm texels takes {ms(render[(0, 1, 1)])} / {ms(render[(0, 2, 1)])} ms "
-                 f"for the whole body and {ms(render[(1, 1, 1)])} / {ms(render[(1, 2, 1)])} ms "
-                 "for a skirt's reach; at 7 mm texels (where the people meet the error targets "
-                 f"above) {ms(render[(0, 1, 4)])} / {ms(render[(0, 2, 4)])} ms and "
-                 f"{ms(render[(1, 1, 4)])} / {ms(render[(1, 2, 4)])} ms (1 / 2 threads); the "
+                 f"at 1.7 mm texels takes {ms(render[(0, 1, 1, 0)])} / "
+                 f"{ms(render[(0, 2, 1, 0)])} ms for the whole body and "
+                 f"{ms(render[(1, 1, 1, 0)])} / {ms(render[(1, 2, 1, 0)])} ms for a skirt's "
+                 "reach; at 7 mm texels (where the people meet the error targets above) "
+                 f"{ms(render[(0, 1, 4, 0)])} / {ms(render[(0, 2, 4, 0)])} ms and "
+                 f"{ms(render[(1, 1, 4, 0)])} / {ms(render[(1, 2, 4, 0)])} ms (1 / 2 threads). "
+                 f"From the render mesh a default bake stores ({count(triangles[1])} "
+                 "triangles, within 1 mm): the whole body at 7 mm "
+                 f"{ms(render[(0, 1, 4, 1)])} / {ms(render[(0, 2, 4, 1)])} ms, the skirt's reach "
+                 f"{ms(render[(1, 1, 4, 1)])} / {ms(render[(1, 2, 4, 1)])} ms. The mannequin "
+                 f"subdivided to {count(triangles[2])} triangles (a dense game character) takes "
+                 f"{ms(render[(0, 1, 4, 2)])} / {ms(render[(0, 2, 4, 2)])} ms at 7 mm, from its "
+                 f"render mesh ({count(triangles[3])} triangles) {ms(render[(0, 1, 4, 3)])} / "
+                 f"{ms(render[(0, 2, 4, 3)])} ms. The "
                  "batch of 10k particles near the body costs "
                  f"{ns(value(gb, p, 'BM_RenderedMapsBatch', (1,)))} / "
                  f"{ns(value(gb, p, 'BM_RenderedMapsBatch', (2,)))} ns per particle on the "
@@ -371,7 +383,9 @@ def following_maps(doc, gb, rows):
     doc.add("## Maps that follow any pose", "",
             "At each character's first measured pose (a clip time between keys, which no default "
             "bake holds): missed % / penetration p99 mm / ns per particle (1 thread). Rendered: "
-            "`BodyMapRenderer`, whole body, at the rest maps' texel (N = 1024 over the body) and "
+            "`BodyMapRenderer`, whole body, from the render mesh a default bake stores (the bind "
+            "mesh simplified to within 1 mm; `maps.render_tolerance`), at the rest maps' texel "
+            "(N = 1024 over the body) and "
             "at 2x and 4x it; its cells give missed % / penetration p99 mm / ms to render the "
             "pose (1 thread) / texel mm. Bone maps: `BoneMapCollider` at the automatic texel (the "
             "rest pose's size / 600), 3 layers." + costs, "",

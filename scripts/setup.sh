@@ -9,7 +9,7 @@ profile=${1:-all}
 runtime_packages=(g++ cmake make pkg-config libcereal-dev libgtest-dev libgmock-dev)
 bake_packages=(libassimp-dev libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libosmesa6-dev
   nlohmann-json3-dev libcli11-dev libstb-dev libbenchmark-dev ccache clang libclang-rt-14-dev
-  libfcl-dev libbullet-dev gnuplot-nox python3 ninja-build libtinygltf-dev)
+  libfcl-dev libbullet-dev gnuplot-nox python3 ninja-build libtinygltf-dev libmeshoptimizer-dev)
 # node and npm from Debian unless some node is installed already (e.g. NodeSource's, which
 # bundles npm and conflicts with Debian's npm package).
 command -v npm >/dev/null || bake_packages+=(nodejs npm)

@@ -1,8 +1,8 @@
 // drape-diff A.drape B.drape [--tolerance FILE.json] [--json]
-// Compares two assets by meaning, for golden files: the skeleton and clips, the bind mesh, per
-// hull its planes (normal angle, offset), vertices and OBB, per joint sphere its centre and
-// radius, per body-map pose the texel depths (p99 and max) and coverage. Prints one line per
-// difference ("hull 'spine_02': 3 planes moved up to 1.4 mm") and whether they are within the
+// Compares two assets by meaning, for golden files: the skeleton and clips, the bind mesh and the
+// render mesh, per hull its planes (normal angle, offset), vertices and OBB, per joint sphere its
+// centre and radius, per body-map pose the texel depths (p99 and max) and coverage. Prints one line
+// per difference ("hull 'spine_02': 3 planes moved up to 1.4 mm") and whether they are within the
 // tolerance. Exit 0: within; 1: beyond; 2: a file could not be read or the arguments are wrong.
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -30,7 +30,7 @@ struct Tolerance {
   double joint_mm = 0.01;          // inverse bind and rest translations
   double joint_deg = 0.01;         // rest rotations, clip key rotations
   double clip_mm = 0.01;           // clip key translations
-  double mesh_mm = 0.01;           // bind mesh positions
+  double mesh_mm = 0.01;           // bind mesh and render mesh positions
   double plane_deg = 0.01;         // hull plane normals
   double plane_mm = 0.01;          // hull plane offsets
   double vertex_mm = 0.01;         // hull vertices
@@ -142,16 +142,18 @@ void CompareClips(const CharacterAsset& a, const CharacterAsset& b, Report* r) {
   }
 }
 
-void CompareMesh(const CharacterAsset& a, const CharacterAsset& b, Report* r) {
-  if (a.mesh.positions.size() != b.mesh.positions.size() || a.mesh.triangles != b.mesh.triangles) {
-    r->Structural("mesh: " + std::to_string(a.mesh.positions.size()) + " vs " +
-                  std::to_string(b.mesh.positions.size()) + " vertices, or other triangles");
+// `name`: "mesh" or "render_mesh".
+void CompareMesh(const std::string& name, const drape::MeshData& a, const drape::MeshData& b,
+                 Report* r) {
+  if (a.positions.size() != b.positions.size() || a.triangles != b.triangles) {
+    r->Structural(name + ": " + std::to_string(a.positions.size()) + " vs " +
+                  std::to_string(b.positions.size()) + " vertices, or other triangles");
     return;
   }
   double mm = 0.0;
-  for (size_t v = 0; v < a.mesh.positions.size(); ++v)
-    mm = std::max(mm, Mm(Distance(a.mesh.positions[v], b.mesh.positions[v])));
-  r->Measured("mesh: vertices moved", mm, r->tolerance.mesh_mm, "mm");
+  for (size_t v = 0; v < a.positions.size(); ++v)
+    mm = std::max(mm, Mm(Distance(a.positions[v], b.positions[v])));
+  r->Measured(name + ": vertices moved", mm, r->tolerance.mesh_mm, "mm");
 }
 
 // "hull 'chest'", "hull 'chest' #2" for a bone's second piece.
@@ -451,7 +453,8 @@ int main(int argc, char** argv) {
   Report report(tolerance);
   CompareSkeleton(a, b, &report);
   CompareClips(a, b, &report);
-  CompareMesh(a, b, &report);
+  CompareMesh("mesh", a.mesh, b.mesh, &report);
+  CompareMesh("render_mesh", a.render_mesh, b.render_mesh, &report);
   CompareColliders(a, b, &report);
   CompareBodyMaps(a, b, &report);
   Print(report, path_a, path_b, as_json);

@@ -1,12 +1,16 @@
 // The body maps that follow any pose, on the mannequin (samples/mannequin) at its walk clip
 // between keys: the cost of rendering the maps of a pose, and of the per-bone local maps' batch.
 //
-//  BM_RenderMaps/<region>/<threads>/<texel>
+//  BM_RenderMaps/<region>/<threads>/<texel>/<mesh>
 //                                     BodyMapRenderer::Render at the rest maps' texel (N = 1024
 //                                     over the body: 1.7 mm) times <texel> (4: 7 mm, where the
 //                                     people meet the error targets in drape-speed-vs-error);
 //                                     region 0: the whole body, 1: a skirt's reach (hips to
-//                                     knees, 0.6 x 0.7 x 0.6 m). Reported: ms per pose
+//                                     knees, 0.6 x 0.7 x 0.6 m); mesh 0: the bind mesh (7 584
+//                                     triangles), 1: its render mesh (SimplifyRenderMesh at the
+//                                     bake's default tolerance), 2: the mannequin subdivided
+//                                     (30 336 triangles, a dense game character), 3: that one's
+//                                     render mesh. Reported: ms per pose, triangles drawn
 //  BM_BoneMapsBatch/<threads>         BoneMapCollider::CollideBatch (SetPose included) on 10k
 //                                     particles within 2 cm of the posed surface moving 5 mm;
 //                                     ns_per_particle
@@ -17,12 +21,17 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <map>
 #include <random>
 #include <vector>
 
+#include "drape/bake/bake_config.h"
 #include "drape/bake/bone_map_baker.h"
 #include "drape/bake/importer.h"
+#include "drape/bake/render_mesh.h"
 #include "drape/runtime/body_map_renderer.h"
 #include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/skeleton_pose.h"
@@ -33,8 +42,49 @@
 namespace drape {
 namespace {
 
+// Each triangle into four at its edges' midpoints; a midpoint takes the mean of its ends'
+// influences, so it skins between them.
+MeshData Subdivided(const MeshData& mesh) {
+  MeshData out = mesh;
+  out.triangles.clear();
+  std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
+  const auto midpoint = [&](uint32_t a, uint32_t b) {
+    const auto key = std::minmax(a, b);
+    const auto [it, added] = midpoints.try_emplace(key, out.vertex_count());
+    if (!added) return it->second;
+    out.positions.push_back((mesh.positions[a] + mesh.positions[b]) * 0.5f);
+    std::map<uint16_t, float> weights;
+    for (const uint32_t v : {a, b}) {
+      for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k)
+        weights[mesh.influence_joints[k]] += 0.5f * mesh.influence_weights[k];
+    }
+    for (const auto& [joint, weight] : weights) {
+      out.influence_joints.push_back(joint);
+      out.influence_weights.push_back(weight);
+    }
+    out.influence_offsets.push_back(static_cast<uint32_t>(out.influence_joints.size()));
+    return it->second;
+  };
+  for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+    const uint32_t a = mesh.triangles[t], b = mesh.triangles[t + 1], c = mesh.triangles[t + 2];
+    const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+    out.triangles.insert(out.triangles.end(), {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca});
+  }
+  return out;
+}
+
+// The render mesh a default bake stores for `mesh`, or `mesh` when it keeps none.
+MeshData RenderMesh(const MeshData& mesh) {
+  MeshData out;
+  bake::RenderMeshReport report;
+  if (!bake::SimplifyRenderMesh(mesh, bake::BakeConfig{}.maps_render_tolerance, &out, &report).ok())
+    std::abort();
+  return report.kept ? out : mesh;
+}
+
 struct Scene {
   bake::Character character;
+  MeshData meshes[4];           // BM_RenderMaps' <mesh>: bind, render, subdivided, its render mesh
   std::vector<Mat34> skinning;  // the walk between keys
   BoneMapSet bone_maps;
   float texel = 0.f;  // metres: the N = 1024 rest maps' texel
@@ -58,6 +108,10 @@ const Scene& TheScene() {
                             &s.bone_maps)
              .ok())
       std::abort();
+    s.meshes[0] = s.character.mesh;
+    s.meshes[1] = RenderMesh(s.meshes[0]);
+    s.meshes[2] = Subdivided(s.meshes[0]);
+    s.meshes[3] = RenderMesh(s.meshes[2]);
     float height = 0.f;
     for (const Float3& p : rest) height = std::max(height, p.y);
     s.texel = height / 1024.f;
@@ -102,7 +156,7 @@ void BM_RenderMaps(benchmark::State& state) {
   BodyMapRenderOptions options;
   options.texel_size = s.texel * static_cast<float>(state.range(2));
   BodyMapRenderer renderer;
-  if (!renderer.Init(s.character.mesh, options).ok()) state.SkipWithError("init");
+  if (!renderer.Init(s.meshes[state.range(3)], options).ok()) state.SkipWithError("init");
   BodyMapCollider maps;
   const RenderRegion region = Region(static_cast<int>(state.range(0)));
   for (auto _ : state) {
@@ -110,12 +164,14 @@ void BM_RenderMaps(benchmark::State& state) {
     benchmark::DoNotOptimize(maps.stats().valid_texels);
   }
   state.counters["texels"] = static_cast<double>(renderer.stats().width) * renderer.stats().height;
+  state.counters["triangles"] = static_cast<double>(s.meshes[state.range(3)].triangle_count());
   state.counters["ms_per_pose"] =
       benchmark::Counter(1e-3 * static_cast<double>(state.iterations()),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_RenderMaps)
-    ->ArgsProduct({{0, 1}, {1, 2}, {1, 4}})
+    ->ArgsProduct({{0, 1}, {1, 2}, {1, 4}, {0, 1}})
+    ->ArgsProduct({{0}, {1, 2}, {4}, {2, 3}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

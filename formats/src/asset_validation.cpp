@@ -155,22 +155,23 @@ void CheckClip(const ClipData& clip, size_t index, size_t joints, Checker& c) {
   }
 }
 
-void CheckMesh(const MeshData& m, size_t joints, Checker& c) {
+// `name`: the field's name in messages ("mesh", "render_mesh").
+void CheckMesh(const MeshData& m, size_t joints, const std::string& name, Checker& c) {
   const size_t v = m.positions.size();
-  if (!c.Require(m.triangles.size() % 3 == 0, "mesh.triangles", "size is not a multiple of 3"))
+  if (!c.Require(m.triangles.size() % 3 == 0, name + ".triangles", "size is not a multiple of 3"))
     return;
   for (size_t i = 0; i < v; ++i)
     if (!IsFinite(m.positions[i]) &&
-        !c.Finite(m.positions[i], "mesh.positions[" + std::to_string(i) + "]"))
+        !c.Finite(m.positions[i], name + ".positions[" + std::to_string(i) + "]"))
       return;
   for (size_t i = 0; i < m.triangles.size(); ++i)
     if (m.triangles[i] >= v && !c.Index(m.triangles[i], static_cast<int64_t>(v),
-                                        "mesh.triangles[" + std::to_string(i) + "]"))
+                                        name + ".triangles[" + std::to_string(i) + "]"))
       return;
   if (m.influence_offsets.empty() && m.influence_joints.empty() && m.influence_weights.empty())
     return;
-  if (!c.Offsets(m.influence_offsets, v, m.influence_joints.size(), "mesh.influence_offsets") ||
-      !c.Size(m.influence_weights.size(), m.influence_joints.size(), "mesh.influence_weights"))
+  if (!c.Offsets(m.influence_offsets, v, m.influence_joints.size(), name + ".influence_offsets") ||
+      !c.Size(m.influence_weights.size(), m.influence_joints.size(), name + ".influence_weights"))
     return;
   for (size_t i = 0; i < m.influence_joints.size(); ++i) {
     const float w = m.influence_weights[i];
@@ -178,10 +179,10 @@ void CheckMesh(const MeshData& m, size_t joints, Checker& c) {
       continue;
     const std::string at = "[" + std::to_string(i) + "]";
     if (!c.Index(m.influence_joints[i], static_cast<int64_t>(joints),
-                 "mesh.influence_joints" + at) ||
+                 name + ".influence_joints" + at) ||
         !c.Require(std::isfinite(m.influence_weights[i]) && m.influence_weights[i] >= 0.f &&
                        m.influence_weights[i] <= 1.f + 1e-4f,
-                   "mesh.influence_weights" + at, "is not in [0, 1]"))
+                   name + ".influence_weights" + at, "is not in [0, 1]"))
       return;
   }
 }
@@ -454,7 +455,13 @@ Status ValidateAsset(const CharacterAsset& asset) {
   const size_t joints = asset.skeleton.parents.size();
   for (size_t i = 0; i < asset.clips.size() && !c.failed(); ++i)
     CheckClip(asset.clips[i], i, joints, c);
-  if (!c.failed()) CheckMesh(asset.mesh, joints, c);
+  if (!c.failed()) CheckMesh(asset.mesh, joints, "mesh", c);
+  // The render mesh's vertices are the bind mesh's (a subset), skinned the same way.
+  if (!c.failed() && !asset.render_mesh.positions.empty()) {
+    CheckMesh(asset.render_mesh, joints, "render_mesh", c);
+    c.Require(asset.render_mesh.influence_offsets.empty() == asset.mesh.influence_offsets.empty(),
+              "render_mesh.influence_offsets", "is empty where mesh's is not, or the reverse");
+  }
   if (!c.failed()) CheckBodyMaps(asset.body_maps, asset.clips.size(), c);
   if (!c.failed()) CheckBoneMaps(asset.bone_maps, asset.clips.size(), joints, c);
   for (size_t i = 0; i < asset.hulls.size() && !c.failed(); ++i)

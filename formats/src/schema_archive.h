@@ -384,7 +384,7 @@ void serialize(Archive& ar, CapsuleColliderData& c, const uint32_t version) {
 
 template <class Archive>
 void serialize(Archive& ar, CharacterAsset& a, const uint32_t version) {
-  detail::CheckVersionRange(version, 1, 3, "CharacterAsset");
+  detail::CheckVersionRange(version, 1, 4, "CharacterAsset");
   ar(cereal::make_nvp("info", a.info), cereal::make_nvp("skeleton", a.skeleton));
   Array(ar, "clips", a.clips);
   ar(cereal::make_nvp("mesh", a.mesh), cereal::make_nvp("body_maps", a.body_maps));
@@ -411,6 +411,16 @@ void serialize(Archive& ar, CharacterAsset& a, const uint32_t version) {
     }
   }
   Array(ar, "capsules", a.capsules);
+  if (version < 4) return;
+  // Version 4 (the render mesh, at the end) from format version 8 on.
+  if constexpr (Archive::is_loading::value) {
+    if (detail::g_format_version != 0 && detail::g_format_version < 8) {
+      throw DecodeError("CharacterAsset version " + std::to_string(version) +
+                        " in a format version " + std::to_string(detail::g_format_version) +
+                        " file");
+    }
+  }
+  ar(cereal::make_nvp("render_mesh", a.render_mesh));
 }
 
 }  // namespace drape
@@ -429,4 +439,5 @@ CEREAL_CLASS_VERSION(drape::MapTableData, 1)
 CEREAL_CLASS_VERSION(drape::HullColliderData, 2)
 CEREAL_CLASS_VERSION(drape::JointSphereData, 1)
 CEREAL_CLASS_VERSION(drape::CapsuleColliderData, 1)
-CEREAL_CLASS_VERSION(drape::CharacterAsset, 3)  // 2: bone_maps (format 5); 3: capsules (format 6)
+// 2: bone_maps (format 5); 3: capsules (format 6); 4: render_mesh (format 8)
+CEREAL_CLASS_VERSION(drape::CharacterAsset, 4)

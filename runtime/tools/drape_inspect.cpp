@@ -154,6 +154,8 @@ std::string JsonSummary(const drape::CharacterAsset& a, const Placement& place,
   o << "],\n  \"mesh\": {\"vertices\": " << a.mesh.vertex_count()
     << ", \"triangles\": " << a.mesh.triangle_count()
     << ", \"influences\": " << a.mesh.influence_joints.size()
+    << "},\n  \"render_mesh\": {\"vertices\": " << a.render_mesh.vertex_count()
+    << ", \"triangles\": " << a.render_mesh.triangle_count()
     << "},\n  \"body_maps\": {\"epsilon\": " << a.body_maps.epsilon
     << ", \"resolution\": " << a.body_maps.resolution << ", \"poses\": [";
   for (size_t p = 0; p < a.body_maps.poses.size(); ++p) {
@@ -226,6 +228,12 @@ void PrintText(const drape::CharacterAsset& a, const Placement& place, const std
   }
   std::printf("  mesh: %u vertices, %u triangles, %zu influences\n", a.mesh.vertex_count(),
               a.mesh.triangle_count(), a.mesh.influence_joints.size());
+  if (a.render_mesh.positions.empty()) {
+    std::printf("  render mesh: none (body maps are rendered from the mesh)\n");
+  } else {
+    std::printf("  render mesh: %u vertices, %u triangles\n", a.render_mesh.vertex_count(),
+                a.render_mesh.triangle_count());
+  }
   std::printf("  body maps: %zu poses (epsilon %.1f mm)\n", a.body_maps.poses.size(),
               a.body_maps.epsilon * 1000.f);
   for (const auto& pose : a.body_maps.poses) {

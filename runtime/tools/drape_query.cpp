@@ -179,7 +179,7 @@ drape::Status PoseMaps(const drape::CharacterAsset& asset, const drape::Skeleton
     options.view_axis = baked.view_axis;
   }
   drape::BodyMapRenderer renderer;
-  if (drape::Status s = renderer.Init(asset.mesh, options); !s.ok()) return s;
+  if (drape::Status s = renderer.Init(drape::RenderMeshOf(asset), options); !s.ok()) return s;
   *rendered = true;
   return renderer.Render(pose.skinning(), maps);
 }

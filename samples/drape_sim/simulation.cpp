@@ -331,7 +331,7 @@ Status SceneSimulation::InitRenderedMaps(const CharacterAsset& asset) {
   options.grid_y = rest.origin_y;
   options.view_axis = rest.view_axis;
   options.sampling = scene_->maps_sampling;
-  if (Status s = renderer_.Init(asset.mesh, options); !s.ok())
+  if (Status s = renderer_.Init(RenderMeshOf(asset), options); !s.ok())
     return Status(s.code(), where + "rendered maps: " + s.message());
   renders_maps_ = true;
   return Status::Ok();

@@ -18,7 +18,8 @@ TEST(BakeConfig, FloatsAtTheirBoundsRoundTrip) {
   BakeConfig config;
   const nlohmann::json bounds = {
       {"hulls", {{"delta", 0.1}, {"max_growth", 1.0}}},
-      {"maps", {{"epsilon", 0.1}, {"margin", 1.0}, {"clip_rate", 1000.0}}},
+      {"maps",
+       {{"epsilon", 0.1}, {"margin", 1.0}, {"clip_rate", 1000.0}, {"render_tolerance", 0.1}}},
       {"spheres", {{"delta", 0.1}}}};
   const Status first = ApplyBakeConfig(bounds, "bounds.json", &config);
   ASSERT_TRUE(first.ok()) << first.message();
@@ -177,6 +178,17 @@ TEST(BakeConfig, MapsViewAxisAndMaxError) {
   EXPECT_EQ(s.message().rfind("c.json: /maps/max_error: ", 0), 0u) << s.message();
   EXPECT_EQ(config.maps_view_axis, BakeConfig::MapViewAxis::kY) << "refused: nothing changes";
   EXPECT_EQ(config.maps_max_error_mm, 1.5f);
+}
+
+TEST(BakeConfig, MapsRenderTolerance) {
+  BakeConfig config;
+  EXPECT_EQ(config.maps_render_tolerance, 0.001f) << "1 mm by default";
+  ASSERT_TRUE(ApplyBakeConfig({{"maps", {{"render_tolerance", 0}}}}, "c.json", &config).ok());
+  EXPECT_EQ(config.maps_render_tolerance, 0.f) << "0: no render mesh";
+  const Status s = ApplyBakeConfig({{"maps", {{"render_tolerance", 0.5}}}}, "c.json", &config);
+  EXPECT_EQ(s.message(),
+            "c.json: /maps/render_tolerance: 0.5 is out of range: must be in [0, 0.1]");
+  EXPECT_EQ(config.maps_render_tolerance, 0.f) << "refused: nothing changes";
 }
 
 TEST(NameSuggestions, IgnoreCaseAndThePrefixEveryNameShares) {

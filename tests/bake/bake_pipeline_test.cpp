@@ -397,6 +397,34 @@ TEST(BakePipeline, ReportCarriesTheContractFields) {
        {"resolution", "texel_size_mm", "coverage", "bytes", "render_ms_front", "renderer"}) {
     EXPECT_TRUE(pose.contains(field)) << field;
   }
+  // The render mesh: kept, what it kept and how far it moved the surface, in the asset.
+  const auto& render_mesh = r["body_maps"]["render_mesh"];
+  for (const char* field :
+       {"kept", "triangles", "vertices", "of_triangles", "error_mm", "tolerance_mm", "attempts"}) {
+    EXPECT_TRUE(render_mesh.contains(field)) << field;
+  }
+  EXPECT_TRUE(render_mesh["kept"].get<bool>());
+  EXPECT_LE(render_mesh["error_mm"].get<double>(), render_mesh["tolerance_mm"].get<double>());
+  EXPECT_EQ(render_mesh["triangles"].get<uint32_t>(), result.asset.render_mesh.triangle_count());
+  EXPECT_LT(result.asset.render_mesh.triangle_count(), result.asset.mesh.triangle_count());
+  EXPECT_EQ(&RenderMeshOf(result.asset), &result.asset.render_mesh);
+  EXPECT_TRUE(r["timings"].contains("render_mesh_ms"));
+}
+
+// maps.render_tolerance 0: no render mesh (the renderer draws the bind mesh); no maps, none either.
+TEST(BakePipeline, RenderToleranceZeroKeepsNoRenderMesh) {
+  for (const bool maps : {true, false}) {
+    BakeConfig config;
+    config.hulls_enabled = false;
+    config.maps_enabled = maps;
+    config.maps_render_tolerance = maps ? 0.f : config.maps_render_tolerance;
+    BakeResult result;
+    ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &result).ok());
+    EXPECT_TRUE(result.asset.render_mesh.positions.empty()) << maps;
+    EXPECT_EQ(&RenderMeshOf(result.asset), &result.asset.mesh);
+    EXPECT_FALSE(result.report.contains("body_maps") &&
+                 result.report["body_maps"].contains("render_mesh"));
+  }
 }
 
 // maps.max_error: the cheapest setting within the budget, every setting tried before it over

@@ -39,21 +39,70 @@ TEST(AssetFile, NewerAndOlderFormatVersionsAreRefusedByName) {
 TEST(AssetFile, UnknownTypeVersionIsRefusedByTypeName) {
   std::vector<uint8_t> bytes = Encode(SmallAsset());
   // Payload: 1 byte of cereal endianness, then CharacterAsset's uint32 class version.
-  ASSERT_EQ(bytes[kAssetHeaderSize + 1], 3);
-  bytes[kAssetHeaderSize + 1] = 4;
+  ASSERT_EQ(bytes[kAssetHeaderSize + 1], 4);
+  bytes[kAssetHeaderSize + 1] = 5;
   FixChecksums(bytes);
   CharacterAsset out;
   const Status s = DecodeAsset(bytes, "t.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_NE(s.message().find("unsupported version 4 of CharacterAsset"), std::string::npos)
+  EXPECT_NE(s.message().find("unsupported version 5 of CharacterAsset"), std::string::npos)
       << s.message();
 }
+
+// Bytes of an empty render mesh at the end of a format 8 payload: its five arrays' counts (its
+// class version went out with the bind mesh).
+constexpr size_t kEmptyRenderMesh = 5 * 8;
 
 // Sets the payload size of the header after bytes were cut off the end, and the checksums.
 void FixPayloadSize(std::vector<uint8_t>& bytes) {
   const uint64_t payload = bytes.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   FixChecksums(bytes);
+}
+
+// The render mesh arrived with format version 8 (CharacterAsset class version 4): a version 4
+// asset under an older header is refused naming both, the older class version reads without it,
+// and the validator names a bad one by its field.
+TEST(AssetFile, RenderMeshNeedsFormatVersion8) {
+  CharacterAsset small = SmallAsset();
+  small.render_mesh = small.mesh;
+  small.render_mesh.triangles.resize(9);  // three of the tetrahedron's four faces
+  std::vector<uint8_t> bytes = Encode(small);
+  CharacterAsset out;
+  ASSERT_TRUE(DecodeAsset(bytes, "v8.drape", &out).ok());
+  EXPECT_EQ(out.render_mesh.triangles, small.render_mesh.triangles);
+  EXPECT_EQ(&RenderMeshOf(out), &out.render_mesh);
+  bytes[8] = 7;
+  FixChecksums(bytes);
+  Status s = DecodeAsset(bytes, "v7.drape", &out);
+  EXPECT_EQ(s.code(), StatusCode::kCorrupt);
+  EXPECT_EQ(s.message(), "v7.drape: CharacterAsset version 4 in a format version 7 file");
+  // As format 7 wrote it: class version 3, no render mesh at the end.
+  small.render_mesh = MeshData{};
+  bytes = Encode(small);
+  bytes[8] = 7;
+  bytes[kAssetHeaderSize + 1] = 3;
+  bytes.resize(bytes.size() - kEmptyRenderMesh);
+  FixPayloadSize(bytes);
+  s = DecodeAsset(bytes, "v7.drape", &out);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(AssetToJson(out), AssetToJson(small));
+  EXPECT_EQ(&RenderMeshOf(out), &out.mesh);  // none: the bind mesh is drawn
+  // Render meshes the validator refuses, named by their field.
+  small.render_mesh = small.mesh;
+  small.render_mesh.triangles[4] = 9;
+  s = EncodeAsset(small, &bytes);
+  EXPECT_NE(s.message().find("render_mesh.triangles[4] = 9"), std::string::npos) << s.message();
+  small.render_mesh = small.mesh;
+  small.render_mesh.influence_joints[1] = 42;
+  s = EncodeAsset(small, &bytes);
+  EXPECT_NE(s.message().find("render_mesh.influence_joints[1]"), std::string::npos) << s.message();
+  small.render_mesh = small.mesh;
+  small.render_mesh.influence_offsets.clear();
+  small.render_mesh.influence_joints.clear();
+  small.render_mesh.influence_weights.clear();
+  s = EncodeAsset(small, &bytes);
+  EXPECT_NE(s.message().find("render_mesh.influence_offsets"), std::string::npos) << s.message();
 }
 
 // Capsules arrived with format version 6 (CharacterAsset class version 3): a version 3 asset
@@ -71,14 +120,14 @@ TEST(AssetFile, CapsulesNeedFormatVersion6) {
   FixChecksums(bytes);
   Status s = DecodeAsset(bytes, "v5.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_EQ(s.message(), "v5.drape: CharacterAsset version 3 in a format version 5 file");
-  // As format 5 wrote it: class version 2, no capsules at the end (a count and one capsule:
-  // 8 + 4 + 4 * 8 bytes, the class version of its element type included).
+  EXPECT_EQ(s.message(), "v5.drape: CharacterAsset version 4 in a format version 5 file");
+  // As format 5 wrote it: class version 2, no capsules and no render mesh at the end (the
+  // capsules' empty array: 8 bytes; the empty render mesh's five arrays: 5 * 8).
   small.capsules.clear();
   bytes = Encode(small);
   bytes[8] = 5;
   bytes[kAssetHeaderSize + 1] = 2;
-  bytes.resize(bytes.size() - 8);
+  bytes.resize(bytes.size() - 8 - kEmptyRenderMesh);
   FixPayloadSize(bytes);
   s = DecodeAsset(bytes, "v5.drape", &out);
   ASSERT_TRUE(s.ok()) << s.message();
@@ -103,11 +152,11 @@ TEST(AssetFile, BoneMapsNeedFormatVersion5) {
   CharacterAsset out;
   Status s = DecodeAsset(bytes, "v4.drape", &out);
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
-  EXPECT_EQ(s.message(), "v4.drape: CharacterAsset version 3 in a format version 4 file");
+  EXPECT_EQ(s.message(), "v4.drape: CharacterAsset version 4 in a format version 4 file");
   // As format 4 wrote it: class version 1, no bone-map set and no capsules at the end (epsilon
   // and an empty array: 4 + 4 + 8 bytes; the capsules' empty array: 8).
   bytes[kAssetHeaderSize + 1] = 1;
-  bytes.resize(bytes.size() - 16 - 8);
+  bytes.resize(bytes.size() - 16 - 8 - kEmptyRenderMesh);
   const uint64_t payload = bytes.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   FixChecksums(bytes);
@@ -199,10 +248,13 @@ TEST(BodyMapViewAxis, ArrivedWithFormatVersion7) {
   EXPECT_EQ(s.code(), StatusCode::kCorrupt);
   EXPECT_EQ(s.message(),
             "axis.drape: body_maps.poses[0].view_axis = 3 is not 0 (z), 1 (x) or 2 (y)");
-  // As format 6 wrote it: class version 3, no axis byte; it reads as z.
+  // As format 6 wrote it: pose class version 3, no axis byte (it reads as z); CharacterAsset
+  // class version 3, no render mesh.
   std::vector<uint8_t> v6 = bytes;
   v6[PoseStart(v6)] = 3;
   v6.erase(v6.begin() + static_cast<std::ptrdiff_t>(axis_at));
+  v6[kAssetHeaderSize + 1] = 3;
+  v6.resize(v6.size() - kEmptyRenderMesh);
   const uint64_t payload = v6.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) v6[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   v6[8] = 6;
@@ -261,7 +313,7 @@ TEST(BodyMapLayers, AFormatHoldsExactlyItsOwnPoseVersion) {
   // As format 2 wrote it: CharacterAsset class version 1, without the bone-map set at the end
   // (its class version, epsilon and an empty array: 16 bytes) and the capsules' empty array (8).
   bytes[kAssetHeaderSize + 1] = 1;
-  bytes.resize(bytes.size() - 16 - 8);
+  bytes.resize(bytes.size() - 16 - 8 - kEmptyRenderMesh);
   const uint64_t payload = bytes.size() - kAssetHeaderSize;
   for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<uint8_t>(payload >> (8 * i));
   bytes[8] = 2;

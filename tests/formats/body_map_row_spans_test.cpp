@@ -63,9 +63,9 @@ TEST(BodyMapLayout, RoundTripKeepsBothLayouts) {
   EXPECT_EQ(spans.depth_f32[0], a.body_maps.poses[1].depth_f32[0]);
   EXPECT_EQ(spans.normal_rgb8[1], a.body_maps.poses[1].normal_rgb8[1]);
   EXPECT_EQ(Encode(b), bytes);
-  // The writer writes format version 7 (BodyMapPose class version 4, one layer here).
-  EXPECT_EQ(bytes[8], 7);
-  EXPECT_EQ(kAssetFormatVersion, 7u);
+  // The writer writes format version 8 (BodyMapPose class version 4, one layer here).
+  EXPECT_EQ(bytes[8], 8);
+  EXPECT_EQ(kAssetFormatVersion, 8u);
   EXPECT_EQ(spans.layers, 1);
 }
 

@@ -63,6 +63,10 @@ const JsonSchema<BakeConfig>& MapsSection() {
                  [](BakeConfig& c) -> float& { return c.maps.epsilon; })
           .Float("margin", "m", Closed(0, 1), "camera box enlargement beyond the offset surface",
                  [](BakeConfig& c) -> float& { return c.maps.margin; })
+          .Float("render_tolerance", "m", Closed(0, 0.1),
+                 "the asset's render mesh (the bind mesh simplified for drawing body maps at run "
+                 "time) stays within this distance of the bind mesh, measured; 0: no render mesh",
+                 [](BakeConfig& c) -> float& { return c.maps_render_tolerance; })
           .Enum<DepthEncoding>(
               "depth_encoding",
               {{"float32", DepthEncoding::kFloat32}, {"unorm16", DepthEncoding::kUnorm16}},

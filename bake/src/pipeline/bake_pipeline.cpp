@@ -14,6 +14,7 @@
 #include "drape/bake/importer.h"
 #include "drape/bake/mesh_reference.h"
 #include "drape/bake/regions.h"
+#include "drape/bake/render_mesh.h"
 #include "drape/formats/asset_file.h"
 #include "drape/runtime/body_map_collider.h"
 #include "drape/runtime/hull_collider_set.h"
@@ -280,6 +281,25 @@ Status CheckRuntimeAccepts(const std::string& input, const CharacterAsset& asset
 }
 
 // Per-bone local maps, and per bone what the report lists: its part, axis choice, size.
+// The render mesh (render_mesh.h) into asset->render_mesh, and what it kept into
+// report["render_mesh"].
+Status BakeRenderMesh(const BakeConfig& config, const Character& character, CharacterAsset* asset,
+                      json* report) {
+  RenderMeshReport kept;
+  if (Status s = SimplifyRenderMesh(character.mesh, config.maps_render_tolerance,
+                                    &asset->render_mesh, &kept);
+      !s.ok())
+    return s;
+  (*report)["render_mesh"] = {{"kept", kept.kept},
+                              {"triangles", kept.kept_triangles},
+                              {"vertices", kept.kept_vertices},
+                              {"of_triangles", kept.triangles},
+                              {"error_mm", 1000.0 * kept.error},
+                              {"tolerance_mm", 1000.0 * config.maps_render_tolerance},
+                              {"attempts", kept.attempts}};
+  return Status::Ok();
+}
+
 Status BakeBoneMapStage(const BakeConfig& config, const Regions& regions,
                         const Character& character, CharacterAsset* asset, json* report) {
   std::vector<BoneMapStats> stats;
@@ -353,6 +373,12 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
       return failed(s);
     report["body_maps"] = maps;
     timings["maps_ms"] = MillisecondsSince(start);
+    if (config.maps_render_tolerance > 0.f) {
+      start = Clock::now();
+      if (Status s = BakeRenderMesh(config, character, &asset, &report["body_maps"]); !s.ok())
+        return failed(s);
+      timings["render_mesh_ms"] = MillisecondsSince(start);
+    }
   }
   if (config.bone_maps_enabled) {
     start = Clock::now();

@@ -52,6 +52,10 @@ struct BakeConfig {
   // Where maps_clip was named ("config.json: /maps/clip", a scene's "/animation/clip"; empty:
   // "/maps/clip"): the refusal of a clip the character lacks names it. Not a config key.
   std::string maps_clip_origin;
+  // Metres, [0, 0.1]: the render mesh (render_mesh.h) stays within this of the bind mesh; 0: none.
+  // 1 mm by default: a fifth of epsilon and of the 5-7 mm texels that meet the people's error
+  // targets at run time, where it keeps 25-55 % of their triangles (docs/ALGORITHMS.md §7.9).
+  float maps_render_tolerance = 0.001f;
 
   // Per-bone local maps (BakeBoneMaps): maps that follow any pose without rendering. Off by
   // default: the rest pose's maps render any pose at run time (BodyMapRenderer).

@@ -18,8 +18,8 @@ namespace drape {
 // 3: BodyMapPose class version 3 (depth layers: the slab and up to three air gaps per texel).
 // 4: HullColliderData class version 2 (internal planes). 5: CharacterAsset class version 2
 // (per-bone local maps). 6: CharacterAsset class version 3 (tapered capsules). 7: BodyMapPose
-// class version 4 (the view axis).
-inline constexpr uint32_t kAssetFormatVersion = 7;
+// class version 4 (the view axis). 8: CharacterAsset class version 4 (the render mesh).
+inline constexpr uint32_t kAssetFormatVersion = 8;
 // The oldest version the loader still reads (1: every class at version 1, body maps dense; the
 // loader reads every version from this one to kAssetFormatVersion).
 inline constexpr uint32_t kOldestAssetFormatVersion = 1;

@@ -32,6 +32,15 @@ struct CharacterAsset {
   std::vector<JointSphereData> joint_spheres;
   BoneMapSet bone_maps;  // per-bone local maps; empty unless the bake was asked for them
   std::vector<CapsuleColliderData> capsules;  // one per bone that carries skin (format 6)
+  // The bind mesh simplified for drawing body maps at run time (BodyMapRenderer): a subset of
+  // mesh's vertices with their influences, within the bake's maps.render_tolerance of its
+  // surface. Empty when the bake kept none (format 8; older files, or nothing to gain).
+  MeshData render_mesh;
 };
+
+// The mesh to render body maps from: the render mesh when the asset has one, else the bind mesh.
+inline const MeshData& RenderMeshOf(const CharacterAsset& asset) {
+  return asset.render_mesh.positions.empty() ? asset.mesh : asset.render_mesh;
+}
 
 }  // namespace drape

@@ -6,13 +6,15 @@
 // costs: docs/ALGORITHMS.md §7.9, docs/PERFORMANCE.md.
 //
 //   BodyMapRenderer renderer;
-//   renderer.Init(asset.mesh, {.texel_size = 0.002f, .epsilon = asset.body_maps.epsilon});
+//   renderer.Init(RenderMeshOf(asset), {.texel_size = 0.002f, .epsilon = asset.body_maps.epsilon});
 //   BodyMapCollider maps;
 //   renderer.Render(pose.skinning(), &maps, &garment_reach);  // per frame
 //   maps.CollideBatch(previous, positions, velocities, flags, params);
 //
-// Baked poses (BodyMapCollider::Build) stay exact for the poses a bake saw; both hold up to three
-// air gaps per texel (options.air_gaps).
+// RenderMeshOf(asset) is the bake's render mesh (the bind mesh simplified to within 1 mm, a
+// quarter to a half of a person's triangles) when the asset has one: the render costs less and
+// the maps move by at most that. Baked poses (BodyMapCollider::Build) stay exact for the poses a
+// bake saw; both hold up to three air gaps per texel (options.air_gaps).
 
 #include <cstddef>
 #include <cstdint>
