@@ -385,16 +385,9 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   // The renderer's per-texel entries are set by a texel's first fragment (its slab's top is
   // then still -inf) and read only where the slab is valid: not cleared here, where most of the
   // window is background.
-  top_face_.resize(texels);
-  bottom_face_.resize(texels);
-  maps->gap_layers_ = options_.air_gaps > 0 ? 1u : 0u;  // PublishGaps sets the deepest found
-  if (options_.air_gaps > 0) {
-    exit_z_.resize(texels);
-    lowest_entry_z_.resize(texels);
-    exit_face_.resize(texels);
-    fragment_count_.resize(texels);
-    fragment_cursor_.resize(texels);  // set by FindGaps
-  }
+  texel_raster_.resize(texels);
+  maps->gap_layers_ = options_.air_gaps > 0 ? 1u : 0u;         // PublishGaps sets the deepest found
+  if (options_.air_gaps > 0) fragment_cursor_.resize(texels);  // set by FindGaps
   maps->width_ = window.width;
   maps->height_ = window.height;
   maps->width_f_ = static_cast<float>(window.width);
@@ -410,13 +403,9 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
 }
 
 void BodyMapRenderer::Reserve(size_t texels) {
-  top_face_.reserve(texels);
-  bottom_face_.reserve(texels);
+  texel_raster_.reserve(texels);
   if (options_.air_gaps == 0) return;
-  exit_z_.reserve(texels);
-  lowest_entry_z_.reserve(texels);
-  for (std::vector<uint32_t>* v : {&exit_face_, &fragment_count_, &fragment_cursor_})
-    v->reserve(texels);
+  fragment_cursor_.reserve(texels);
   // Gap texels (rays crossing more than one part) on up to an eighth of the window, with four
   // surfaces each on average: a human has them on a few percent.
   const size_t gap_texels = texels / 8 + 1;
@@ -444,42 +433,38 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
   raster_.resize(std::max(raster_.size(), drawn));
   raster_count_ = detail::SetUpTriangles(offset_, mesh_->triangles.data(), drawn_, w, placed_,
                                          all_boxes_, raster_faces_, raster_boxes_, raster_);
-  // The per-texel arrays as plain pointers: the fragment writes through them, and the compiler
-  // would reload each vector's data pointer after every store.
-  uint32_t* top_face = top_face_.data();
-  uint32_t* bottom_face = bottom_face_.data();
-  uint32_t* fragment_count = fragment_count_.data();
-  float* exit_z = exit_z_.data();
-  uint32_t* exit_face = exit_face_.data();
-  float* lowest_entry_z = lowest_entry_z_.data();
+  // A plain pointer: the fragment writes through it, and the compiler would reload the vector's
+  // data pointer after every store.
+  TexelRaster* texel_raster = texel_raster_.data();
   detail::RasterizeInBands(
       RasterFaces(), RasterSetUps(), RasterBoxes(), w, nullptr,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool) {
         const float z = r.Depth(px, py);
         BodyMapCollider::Slab& s = slabs[k];
+        TexelRaster& e = texel_raster[k];
         if (gaps && s.top == -kInf) {  // the texel's first fragment (z is finite)
-          fragment_count[k] = 0;
-          exit_z[k] = -kInf;
-          exit_face[k] = kNoFace;
-          lowest_entry_z[k] = kInf;
+          e.fragment_count = 0;
+          e.exit_z = -kInf;
+          e.exit_face = kNoFace;
+          e.lowest_entry_z = kInf;
         }
         if (z > s.top) {
           s.top = z;
-          top_face[k] = t;
+          e.top_face = t;
         }
         if (z < s.bottom) {
           s.bottom = z;
-          bottom_face[k] = t;
+          e.bottom_face = t;
         }
         if (!gaps) return;
-        ++fragment_count[k];
+        ++e.fragment_count;
         // A surface leaving the body going along -z: a gap's upper boundary candidate.
-        if (!r.entering && z > exit_z[k]) {
-          exit_z[k] = z;
-          exit_face[k] = t;
+        if (!r.entering && z > e.exit_z) {
+          e.exit_z = z;
+          e.exit_face = t;
         }
         // A surface entering it: where none lies below the first candidate, no gap can.
-        if (r.entering && z < lowest_entry_z[k]) lowest_entry_z[k] = z;
+        if (r.entering && z < e.lowest_entry_z) e.lowest_entry_z = z;
       });
 }
 
@@ -509,8 +494,9 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
       normals[k] = background;
       return;
     }
-    const std::array<uint16_t, 2> a = EncodeOct16(shading_[top_face_[k]].At(px, py, kUp));
-    const std::array<uint16_t, 2> b = EncodeOct16(shading_[bottom_face_[k]].At(px, py, kDown));
+    const TexelRaster& e = texel_raster_[k];
+    const std::array<uint16_t, 2> a = EncodeOct16(shading_[e.top_face].At(px, py, kUp));
+    const std::array<uint16_t, 2> b = EncodeOct16(shading_[e.bottom_face].At(px, py, kDown));
     normals[k] = {{a[0], a[1]}, {b[0], b[1]}};
   };
   detail::ParallelFor(height, 8, [&](int64_t j) {
@@ -532,8 +518,8 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
       const detail::TriangleShading* back[4];
       for (uint32_t l = 0; l < 4; ++l) {
         const size_t texel = (covered >> l) & 1u ? k + l : any;
-        front[l] = &shading_[top_face_[texel]];
-        back[l] = &shading_[bottom_face_[texel]];
+        front[l] = &shading_[texel_raster_[texel].top_face];
+        back[l] = &shading_[texel_raster_[texel].bottom_face];
       }
       const __m128 px =
           _mm_add_ps(_mm_cvtepi32_ps(_mm_add_epi32(_mm_set1_epi32(static_cast<int32_t>(i)),
@@ -621,11 +607,10 @@ Status BodyMapRenderer::Load(const RenderedMapsView& view, BodyMapCollider* maps
 size_t BodyMapRenderer::memory_bytes() const {
   return sizeof(*this) +
          (vertex_triangle_offsets_.capacity() + vertex_triangles_.capacity() + drawn_.capacity() +
-          raster_faces_.capacity() + gap_triangles_.capacity() + top_face_.capacity() +
-          bottom_face_.capacity() + exit_face_.capacity() + fragment_count_.capacity() +
-          fragment_cursor_.capacity() + gap_texels_.capacity() + fragment_offsets_.capacity()) *
+          raster_faces_.capacity() + gap_triangles_.capacity() + fragment_cursor_.capacity() +
+          gap_texels_.capacity() + fragment_offsets_.capacity()) *
              sizeof(uint32_t) +
-         (exit_z_.capacity() + lowest_entry_z_.capacity()) * sizeof(float) +
+         texel_raster_.capacity() * sizeof(TexelRaster) +
          fragments_.capacity() * sizeof(GapFragment) + texel_gaps_.capacity() * sizeof(FoundGap) +
          gaps_per_texel_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *

@@ -76,11 +76,12 @@ void BodyMapRenderer::SelectGapTexels(const BodyMapCollider& maps, size_t texels
     if (!(slab.top >= slab.bottom)) continue;
     // A gap's lower boundary is a surface entering the body below its upper one, which lies at
     // or below the first candidate: none there, no gap (parts sunk into each other).
-    const bool room = exit_face_[k] != kNoFace && exit_z_[k] > slab.bottom + 2.f * kMinGap &&
-                      lowest_entry_z_[k] < exit_z_[k];
-    const uint32_t surfaces = fragment_count_[k];
+    const bool room = texel_raster_[k].exit_face != kNoFace &&
+                      texel_raster_[k].exit_z > slab.bottom + 2.f * kMinGap &&
+                      texel_raster_[k].lowest_entry_z < texel_raster_[k].exit_z;
+    const uint32_t surfaces = texel_raster_[k].fragment_count;
     if (!room || surfaces > kMaxSurfacesPerGapTexel || surfaces > kMaxGapFragments - total) {
-      fragment_count_[k] = 0;
+      texel_raster_[k].fragment_count = 0;
       continue;
     }
     gap_texels_.push_back(static_cast<uint32_t>(k));
@@ -105,7 +106,8 @@ void BodyMapRenderer::CollectGapFragments(const Window& window) {
   detail::RasterizeInBands(
       RasterFaces(), RasterSetUps(), RasterBoxes(), w, &gap_triangles_,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool once) {
-        uint32_t& left = fragment_count_[k];  // the same coverage as the raster pass counted
+        uint32_t& left =
+            texel_raster_[k].fragment_count;  // the same coverage as the raster pass counted
         if (left == 0) return;
         --left;
         const uint32_t flags = (r.entering ? kEnteringBit : 0u) | (once ? kCountsOnceBit : 0u);
@@ -123,8 +125,8 @@ uint32_t BodyMapRenderer::SearchTexelGaps(uint32_t candidate, BodyMapCollider* m
   const GapFragment* begin = fragments_.data() + fragment_offsets_[candidate];
   const GapFragment* end = fragments_.data() + fragment_offsets_[candidate + 1];
   BodyMapCollider::Slab& slab = maps->slabs_[k];
-  float upper = exit_z_[k];
-  uint32_t upper_face = exit_face_[k];
+  float upper = texel_raster_[k].exit_z;
+  uint32_t upper_face = texel_raster_[k].exit_face;
   uint32_t gaps = 0;
   for (uint32_t step = 0; step < 2 * options_.air_gaps; ++step) {
     // No room for a gap of kMinGap and its two boundaries above the back surface.
@@ -176,11 +178,11 @@ uint32_t BodyMapRenderer::SearchTexelGaps(uint32_t candidate, BodyMapCollider* m
       below = lower;
     } else if (bounded && !body_below) {
       slab.bottom = upper;  // below the air only a sliver: the slab's back is the air's top
-      bottom_face_[k] = upper_face;
+      texel_raster_[k].bottom_face = upper_face;
       break;
     } else if (bounded) {
       slab.top = lower;  // above the air only a sliver: the slab's front is the air's bottom
-      top_face_[k] = lower_face;
+      texel_raster_[k].top_face = lower_face;
       below = lower;
     } else if (balanced && enclosed) {
       below = upper;  // the next exit below this one may open the gap

@@ -189,15 +189,20 @@ class BodyMapRenderer {
   std::vector<detail::RasterBox> raster_boxes_;
   std::vector<detail::RasterTriangle> raster_;
   std::vector<detail::TriangleShading> shading_;  // per triangle; set for raster_faces_
-  std::vector<uint32_t> top_face_;                // per texel: the triangle of the front surface
-  std::vector<uint32_t> bottom_face_;             // per texel: the triangle of the back surface
-  // The gap search (air_gaps). Per texel, from the raster pass: the highest surface leaving the
-  // body going along -z (the first candidate upper boundary) and its triangle, and how many
-  // surfaces its ray crosses (then the fragments still to collect, 0 off the gap texels).
-  std::vector<float> exit_z_;
-  std::vector<float> lowest_entry_z_;  // per texel: the lowest surface entering the body
-  std::vector<uint32_t> exit_face_;
-  std::vector<uint32_t> fragment_count_;
+  // What the raster pass keeps per texel, in one place: a fragment touches one entry (and its
+  // slab), where seven arrays had it touch seven cache lines per texel row. 24 bytes.
+  struct TexelRaster {
+    uint32_t top_face;     // the triangle of the front surface
+    uint32_t bottom_face;  // the triangle of the back surface
+    // The gap search (air_gaps): the highest surface leaving the body going along -z (the first
+    // candidate upper boundary) and its triangle, the lowest surface entering the body, and how
+    // many surfaces the ray crosses (then the fragments still to collect, 0 off the gap texels).
+    float exit_z;
+    float lowest_entry_z;
+    uint32_t exit_face;
+    uint32_t fragment_count;
+  };
+  std::vector<TexelRaster> texel_raster_;   // per texel of the window
   std::vector<uint32_t> fragment_cursor_;   // per texel: where its next fragment goes
   std::vector<uint32_t> gap_texels_;        // texels where a gap may lie, ascending
   std::vector<uint32_t> fragment_offsets_;  // per gap texel: its fragments' start, and the end
