@@ -191,6 +191,16 @@ TEST(BakeConfig, MapsRenderTolerance) {
   EXPECT_EQ(config.maps_render_tolerance, 0.f) << "refused: nothing changes";
 }
 
+TEST(BakeConfig, MapsAssetBudget) {
+  BakeConfig config;
+  EXPECT_EQ(config.maps_asset_budget_mb, 8.f) << "8 MB by default";
+  ASSERT_TRUE(ApplyBakeConfig({{"maps", {{"asset_budget_mb", 0}}}}, "c.json", &config).ok());
+  EXPECT_EQ(config.maps_asset_budget_mb, 0.f) << "0: none";
+  const Status s = ApplyBakeConfig({{"maps", {{"asset_budget_mb", -2}}}}, "c.json", &config);
+  EXPECT_EQ(s.message().rfind("c.json: /maps/asset_budget_mb: -2 is out of range", 0), 0u)
+      << s.message();
+}
+
 TEST(NameSuggestions, IgnoreCaseAndThePrefixEveryNameShares) {
   using detail::NearestNames;
   // Game rigs prefix every joint: the prefix does not count, and neither does case.

@@ -411,6 +411,75 @@ TEST(BakePipeline, ReportCarriesTheContractFields) {
   EXPECT_TRUE(r["timings"].contains("render_mesh_ms"));
 }
 
+double EncodedBytes(const CharacterAsset& asset) {
+  std::vector<uint8_t> bytes;
+  EXPECT_TRUE(EncodeAsset(asset, &bytes).ok());
+  return static_cast<double>(bytes.size());
+}
+
+// maps.asset_budget_mb: over it, the maps are baked again at a resolution that fits, and the
+// report says from which to which; a budget the other sections alone exceed ends at N = 256 with
+// a warning naming the sizes; 0 keeps N.
+TEST(BakePipeline, TheAssetBudgetLowersTheMapsResolution) {
+  BakeConfig config;
+  config.hulls_enabled = false;
+  config.spheres_enabled = false;
+  BakeResult free;
+  config.maps_asset_budget_mb = 0.f;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &free).ok());
+  EXPECT_EQ(free.asset.body_maps.resolution, 1024u);
+  const double full = EncodedBytes(free.asset);
+  EXPECT_FALSE(free.report["size"].contains("maps_resolution"));
+
+  config.maps_asset_budget_mb = static_cast<float>(0.5 * full * 1e-6);
+  BakeResult fitted;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &fitted).ok());
+  const uint32_t n = fitted.asset.body_maps.resolution;
+  EXPECT_LT(n, 1024u);
+  EXPECT_GE(n, 256u);
+  EXPECT_LE(EncodedBytes(fitted.asset), 0.5 * full);
+  EXPECT_EQ(fitted.report["size"]["maps_resolution"]["from"].get<uint32_t>(), 1024u);
+  EXPECT_EQ(fitted.report["size"]["maps_resolution"]["to"].get<uint32_t>(), n);
+  EXPECT_EQ(fitted.report["body_maps"]["poses"][0]["resolution"].get<uint32_t>(), n);
+  EXPECT_TRUE(fitted.report["body_maps"].contains("render_mesh")) << "kept from the first bake";
+  EXPECT_TRUE(fitted.report["warnings"].empty()) << fitted.report["warnings"].dump();
+  EXPECT_LE(fitted.report["size"]["bytes"].get<double>(), 0.5 * full);
+
+  config.maps_asset_budget_mb = 0.1f;  // less than the mesh and clips alone
+  BakeResult over;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &over).ok());
+  EXPECT_EQ(over.asset.body_maps.resolution, 256u);
+  ASSERT_EQ(over.report["warnings"].size(), 1u);
+  const std::string warning = over.report["warnings"][0].get<std::string>();
+  EXPECT_NE(warning.find("over maps.asset_budget_mb (0.10 MB)"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("N = 256"), std::string::npos) << warning;
+}
+
+// The default bake of every shared character fits the 8 MB budget, whatever its size in its
+// file (RobotExpressive spans 4.5 m and has 190 convex pieces; at N = 1024 it took 11.7 MB).
+class SharedCharacterBudget : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SharedCharacterBudget, DefaultBakeFitsEightMegabytes) {
+  const std::string path = test::CharacterPath(GetParam());
+  DRAPE_REQUIRE_FILE(path);
+  BakeResult baked;
+  const Status s = BakeCharacter(path, BakeConfig{}, &baked);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_LE(EncodedBytes(baked.asset), 8e6);
+  EXPECT_GE(baked.asset.body_maps.resolution, 256u);
+  for (const auto& w : baked.report["warnings"])
+    EXPECT_EQ(w.get<std::string>().find("asset_budget_mb"), std::string::npos) << w;
+}
+
+INSTANTIATE_TEST_SUITE_P(Characters, SharedCharacterBudget,
+                         ::testing::Values("RobotExpressive/RobotExpressive.glb",
+                                           "QuaterniusAnimatedHuman/Animated_Human.fbx",
+                                           "QuaterniusSpider/Spider.fbx"),
+                         [](const ::testing::TestParamInfo<const char*>& param_info) {
+                           const std::string path = param_info.param;
+                           return test::CharacterTestName(path);
+                         });
+
 // maps.render_tolerance 0: no render mesh (the renderer draws the bind mesh); no maps, none either.
 TEST(BakePipeline, RenderToleranceZeroKeepsNoRenderMesh) {
   for (const bool maps : {true, false}) {

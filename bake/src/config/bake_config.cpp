@@ -67,6 +67,10 @@ const JsonSchema<BakeConfig>& MapsSection() {
                  "the asset's render mesh (the bind mesh simplified for drawing body maps at run "
                  "time) stays within this distance of the bind mesh, measured; 0: no render mesh",
                  [](BakeConfig& c) -> float& { return c.maps_render_tolerance; })
+          .Float("asset_budget_mb", "MB", Closed(0, 1e6),
+                 "the whole asset's size in MB (10^6 bytes) the bake keeps to by lowering the "
+                 "body maps' resolution (not below 256); over it even then, a warning; 0: none",
+                 [](BakeConfig& c) -> float& { return c.maps_asset_budget_mb; })
           .Enum<DepthEncoding>(
               "depth_encoding",
               {{"float32", DepthEncoding::kFloat32}, {"unorm16", DepthEncoding::kUnorm16}},

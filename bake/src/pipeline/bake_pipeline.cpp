@@ -280,7 +280,6 @@ Status CheckRuntimeAccepts(const std::string& input, const CharacterAsset& asset
   return Status::Ok();
 }
 
-// Per-bone local maps, and per bone what the report lists: its part, axis choice, size.
 // The render mesh (render_mesh.h) into asset->render_mesh, and what it kept into
 // report["render_mesh"].
 Status BakeRenderMesh(const BakeConfig& config, const Character& character, CharacterAsset* asset,
@@ -300,6 +299,7 @@ Status BakeRenderMesh(const BakeConfig& config, const Character& character, Char
   return Status::Ok();
 }
 
+// Per-bone local maps, and per bone what the report lists: its part, axis choice, size.
 Status BakeBoneMapStage(const BakeConfig& config, const Regions& regions,
                         const Character& character, CharacterAsset* asset, json* report) {
   std::vector<BoneMapStats> stats;
@@ -426,6 +426,14 @@ Status BakeCharacter(const std::string& input, const BakeConfig& config, BakeRes
     start = Clock::now();
     if (Status s = ApplySceneReach(*scene, &asset, &report); !s.ok()) return s;
     timings["reach_ms"] = MillisecondsSince(start);
+  }
+  if (config.maps_enabled) {
+    start = Clock::now();
+    if (Status s = detail::FitMapsToBudget(config, map_requests, regions, character, preview_dir,
+                                           &asset, &report);
+        !s.ok())
+      return failed(s);
+    timings["budget_ms"] = MillisecondsSince(start);
   }
   report["warnings"] = character.warnings;
 

@@ -9,6 +9,7 @@
 
 #include "body_map/map_error.h"
 #include "config/clip_lookup.h"
+#include "drape/formats/asset_file.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
 
@@ -190,6 +191,87 @@ Status BakeMapStage(const BakeConfig& config, std::span<const MapPoseRequest> re
         SampleMapError(regions.rest_positions, character.mesh.triangles);
     (*report)["expected_error"] =
         MapErrorToJson(MeasureMapError(asset->body_maps.poses[0], options.epsilon, samples));
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+// Bytes of the asset as the writer encodes it (0 when it does not encode: CheckRuntimeAccepts
+// says why later).
+double EncodedBytes(const CharacterAsset& asset) {
+  std::vector<uint8_t> bytes;
+  return EncodeAsset(asset, &bytes).ok() ? static_cast<double>(bytes.size()) : 0.0;
+}
+
+// Megabytes with two decimals, for messages.
+std::string Megabytes(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.2f MB", bytes * 1e-6);
+  return text;
+}
+
+}  // namespace
+
+Status FitMapsToBudget(const BakeConfig& config, std::span<const MapPoseRequest> requests,
+                       const Regions& regions, Character& character, const std::string& preview_dir,
+                       CharacterAsset* asset, json* report) {
+  const double budget = 1e6 * static_cast<double>(config.maps_asset_budget_mb);  // bytes
+  double bytes = EncodedBytes(*asset);
+  const uint32_t first = asset->body_maps.resolution;
+  for (int attempt = 0; attempt < 3 && budget > 0.0 && bytes > budget; ++attempt) {
+    // What the other sections take: the asset encoded without its poses.
+    std::vector<BodyMapPose> poses = std::move(asset->body_maps.poses);
+    asset->body_maps.poses.clear();
+    const double other = EncodedBytes(*asset);
+    asset->body_maps.poses = std::move(poses);
+    const double maps = bytes - other;
+    const uint32_t n = asset->body_maps.resolution;
+    if (!(maps > 0.0) || n <= kMinBudgetResolution) break;
+    // Bytes go with the texels, N^2; 3 % under, to a multiple of 16. The other sections alone
+    // over the budget: the least resolution, the nearest the asset gets.
+    const double scale = other < budget ? std::sqrt((budget - other) / maps) * 0.97 : 0.0;
+    const uint32_t next =
+        std::max(kMinBudgetResolution, static_cast<uint32_t>(n * scale) / 16u * 16u);
+    if (next >= n) break;
+    BakeConfig lower = config;
+    lower.maps.resolution = next;
+    lower.maps_max_error_mm = 0.f;  // the budget decides now (below)
+    if (!asset->body_maps.poses.empty()) lower.maps.layers = asset->body_maps.poses[0].layers;
+    json maps_report = {{"renderer", (*report)["body_maps"]["renderer"]}, {"poses", json::array()}};
+    asset->body_maps.poses.clear();
+    if (Status s =
+            BakeMapStage(lower, requests, regions, character, preview_dir, asset, &maps_report);
+        !s.ok())
+      return s;
+    for (const auto& [key, value] : (*report)["body_maps"].items())
+      if (!maps_report.contains(key)) maps_report[key] = value;  // render mesh, max_error
+    (*report)["body_maps"] = std::move(maps_report);
+    bytes = EncodedBytes(*asset);
+  }
+  const uint32_t last = asset->body_maps.resolution;
+  (*report)["size"] = {{"bytes", bytes}, {"budget_bytes", budget}};
+  if (last != first) {
+    (*report)["size"]["maps_resolution"] = {{"from", first}, {"to", last}};
+    if (config.maps_max_error_mm > 0.f) {
+      character.warnings.push_back(
+          "maps.max_error chose N = " + std::to_string(first) +
+          ", lowered to N = " + std::to_string(last) +
+          " to keep the asset within maps.asset_budget_mb (" + Megabytes(budget) +
+          "); the maps' expected error is the report's, at N = " + std::to_string(last));
+    }
+  }
+  if (budget > 0.0 && bytes > budget) {
+    std::vector<BodyMapPose> poses = std::move(asset->body_maps.poses);
+    asset->body_maps.poses.clear();
+    const double other = EncodedBytes(*asset);
+    asset->body_maps.poses = std::move(poses);
+    character.warnings.push_back(
+        "the asset takes " + Megabytes(bytes) + ", over maps.asset_budget_mb (" +
+        Megabytes(budget) + "): its " + std::to_string(asset->body_maps.poses.size()) +
+        " body-map poses at N = " + std::to_string(last) + " take " + Megabytes(bytes - other) +
+        " (N = " + std::to_string(kMinBudgetResolution) +
+        " at least), the rest (colliders, mesh, clips) " + Megabytes(other));
   }
   return Status::Ok();
 }

@@ -38,4 +38,14 @@ Status BakeMapStage(const BakeConfig& config, std::span<const MapPoseRequest> re
                     const Regions& regions, Character& character, const std::string& preview_dir,
                     CharacterAsset* asset, nlohmann::json* report);
 
+// maps.asset_budget_mb: the whole encoded asset against the budget (report["size"]). Over it,
+// the maps of every pose are baked again at the resolution that fits what the other sections
+// leave (never below kMinBudgetResolution; at it when they leave nothing), up to three times,
+// replacing report["body_maps"]'s poses; still over: a warning naming what takes the bytes.
+// 0: no budget.
+inline constexpr uint32_t kMinBudgetResolution = 256;
+Status FitMapsToBudget(const BakeConfig& config, std::span<const MapPoseRequest> requests,
+                       const Regions& regions, Character& character, const std::string& preview_dir,
+                       CharacterAsset* asset, nlohmann::json* report);
+
 }  // namespace drape::bake::detail

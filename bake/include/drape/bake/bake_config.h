@@ -56,6 +56,12 @@ struct BakeConfig {
   // 1 mm by default: a fifth of epsilon and of the 5-7 mm texels that meet the people's error
   // targets at run time, where it keeps 25-55 % of their triangles (docs/ALGORITHMS.md §7.9).
   float maps_render_tolerance = 0.001f;
+  // MB (10^6 bytes), >= 0; 0: none. The whole asset's budget: over it, the bake lowers the body
+  // maps' resolution until the asset fits (never below N = 256, where the people meet the
+  // speed-vs-error targets), and warns when it cannot. 8 MB: a character's share of a game's
+  // memory; a default bake of a person takes 3-5 MB, a robot of 190 convex pieces at N = 1024
+  // 11.7 MB.
+  float maps_asset_budget_mb = 8.f;
 
   // Per-bone local maps (BakeBoneMaps): maps that follow any pose without rendering. Off by
   // default: the rest pose's maps render any pose at run time (BodyMapRenderer).
