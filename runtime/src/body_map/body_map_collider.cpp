@@ -7,6 +7,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "drape/runtime/normal_encoding.h"
@@ -105,11 +106,19 @@ void BodyMapCollider::CountGapsBeforeWords() {
   }
 }
 
-void BodyMapCollider::Finish() {
-  FinishBounds();
+namespace {
+// Row j's texels that may be valid: [first, second) of `row_spans`, or the whole row.
+std::pair<size_t, size_t> RowSpan(std::span<const uint32_t> row_spans, size_t j, size_t width) {
+  if (row_spans.empty()) return {0, width};
+  return {row_spans[2 * j], row_spans[2 * j + 1]};
+}
+}  // namespace
+
+void BodyMapCollider::Finish(std::span<const uint32_t> row_spans) {
+  FinishBounds(row_spans);
   FinishBilinearBlocks();
-  FinishMinMaxBlocks();
-  FinishAirReach();
+  FinishMinMaxBlocks(row_spans);
+  FinishAirReach(row_spans);
 }
 
 // Per texel, the Chebyshev distance in texels to the nearest texel with air inside the grid's
@@ -119,7 +128,7 @@ void BodyMapCollider::Finish() {
 // look for (NearerSideExit). The distances along each row first, then down each column over
 // them, in place (the rows above a texel already hold their final values, so their row
 // distances wait in a small ring); no allocation once the grid's size was seen.
-void BodyMapCollider::FinishAirReach() {
+void BodyMapCollider::FinishAirReach(std::span<const uint32_t> row_spans) {
   const int64_t w = width_, h = height_;
   constexpr int kCap = kSideExitTexels + 1;
   air_reach_.resize(static_cast<size_t>(w * h));
@@ -127,15 +136,21 @@ void BodyMapCollider::FinishAirReach() {
   detail::ParallelFor(h, kFinishRowGrain, [&](int64_t j) {
     uint8_t* row = reach + j * w;
     const Slab* slab = slabs_.data() + j * w;
+    // Outside the row's span every texel is background (distance 0), and each end of the span
+    // borders background or the grid's edge, so the runs start there.
+    const auto [lo, hi] = RowSpan(row_spans, static_cast<size_t>(j), static_cast<size_t>(w));
+    const int64_t begin = static_cast<int64_t>(lo), end = static_cast<int64_t>(hi);
+    std::fill(row, row + begin, uint8_t{0});
+    std::fill(row + end, row + w, uint8_t{0});
     int run = 0;  // texels since the last one with air (the grid's edge is one)
-    for (int64_t i = 0; i < w; ++i) {
+    for (int64_t i = begin; i < end; ++i) {
       const bool solid =
           slab[i].top >= slab[i].bottom && !TexelHasGaps(static_cast<size_t>(j * w + i));
       run = solid ? std::min(run + 1, kCap) : 0;
       row[i] = static_cast<uint8_t>(run);
     }
     run = 0;
-    for (int64_t i = w - 1; i >= 0; --i) {
+    for (int64_t i = end - 1; i >= begin; --i) {
       run = row[i] == 0 ? 0 : std::min(run + 1, kCap);
       row[i] = static_cast<uint8_t>(std::min<int>(row[i], run));
     }
@@ -170,7 +185,7 @@ void BodyMapCollider::FinishAirReach() {
 
 // Marks the texels with gaps in their slabs' tops (WithGapFlag: the lanes read the flag from the
 // slab they load anyway), counts the valid texels, and sets the bounds and the clip box.
-void BodyMapCollider::FinishBounds() {
+void BodyMapCollider::FinishBounds(std::span<const uint32_t> row_spans) {
   const size_t w = width_, h = height_;
   // Row chunks on the workers, each with its own counts and bounds, joined in chunk order: the
   // same bits as one pass in row order (the first of equal z values kept, as std::min keeps it).
@@ -186,7 +201,8 @@ void BodyMapCollider::FinishBounds() {
   detail::ParallelRanges(static_cast<int64_t>(h), rows_per_chunk, [&](int64_t begin, int64_t end) {
     Partial& p = partials[begin / rows_per_chunk];
     for (size_t j = static_cast<size_t>(begin); j < static_cast<size_t>(end); ++j) {
-      for (size_t i = 0; i < w; ++i) {
+      const auto [lo, hi] = RowSpan(row_spans, j, w);
+      for (size_t i = lo; i < hi; ++i) {
         Slab& s = slabs_[j * w + i];
         if (!(s.top >= s.bottom)) continue;  // background: top -inf, no gaps, its low bit clear
         if (gap_layers_ != 0) s.top = WithGapFlag(s.top, TexelHasGaps(j * w + i) ? 1u : 0u);
@@ -287,7 +303,7 @@ void BodyMapCollider::FinishBilinearBlocks() {
 
 // The min/max level: 8x8 texel blocks, bounds over the block widened by one texel on each side,
 // padded by 10 um per metre of |z| (+ 10 um) against the float rounding of the walk's Z(s).
-void BodyMapCollider::FinishMinMaxBlocks() {
+void BodyMapCollider::FinishMinMaxBlocks(std::span<const uint32_t> row_spans) {
   const size_t w = width_, h = height_;
   blocks_w_ = static_cast<uint32_t>((w + kBlockTexels - 1) >> kBlockShift);
   blocks_h_ = static_cast<uint32_t>((h + kBlockTexels - 1) >> kBlockShift);
@@ -301,7 +317,8 @@ void BodyMapCollider::FinishMinMaxBlocks() {
       const size_t j_end = std::min(h, (bj + 1) * kBlockTexels + 1);
       float max_top = -kInf, min_bottom = kInf;
       for (size_t j = j_begin; j < j_end; ++j) {
-        for (size_t i = i_begin; i < i_end; ++i) {
+        const auto [lo, hi] = RowSpan(row_spans, j, w);
+        for (size_t i = std::max(i_begin, lo); i < std::min(i_end, hi); ++i) {
           const Slab& c = slabs_[j * w + i];
           if (!(c.top >= c.bottom)) continue;
           max_top = std::max(max_top, c.top);

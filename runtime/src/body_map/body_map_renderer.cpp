@@ -185,7 +185,7 @@ Status BodyMapRenderer::Render(std::span<const Mat34> skinning, BodyMapCollider*
     PublishGaps(window, maps);
   }
   ShadeNormals(window, maps);
-  maps->Finish();
+  maps->Finish(row_spans_);
   stats_.valid_texels = maps->stats().valid_texels;
   stats_.gap_texels = maps->stats().gap_texels;
   // The renderer's own buffers also grow with more gap texels or surfaces than reserved.
@@ -386,6 +386,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
   // then still -inf) and read only where the slab is valid: not cleared here, where most of the
   // window is background.
   texel_raster_.resize(texels);
+  row_spans_.resize(2 * static_cast<size_t>(window.height));
   maps->gap_layers_ = options_.air_gaps > 0 ? 1u : 0u;         // PublishGaps sets the deepest found
   if (options_.air_gaps > 0) fragment_cursor_.resize(texels);  // set by FindGaps
   maps->width_ = window.width;
@@ -404,6 +405,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
 
 void BodyMapRenderer::Reserve(size_t texels) {
   texel_raster_.reserve(texels);
+  row_spans_.reserve(2 * texels);  // more than any window of `texels` has rows
   if (options_.air_gaps == 0) return;
   fragment_cursor_.reserve(texels);
   // Gap texels (rays crossing more than one part) on up to an eighth of the window, with four
@@ -465,7 +467,8 @@ void BodyMapRenderer::Rasterize(const Window& window, BodyMapCollider* maps) {
         }
         // A surface entering it: where none lies below the first candidate, no gap can.
         if (r.entering && z < e.lowest_entry_z) e.lowest_entry_z = z;
-      });
+      },
+      row_spans_.data());
 }
 
 // Stage 5: the normal rule of every drawn triangle, then the outward normal of each covered
@@ -501,11 +504,16 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
   };
   detail::ParallelFor(height, 8, [&](int64_t j) {
     const float py = static_cast<float>(j) + 0.5f;
-    int64_t i = 0;
+    // Only the row's span can hold covered texels (RasterizeInBands); the rest is background.
+    const int64_t span_begin = std::min<int64_t>(row_spans_[2 * j], width);
+    const int64_t span_end = std::max<int64_t>(row_spans_[2 * j + 1], span_begin);
+    std::fill(normals + j * width, normals + j * width + span_begin, background);
+    std::fill(normals + j * width + span_end, normals + (j + 1) * width, background);
+    int64_t i = span_begin;
 #if defined(__SSE2__)
     // Four texels at a time, the same bits (texel_normal_lanes.h). A background lane borrows a
     // covered lane's triangles and is overwritten.
-    for (; i + 4 <= width; i += 4) {
+    for (; i + 4 <= span_end; i += 4) {
       const size_t k = static_cast<size_t>(j * width + i);
       uint32_t covered = 0;
       for (uint32_t l = 0; l < 4; ++l) covered |= valid(k + l) ? 1u << l : 0u;
@@ -541,7 +549,7 @@ void BodyMapRenderer::ShadeNormals(const Window& window, BodyMapCollider* maps) 
       }
     }
 #endif
-    for (; i < width; ++i) {
+    for (; i < span_end; ++i) {
       one_texel(static_cast<size_t>(j * width + i), static_cast<float>(i) + 0.5f, py);
     }
   });
@@ -610,7 +618,7 @@ size_t BodyMapRenderer::memory_bytes() const {
           raster_faces_.capacity() + gap_triangles_.capacity() + fragment_cursor_.capacity() +
           gap_texels_.capacity() + fragment_offsets_.capacity()) *
              sizeof(uint32_t) +
-         texel_raster_.capacity() * sizeof(TexelRaster) +
+         texel_raster_.capacity() * sizeof(TexelRaster) + row_spans_.capacity() * sizeof(uint32_t) +
          fragments_.capacity() * sizeof(GapFragment) + texel_gaps_.capacity() * sizeof(FoundGap) +
          gaps_per_texel_.capacity() +
          (posed_.capacity() + normals_.capacity() + offset_.capacity() + face_normals_.capacity()) *

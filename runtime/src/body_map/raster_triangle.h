@@ -308,11 +308,14 @@ inline void TrianglesOnTiles(std::span<const RasterBox> boxes, const TileMask& t
 // r.Depth(px, py) is its depth. Row bands run in parallel, each drawing every triangle that
 // crosses its rows, so a texel is handled by one band only, its triangles in order, whatever the
 // banding: a fragment may write texel k's entries without a lock and the result does not depend
-// on the thread count.
+// on the thread count. row_spans (optional, 2 per row of the window): each row's columns
+// [first, second) that the drawn triangles' boxes reach (empty: [width, 0)); no fragment lies
+// outside them.
 template <class Fragment>
 void RasterizeInBands(std::span<const uint32_t> faces, std::span<const RasterTriangle> set_up,
                       std::span<const RasterBox> boxes, const RasterWindow& w,
-                      const std::vector<uint32_t>* positions, Fragment&& fragment) {
+                      const std::vector<uint32_t>* positions, Fragment&& fragment,
+                      uint32_t* row_spans = nullptr) {
   // Balance, not results: four bands per worker, one without a second worker (each band scans
   // every triangle's box).
   const int64_t workers = GetTaskSystem().WorkerCount();
@@ -323,6 +326,10 @@ void RasterizeInBands(std::span<const uint32_t> faces, std::span<const RasterTri
   ParallelFor(band_count, 1, [&](int64_t band) {
     const int64_t row_begin = band * rows_per_band;
     const int64_t row_end = std::min(w.height, row_begin + rows_per_band);
+    for (int64_t j = row_begin; row_spans != nullptr && j < row_end; ++j) {
+      row_spans[2 * j] = static_cast<uint32_t>(w.width);
+      row_spans[2 * j + 1] = 0;
+    }
     for (size_t n = 0; n < count; ++n) {
       const size_t c = positions != nullptr ? (*positions)[n] : n;
       const RasterBox& b = boxes[c];
@@ -331,6 +338,10 @@ void RasterizeInBands(std::span<const uint32_t> faces, std::span<const RasterTri
       if (j_begin >= j_end) continue;
       DrawTriangleRows(faces[c], set_up[c], w, j_begin, j_end, b.left, int64_t{b.right} + 1,
                        fragment);
+      for (int64_t j = j_begin; row_spans != nullptr && j < j_end; ++j) {
+        row_spans[2 * j] = std::min(row_spans[2 * j], static_cast<uint32_t>(b.left));
+        row_spans[2 * j + 1] = std::max(row_spans[2 * j + 1], static_cast<uint32_t>(b.right) + 1);
+      }
     }
   });
 }

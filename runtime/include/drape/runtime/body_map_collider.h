@@ -273,12 +273,14 @@ class BodyMapCollider {
   bool BilinearBlock(int i0, int j0) const;  // block with texel (i0, j0) as its lower corner
   Float3 SampleNormal(int ci, int cj, float u, float v, bool back) const;
   // Recomputes bounds, the clip box, the valid count, bilinear eligibility, the min/max blocks
-  // and the gap flags from slabs_ (Build and sequence blending).
-  void Finish();
-  void FinishBounds();
+  // and the gap flags from slabs_ (Build and sequence blending). row_spans (optional, 2 per row:
+  // the renderer's): every texel of row j outside [row_spans[2j], row_spans[2j + 1]) is
+  // background, so the passes skip it.
+  void Finish(std::span<const uint32_t> row_spans = {});
+  void FinishBounds(std::span<const uint32_t> row_spans);
   void FinishBilinearBlocks();
-  void FinishMinMaxBlocks();
-  void FinishAirReach();
+  void FinishMinMaxBlocks(std::span<const uint32_t> row_spans);
+  void FinishAirReach(std::span<const uint32_t> row_spans);
   void CountGapsBeforeWords();  // gap_word_first_ from gap_texel_bits_
   void Clear();
 

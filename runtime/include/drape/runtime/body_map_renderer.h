@@ -202,7 +202,10 @@ class BodyMapRenderer {
     uint32_t exit_face;
     uint32_t fragment_count;
   };
-  std::vector<TexelRaster> texel_raster_;   // per texel of the window
+  std::vector<TexelRaster> texel_raster_;  // per texel of the window
+  // Per row of the window: the columns [first, second) the drawn triangles reach (the raster
+  // pass's); the passes after it treat the rest of the row as background.
+  std::vector<uint32_t> row_spans_;
   std::vector<uint32_t> fragment_cursor_;   // per texel: where its next fragment goes
   std::vector<uint32_t> gap_texels_;        // texels where a gap may lie, ascending
   std::vector<uint32_t> fragment_offsets_;  // per gap texel: its fragments' start, and the end
