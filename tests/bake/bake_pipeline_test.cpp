@@ -453,6 +453,20 @@ TEST(BakePipeline, TheAssetBudgetLowersTheMapsResolution) {
   const std::string warning = over.report["warnings"][0].get<std::string>();
   EXPECT_NE(warning.find("over maps.asset_budget_mb (0.10 MB)"), std::string::npos) << warning;
   EXPECT_NE(warning.find("N = 256"), std::string::npos) << warning;
+
+  // A resolution maps.max_error chose is lowered with a warning, its layers kept.
+  config.maps_max_error_mm = 0.5f;
+  BakeResult chosen;
+  ASSERT_TRUE(BakeCharacter(test::MannequinPath(), config, &chosen).ok());
+  const auto& max_error = chosen.report["body_maps"]["max_error"];
+  EXPECT_EQ(chosen.asset.body_maps.resolution, 256u);
+  EXPECT_LE(chosen.asset.body_maps.poses[0].layers, max_error["layers"].get<uint32_t>());
+  bool said = false;
+  for (const auto& w : chosen.report["warnings"])
+    said |= w.get<std::string>().find("maps.max_error chose N = " +
+                                      std::to_string(max_error["resolution"].get<uint32_t>()) +
+                                      ", lowered to N = 256") != std::string::npos;
+  EXPECT_TRUE(said) << chosen.report["warnings"].dump();
 }
 
 // The default bake of every shared character fits the 8 MB budget, whatever its size in its

@@ -294,6 +294,8 @@ Status BakeRenderMesh(const BakeConfig& config, const Character& character, Char
                               {"vertices", kept.kept_vertices},
                               {"of_triangles", kept.triangles},
                               {"error_mm", 1000.0 * kept.error},
+                              {"normal_turn_deg", kept.normal_turn_degrees},
+                              {"turned_vertices", kept.turned_vertices},
                               {"tolerance_mm", 1000.0 * config.maps_render_tolerance},
                               {"attempts", kept.attempts}};
   return Status::Ok();

@@ -204,6 +204,15 @@ double EncodedBytes(const CharacterAsset& asset) {
   return EncodeAsset(asset, &bytes).ok() ? static_cast<double>(bytes.size()) : 0.0;
 }
 
+// Bytes of the asset without its body-map poses: what the other sections take.
+double BytesBesideMaps(CharacterAsset* asset) {
+  std::vector<BodyMapPose> poses = std::move(asset->body_maps.poses);
+  asset->body_maps.poses.clear();
+  const double bytes = EncodedBytes(*asset);
+  asset->body_maps.poses = std::move(poses);
+  return bytes;
+}
+
 // Megabytes with two decimals, for messages.
 std::string Megabytes(double bytes) {
   char text[32];
@@ -220,11 +229,7 @@ Status FitMapsToBudget(const BakeConfig& config, std::span<const MapPoseRequest>
   double bytes = EncodedBytes(*asset);
   const uint32_t first = asset->body_maps.resolution;
   for (int attempt = 0; attempt < 3 && budget > 0.0 && bytes > budget; ++attempt) {
-    // What the other sections take: the asset encoded without its poses.
-    std::vector<BodyMapPose> poses = std::move(asset->body_maps.poses);
-    asset->body_maps.poses.clear();
-    const double other = EncodedBytes(*asset);
-    asset->body_maps.poses = std::move(poses);
+    const double other = BytesBesideMaps(asset);
     const double maps = bytes - other;
     const uint32_t n = asset->body_maps.resolution;
     if (!(maps > 0.0) || n <= kMinBudgetResolution) break;
@@ -237,7 +242,11 @@ Status FitMapsToBudget(const BakeConfig& config, std::span<const MapPoseRequest>
     BakeConfig lower = config;
     lower.maps.resolution = next;
     lower.maps_max_error_mm = 0.f;  // the budget decides now (below)
-    if (!asset->body_maps.poses.empty()) lower.maps.layers = asset->body_maps.poses[0].layers;
+    // The layers maps.max_error chose, else the configured ones (a pose holds only as many as
+    // the gaps it found).
+    const json& chosen = (*report)["body_maps"];
+    if (chosen.contains("max_error"))
+      lower.maps.layers = chosen["max_error"]["layers"].get<uint8_t>();
     json maps_report = {{"renderer", (*report)["body_maps"]["renderer"]}, {"poses", json::array()}};
     asset->body_maps.poses.clear();
     if (Status s =
@@ -262,10 +271,7 @@ Status FitMapsToBudget(const BakeConfig& config, std::span<const MapPoseRequest>
     }
   }
   if (budget > 0.0 && bytes > budget) {
-    std::vector<BodyMapPose> poses = std::move(asset->body_maps.poses);
-    asset->body_maps.poses.clear();
-    const double other = EncodedBytes(*asset);
-    asset->body_maps.poses = std::move(poses);
+    const double other = BytesBesideMaps(asset);
     character.warnings.push_back(
         "the asset takes " + Megabytes(bytes) + ", over maps.asset_budget_mb (" +
         Megabytes(budget) + "): its " + std::to_string(asset->body_maps.poses.size()) +

@@ -54,7 +54,8 @@ struct BakeConfig {
   std::string maps_clip_origin;
   // Metres, [0, 0.1]: the render mesh (render_mesh.h) stays within this of the bind mesh; 0: none.
   // 1 mm by default: a fifth of epsilon and of the 5-7 mm texels that meet the people's error
-  // targets at run time, where it keeps 25-55 % of their triangles (docs/ALGORITHMS.md §7.9).
+  // targets at run time, where it keeps 55-80 % of a person's triangles and a fifth of a dense
+  // mesh's (docs/ALGORITHMS.md §7.9).
   float maps_render_tolerance = 0.001f;
   // MB (10^6 bytes), >= 0; 0: none. The whole asset's budget: over it, the bake lowers the body
   // maps' resolution until the asset fits (never below N = 256, where the people meet the

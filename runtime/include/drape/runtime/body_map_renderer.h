@@ -11,9 +11,9 @@
 //   renderer.Render(pose.skinning(), &maps, &garment_reach);  // per frame
 //   maps.CollideBatch(previous, positions, velocities, flags, params);
 //
-// RenderMeshOf(asset) is the bake's render mesh (the bind mesh simplified to within 1 mm, a
-// quarter to a half of a person's triangles) when the asset has one: the render costs less and
-// the maps move by at most that. Baked poses (BodyMapCollider::Build) stay exact for the poses a
+// RenderMeshOf(asset) is the bake's render mesh (the bind mesh simplified to within 1 mm, about
+// half of a person's triangles, a fifth of a dense mesh's) when the asset has one: the render
+// costs less and the surface moves by at most that. Baked poses (BodyMapCollider::Build) stay exact for the poses a
 // bake saw; both hold up to three air gaps per texel (options.air_gaps).
 
 #include <cstddef>
@@ -190,7 +190,8 @@ class BodyMapRenderer {
   std::vector<detail::RasterTriangle> raster_;
   std::vector<detail::TriangleShading> shading_;  // per triangle; set for raster_faces_
   // What the raster pass keeps per texel, in one place: a fragment touches one entry (and its
-  // slab), where seven arrays had it touch seven cache lines per texel row. 24 bytes.
+  // slab), not a cache line per field (a body's triangle rows hold one or two fragments each).
+  // 24 bytes.
   struct TexelRaster {
     uint32_t top_face;     // the triangle of the front surface
     uint32_t bottom_face;  // the triangle of the back surface
