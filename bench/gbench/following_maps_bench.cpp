@@ -24,7 +24,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <map>
 #include <random>
 #include <vector>
 
@@ -36,42 +35,12 @@
 #include "drape/runtime/bone_map_collider.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
+#include "subdivided_mesh.h"
 #include "test_support.h"
 #include "workers.h"
 
 namespace drape {
 namespace {
-
-// Each triangle into four at its edges' midpoints; a midpoint takes the mean of its ends'
-// influences, so it skins between them.
-MeshData Subdivided(const MeshData& mesh) {
-  MeshData out = mesh;
-  out.triangles.clear();
-  std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
-  const auto midpoint = [&](uint32_t a, uint32_t b) {
-    const auto key = std::minmax(a, b);
-    const auto [it, added] = midpoints.try_emplace(key, out.vertex_count());
-    if (!added) return it->second;
-    out.positions.push_back((mesh.positions[a] + mesh.positions[b]) * 0.5f);
-    std::map<uint16_t, float> weights;
-    for (const uint32_t v : {a, b}) {
-      for (uint32_t k = mesh.influence_offsets[v]; k < mesh.influence_offsets[v + 1]; ++k)
-        weights[mesh.influence_joints[k]] += 0.5f * mesh.influence_weights[k];
-    }
-    for (const auto& [joint, weight] : weights) {
-      out.influence_joints.push_back(joint);
-      out.influence_weights.push_back(weight);
-    }
-    out.influence_offsets.push_back(static_cast<uint32_t>(out.influence_joints.size()));
-    return it->second;
-  };
-  for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
-    const uint32_t a = mesh.triangles[t], b = mesh.triangles[t + 1], c = mesh.triangles[t + 2];
-    const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-    out.triangles.insert(out.triangles.end(), {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca});
-  }
-  return out;
-}
 
 // The render mesh a default bake stores for `mesh`, or `mesh` when it keeps none.
 MeshData RenderMesh(const MeshData& mesh) {
@@ -110,7 +79,7 @@ const Scene& TheScene() {
       std::abort();
     s.meshes[0] = s.character.mesh;
     s.meshes[1] = RenderMesh(s.meshes[0]);
-    s.meshes[2] = Subdivided(s.meshes[0]);
+    s.meshes[2] = test::SubdividedMesh(s.meshes[0]);
     s.meshes[3] = RenderMesh(s.meshes[2]);
     float height = 0.f;
     for (const Float3& p : rest) height = std::max(height, p.y);
