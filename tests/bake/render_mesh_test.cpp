@@ -22,6 +22,7 @@
 #include "drape/runtime/math.h"
 #include "drape/runtime/skeleton_pose.h"
 #include "drape/runtime/skinning.h"
+#include "subdivided_mesh.h"
 #include "test_support.h"
 
 namespace drape::bake {
@@ -111,13 +112,23 @@ TEST(RenderMesh, TheMannequinKeepsUnderTwoThirdsWithinTheTolerance) {
 }
 
 TEST(RenderMesh, SharedCharactersStayWithinTheTolerance) {
-  for (const char* relative : {"CesiumMan/CesiumMan.glb", "Fox/Fox.glb"}) {
-    const std::string path = test::CharacterPath(relative);
-    DRAPE_REQUIRE_FILE(path);
-    SCOPED_TRACE(relative);
-    const Character c = Import(path);
-    ExpectWithinTolerance(c.mesh, kTolerance, 0.85);
-  }
+  const std::string path = test::CharacterPath("CesiumMan/CesiumMan.glb");
+  DRAPE_REQUIRE_FILE(path);
+  const Character c = Import(path);
+  ExpectWithinTolerance(c.mesh, kTolerance, 0.7);
+}
+
+// A mesh that simplifies little keeps nothing: the Fox (576 triangles) would keep 458, and its
+// maps at a pose between keys missed 0.34 % of the contacts instead of 0.01 %.
+TEST(RenderMesh, LittleToGainKeepsNone) {
+  const std::string path = test::CharacterPath("Fox/Fox.glb");
+  DRAPE_REQUIRE_FILE(path);
+  const Character c = Import(path);
+  MeshData render;
+  RenderMeshReport report;
+  ASSERT_TRUE(SimplifyRenderMesh(c.mesh, kTolerance, &render, &report).ok());
+  EXPECT_FALSE(report.kept);
+  EXPECT_TRUE(render.positions.empty());
 }
 
 // Low-poly bodies of flat faces (Quaternius' Animated_Human, RobotExpressive, the Spider), at a
@@ -174,26 +185,7 @@ TEST(RenderMesh, ADenseMeshSimplifiesToAboutTheCoarseOnesSize) {
   // Each mannequin triangle into four at its midpoints: the same surface with 4x the triangles
   // (a densely meshed game character). Its render mesh needs about as few as the coarse one's.
   const Character c = Import(test::MannequinPath());
-  MeshData dense = c.mesh;
-  dense.triangles.clear();
-  std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
-  const auto midpoint = [&](uint32_t a, uint32_t b) {
-    const auto [it, added] = midpoints.try_emplace(std::minmax(a, b), dense.vertex_count());
-    if (!added) return it->second;
-    dense.positions.push_back((c.mesh.positions[a] + c.mesh.positions[b]) * 0.5f);
-    for (uint32_t k = c.mesh.influence_offsets[a]; k < c.mesh.influence_offsets[a + 1]; ++k) {
-      dense.influence_joints.push_back(c.mesh.influence_joints[k]);
-      dense.influence_weights.push_back(c.mesh.influence_weights[k]);
-    }
-    dense.influence_offsets.push_back(static_cast<uint32_t>(dense.influence_joints.size()));
-    return it->second;
-  };
-  for (size_t t = 0; t < c.mesh.triangles.size(); t += 3) {
-    const uint32_t a = c.mesh.triangles[t], b = c.mesh.triangles[t + 1],
-                   d = c.mesh.triangles[t + 2];
-    const uint32_t ab = midpoint(a, b), bd = midpoint(b, d), da = midpoint(d, a);
-    dense.triangles.insert(dense.triangles.end(), {a, ab, da, ab, b, bd, da, bd, d, ab, bd, da});
-  }
+  const MeshData dense = test::SubdividedMesh(c.mesh);
   ExpectWithinTolerance(dense, kTolerance, 0.3);
 }
 

@@ -36,7 +36,7 @@ struct RenderMeshReport {
 // degrees within the distance, and its maps filled with false air gaps.) A result beyond either is
 // simplified again from the bind mesh at a target lowered by the overshoot, up to eight attempts in
 // all. *out is left empty (report->kept false) when no attempt met the tolerance or the result
-// keeps more than 90 % of the triangles: the renderer then draws the bind mesh. kInvalidArgument
+// keeps more than 70 % of the triangles: the renderer then draws the bind mesh. kInvalidArgument
 // for a tolerance that is not finite and > 0 or a mesh whose indices are out of range.
 Status SimplifyRenderMesh(const MeshData& mesh, float tolerance, MeshData* out,
                           RenderMeshReport* report);
