@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -64,20 +65,13 @@ MeshData KeepUsedVertices(const MeshData& mesh, std::span<const uint32_t> triang
   return out;
 }
 
-void ToDouble(Float3 p, double out[3]) {
-  out[0] = p.x;
-  out[1] = p.y;
-  out[2] = p.z;
-}
-
 // The largest distance from the samples of `from` (its vertices, its edge midpoints when
 // `midpoints`, its triangle centroids) to the surface `to`.
 double FarthestSample(const MeshData& from, const MeshReference& to, bool vertices,
                       bool midpoints) {
   double farthest = 0.0;
-  double q[3];
   const auto measure = [&](Float3 p) {
-    ToDouble(p, q);
+    const double q[3] = {p.x, p.y, p.z};
     farthest = std::max(farthest, to.Distance(q));
   };
   if (vertices) {

@@ -405,7 +405,7 @@ void BodyMapRenderer::Publish(const Window& window, BodyMapCollider* maps) {
 
 void BodyMapRenderer::Reserve(size_t texels) {
   texel_raster_.reserve(texels);
-  row_spans_.reserve(2 * texels);  // more than any window of `texels` has rows
+  row_spans_.reserve(2 * size_t{options_.max_side});  // a taller window is refused
   if (options_.air_gaps == 0) return;
   fragment_cursor_.reserve(texels);
   // Gap texels (rays crossing more than one part) on up to an eighth of the window, with four
