@@ -76,12 +76,12 @@ void BodyMapRenderer::SelectGapTexels(const BodyMapCollider& maps, size_t texels
     if (!(slab.top >= slab.bottom)) continue;
     // A gap's lower boundary is a surface entering the body below its upper one, which lies at
     // or below the first candidate: none there, no gap (parts sunk into each other).
-    const bool room = texel_raster_[k].exit_face != kNoFace &&
-                      texel_raster_[k].exit_z > slab.bottom + 2.f * kMinGap &&
-                      texel_raster_[k].lowest_entry_z < texel_raster_[k].exit_z;
-    const uint32_t surfaces = texel_raster_[k].fragment_count;
+    TexelRaster& e = texel_raster_[k];
+    const bool room = e.exit_face != kNoFace && e.exit_z > slab.bottom + 2.f * kMinGap &&
+                      e.lowest_entry_z < e.exit_z;
+    const uint32_t surfaces = e.fragment_count;
     if (!room || surfaces > kMaxSurfacesPerGapTexel || surfaces > kMaxGapFragments - total) {
-      texel_raster_[k].fragment_count = 0;
+      e.fragment_count = 0;
       continue;
     }
     gap_texels_.push_back(static_cast<uint32_t>(k));
@@ -106,8 +106,8 @@ void BodyMapRenderer::CollectGapFragments(const Window& window) {
   detail::RasterizeInBands(
       RasterFaces(), RasterSetUps(), RasterBoxes(), w, &gap_triangles_,
       [&](uint32_t t, const RasterTriangle& r, size_t k, double px, double py, bool once) {
-        uint32_t& left =
-            texel_raster_[k].fragment_count;  // the same coverage as the raster pass counted
+        // The same coverage as the raster pass counted.
+        uint32_t& left = texel_raster_[k].fragment_count;
         if (left == 0) return;
         --left;
         const uint32_t flags = (r.entering ? kEnteringBit : 0u) | (once ? kCountsOnceBit : 0u);
